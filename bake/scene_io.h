@@ -1,0 +1,48 @@
+// aggrelod bake: scene files in and out (glTF via tinygltf, stats JSON).
+// This is the only place that knows file formats; module/ sees plain meshes.
+#pragma once
+
+#include <aggrelod/aggregate3d.h>
+
+#include <string>
+#include <vector>
+
+namespace aggrelod::io {
+
+/// What one input object is.
+enum class ObjectUnit {
+    Node,    ///< every node with a mesh is one object (all its triangle primitives together)
+    Subtree  ///< every child of a scene root, with all meshes below it, is one object
+};
+
+struct SceneReadOptions {
+    std::string excludeRegex;            ///< ECMAScript regex; nodes whose name matches are left out (with their subtree)
+    ObjectUnit objectUnit = ObjectUnit::Node;
+};
+
+struct SceneReadResult {
+    std::vector<InputObject> objects;    ///< world-space triangles, ids = order of appearance
+    std::vector<Diagnostic> diagnostics; ///< skipped primitives, unknown extensions, ...
+};
+
+/// Reads a .glb or .gltf file. Returns false with a message in `error` when the file
+/// cannot be read at all (missing, truncated, not glTF). Never throws.
+bool readGltfScene(const std::string& path, const SceneReadOptions& options,
+                   SceneReadResult& out, std::string& error);
+
+/// Writes objects as a GLB, one node (with extras.id) per object. For samples and tests.
+bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string& path,
+                     std::string& error);
+
+/// Writes OUTDIR/levels.glb: one node per aggregate per level, grouped under one parent
+/// node per level; extras {level, delta, sources: [input object names]}.
+bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                    const std::string& path, std::string& error);
+
+/// Writes the stats JSON (see README "Stats file"). Timings are written last, in their
+/// own object, so determinism checks can drop them.
+bool writeStatsJson(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                    const std::vector<Diagnostic>& readDiagnostics, const std::string& path,
+                    std::string& error);
+
+}  // namespace aggrelod::io

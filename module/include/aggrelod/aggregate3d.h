@@ -1,0 +1,131 @@
+// aggrelod module: 3D aggregation of disjoint objects into a level-of-detail hierarchy.
+//
+// Implements "distance aggregation" (paper in shared/paper, Sections 3 and 4.4):
+// a constrained Delaunay tetrahedralization of the free space between objects gives a
+// neighbourhood graph; Kruskal merges give a dendrogram; at threshold delta the models
+// closer than delta form one group whose free-space tetrahedra are sculpted with an
+// aggregate function (constant = Eq. 1, adaptive = Eq. 2) into one watertight solid.
+//
+// Units: every length is in the input's world units (glTF: metres); volumes in units^3.
+// Arrays: positions are xyz triples (size 3 * vertexCount), indices are triangle
+// corner triples (size 3 * triangleCount), counter-clockwise seen from outside.
+// Determinism: the same objects (same order) and settings give bit-identical results.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace aggrelod {
+
+/// One input object: a closed, outward-oriented triangle mesh in world space.
+struct InputObject {
+    std::string name;                ///< shown in every diagnostic about this object
+    uint32_t id = 0;                 ///< caller's id, copied to outputs (sources)
+    std::vector<double> positions;   ///< 3 * vertexCount, world units
+    std::vector<uint32_t> indices;   ///< 3 * triangleCount
+};
+
+/// A problem found in the input or while baking. Never fatal unless severity is Error.
+struct Diagnostic {
+    enum class Severity { Note, Warning, Error };
+    Severity severity = Severity::Warning;
+    std::string object;   ///< object name(s) concerned; empty for scene-wide problems
+    std::string message;  ///< what is wrong and what was done about it
+};
+
+/// Which distance weights the neighbourhood graph (DESIGN 2.2).
+enum class DistanceMode {
+    Exact,  ///< exact mesh-to-mesh minimum distance (default)
+    Cdt     ///< shortest triangulation edge joining the models (the paper's choice)
+};
+
+/// Which aggregate function sculpts the fill (DESIGN 2.4, paper Eqs. 1 and 2).
+enum class AggregateFunctionKind {
+    Adaptive,  ///< F = 0.5 * (min(m1,m2) + sigma(m1,m2) + delta)
+    Constant   ///< F = delta
+};
+
+/// Inputs of an aggregate function for one exposed edge whose endpoints lie on models m1, m2.
+struct AggregateFunctionInput {
+    double delta = 0;            ///< level threshold
+    double minDistance = 0;      ///< minimum distance between m1 and m2 (0 when m1 == m2)
+    double sigma = 0;            ///< std deviation of free-space edge lengths joining m1, m2
+    double meanEdgeLength = 0;   ///< mean of those lengths
+    bool sameModel = false;      ///< m1 == m2
+};
+/// Pluggable aggregate function: returns the longest exposed edge length kept (world units).
+using AggregateFunction = std::function<double(const AggregateFunctionInput&)>;
+
+/// Built-in functions. Constant: paper Eq. 1. Adaptive: paper Eq. 2 (sigma documented in README).
+AggregateFunction makeAggregateFunction(AggregateFunctionKind kind);
+
+/// Progress report: stage name and fraction done in [0, 1]. Called from the baking thread.
+using ProgressCallback = std::function<void(const char* stage, double fraction)>;
+
+struct Settings3D {
+    std::vector<double> deltas;       ///< explicit thresholds (world units, ascending); empty = automatic
+    int automaticLevelCount = 8;      ///< number of automatic levels when deltas is empty
+    AggregateFunctionKind function = AggregateFunctionKind::Adaptive;
+    AggregateFunction customFunction; ///< overrides `function` when set
+    DistanceMode distance = DistanceMode::Exact;
+    double touchTolerance = -1;       ///< objects closer than this are one model; < 0: 1e-6 * scene diagonal
+    bool computeHullBaseline = true;  ///< convex hull of each group as a baseline measure
+    bool computeConstantBaseline = true; ///< also measure the constant function at the same groups
+    ProgressCallback progress;        ///< optional
+};
+
+/// Figures of a set of closed meshes.
+struct SolidMeasures {
+    double volume = 0;       ///< units^3
+    double area = 0;         ///< units^2
+    double sphericity = 0;   ///< pi^(1/3) (6V)^(2/3) / A of the total V and A; 1 for one sphere
+};
+
+/// One aggregate: the watertight proxy of one group of models at one level.
+struct Aggregate {
+    std::vector<double> positions;       ///< 3 * vertexCount
+    std::vector<uint32_t> indices;       ///< 3 * triangleCount, closed, edge-manifold, outward
+    std::vector<uint32_t> sourceObjects; ///< indices into the input object array, ascending
+    int componentCount = 0;              ///< connected shells in this aggregate
+    SolidMeasures measures;
+    double volumeOriginal = 0;           ///< sum of the source objects' volumes
+    double volumeHull = 0;               ///< convex hull of the group (0 when not computed)
+};
+
+struct Level {
+    double delta = 0;                 ///< threshold: models closer than delta are joined
+    std::vector<Aggregate> aggregates; ///< one per group, ordered by smallest source index
+    SolidMeasures measures;           ///< of all aggregates together
+    double volumeOriginal = 0;        ///< of all objects
+    double volumeHull = 0;            ///< sum of the groups' convex hull volumes
+    double volumeConstant = 0;        ///< total volume with the constant function (baseline)
+    size_t triangleCount = 0;
+};
+
+/// One Kruskal merge of the dendrogram.
+struct Merge {
+    double height = 0;          ///< graph edge weight (distance) that caused the merge
+    uint32_t modelA = 0, modelB = 0;
+};
+
+struct Hierarchy3D {
+    std::vector<Level> levels;               ///< ascending delta
+    std::vector<uint32_t> objectModel;       ///< per input object: its model (touching objects share one)
+    size_t modelCount = 0;
+    std::vector<Merge> merges;               ///< dendrogram, ascending height
+    SolidMeasures originals;                 ///< of all input objects
+    std::vector<Diagnostic> diagnostics;     ///< every problem found, in a deterministic order
+    std::vector<std::pair<std::string, double>> timings; ///< stage name -> seconds, in run order
+    size_t tetrahedronCount = 0;
+    size_t inputTriangleCount = 0;
+};
+
+/// Bakes the whole hierarchy.
+/// Returns false (with an Error diagnostic in out.diagnostics) when baking cannot go on:
+/// no usable object, or the triangulator failed beyond recovery. Never throws for bad input.
+bool buildHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings,
+                      Hierarchy3D& out);
+
+}  // namespace aggrelod

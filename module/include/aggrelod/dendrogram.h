@@ -1,0 +1,34 @@
+// Neighbourhood graph -> dendrogram -> levels (DESIGN 2.3; paper Section 3.2, Algorithm 1).
+// Shared by 2D and 3D: models are plain indices, weights are distances in world units.
+#pragma once
+
+#include <aggrelod/aggregate3d.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace aggrelod {
+
+/// One edge of the neighbourhood graph between models a and b (a != b).
+struct GraphEdge {
+    uint32_t a = 0, b = 0;
+    double weight = 0;  ///< distance between the models, world units
+};
+
+/// Kruskal merges: edges sorted by (weight, smaller id, larger id), merged with union-find.
+/// Returns the dendrogram's merges in ascending height (at most modelCount - 1).
+std::vector<Merge> kruskalMerges(size_t modelCount, std::vector<GraphEdge> edges);
+
+/// Groups at threshold delta: models joined by merges with height < delta.
+/// Returns, per model, its group index; groups are numbered 0.. in order of their smallest model.
+/// `groupCount` (optional) receives the number of groups.
+std::vector<uint32_t> groupsAtThreshold(size_t modelCount, const std::vector<Merge>& merges, double delta,
+                                        size_t* groupCount = nullptr);
+
+/// Automatic thresholds: `levelCount` targets on a geometric series between the smallest and
+/// largest merge height; each is moved to just above a merge height, so every level changes
+/// the grouping, the first joins the closest pair and the last joins every connected model.
+/// Returns ascending, distinct deltas (fewer than levelCount when there are fewer merges).
+std::vector<double> automaticDeltas(const std::vector<Merge>& merges, int levelCount);
+
+}  // namespace aggrelod

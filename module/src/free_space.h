@@ -1,0 +1,40 @@
+// The tetrahedralized scene shared by every level (DESIGN 2.1 and 2.2): which model owns
+// each vertex, which tets are free space, and the per-pair statistics of the neighbourhood
+// graph. Built once per bake; levels only read it.
+#pragma once
+
+#include "tetgen_backend.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace aggrelod::detail {
+
+/// Statistics of one neighbourhood-graph edge (a < b).
+struct ModelPair {
+    uint32_t a = 0, b = 0;
+    uint32_t edgeCount = 0;         ///< free-space triangulation edges joining a and b
+    double meanEdge = 0;            ///< mean of their lengths
+    double sigmaEdge = 0;           ///< population standard deviation of their lengths
+    double shortestEdge = 0;        ///< the paper's weight (cdt distance)
+    int shortestEdgeVertexA = -1;   ///< its endpoint on a (tet mesh vertex)
+    int shortestEdgeVertexB = -1;   ///< its endpoint on b
+    double exactDistance = 0;       ///< exact mesh-to-mesh minimum distance
+    double closestA[3] = {0, 0, 0}; ///< closest point on a
+    double closestB[3] = {0, 0, 0}; ///< closest point on b
+    double weight = 0;              ///< the one used for grouping (exact or cdt)
+};
+
+struct FreeSpace {
+    TetMesh mesh;
+    std::vector<int> vertexModel;   ///< per mesh vertex: owning model, -1 for Steiner points
+    std::vector<int> tetModel;      ///< per tet: -1 free space, else the model it lies inside
+    std::vector<double> tetVolume;  ///< per tet, units^3 (positive)
+    std::vector<ModelPair> pairs;   ///< sorted by (a, b)
+    size_t modelCount = 0;
+
+    /// Index into `pairs` of (a, b) in any order, or -1.
+    int findPair(uint32_t a, uint32_t b) const;
+};
+
+}  // namespace aggrelod::detail

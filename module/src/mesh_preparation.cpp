@@ -1,0 +1,265 @@
+// Input clean-up (DESIGN 2 and 5): exact weld, degenerate removal, finiteness check,
+// closedness / manifoldness / orientation analysis, inside-out repair per shell.
+#include "mesh_preparation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <tuple>
+
+namespace aggrelod::detail {
+namespace {
+
+void addDiagnostic(std::vector<Diagnostic>& out, Diagnostic::Severity severity, const std::string& object,
+                   const std::string& message) {
+    out.push_back(Diagnostic{severity, object, message});
+}
+
+double triangleArea(const double* a, const double* b, const double* c) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+struct UnionFind {
+    std::vector<uint32_t> parent;
+    explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+    uint32_t find(uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    }
+    void unite(uint32_t a, uint32_t b) {
+        a = find(a);
+        b = find(b);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+};
+
+}  // namespace
+
+void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint32_t>& triangles,
+                    double& volume, double& area) {
+    volume = 0;
+    area = 0;
+    for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+        const double* a = &positions[3 * triangles[t]];
+        const double* b = &positions[3 * triangles[t + 1]];
+        const double* c = &positions[3 * triangles[t + 2]];
+        volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                   a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+        area += triangleArea(a, b, c);
+    }
+}
+
+void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject& out,
+                   std::vector<Diagnostic>& diagnostics) {
+    out = PreparedObject{};
+    const std::string& name = object.name;
+    const size_t vertexCount = object.positions.size() / 3;
+    if (object.positions.size() % 3 != 0) {
+        addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                      "position array length is not a multiple of 3; object skipped");
+        return;
+    }
+    if (object.indices.size() % 3 != 0) {
+        addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                      "index array length is not a multiple of 3; object skipped");
+        return;
+    }
+    for (size_t i = 0; i < object.indices.size(); ++i) {
+        if (object.indices[i] >= vertexCount) {
+            addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                          "index out of range: triangle " + std::to_string(i / 3) + " uses vertex " +
+                              std::to_string(object.indices[i]) + " of " + std::to_string(vertexCount) +
+                              "; object skipped");
+            return;
+        }
+    }
+    for (size_t i = 0; i < object.positions.size(); ++i) {
+        if (!std::isfinite(object.positions[i])) {
+            addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                          std::string("coordinate is not finite (") + (std::isnan(object.positions[i]) ? "NaN" : "inf") +
+                              ") at vertex " + std::to_string(i / 3) + "; object skipped");
+            return;
+        }
+    }
+    if (object.indices.empty()) {
+        addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name, "has no triangles; object skipped");
+        return;
+    }
+
+    // Exact weld: sort vertices by position, merge equal ones (deterministic, no hashing).
+    std::vector<uint32_t> order(vertexCount);
+    std::iota(order.begin(), order.end(), 0u);
+    auto pos = [&](uint32_t v) {
+        return std::make_tuple(object.positions[3 * v], object.positions[3 * v + 1], object.positions[3 * v + 2]);
+    };
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return pos(a) < pos(b); });
+    std::vector<uint32_t> remap(vertexCount, 0);
+    std::vector<uint32_t> firstUse;  // welded vertex -> representative input vertex
+    for (size_t i = 0; i < order.size(); ++i) {
+        if (i == 0 || pos(order[i]) != pos(order[i - 1])) firstUse.push_back(order[i]);
+        remap[order[i]] = static_cast<uint32_t>(firstUse.size() - 1);
+    }
+    // Renumber welded vertices in order of first appearance in the index list (stable output).
+    std::vector<uint32_t> newIndex(firstUse.size(), UINT32_MAX);
+    uint32_t next = 0;
+    size_t degenerate = 0;
+    for (size_t t = 0; t < object.indices.size(); t += 3) {
+        uint32_t a = remap[object.indices[t]], b = remap[object.indices[t + 1]], c = remap[object.indices[t + 2]];
+        const double* pa = &object.positions[3 * firstUse[a]];
+        const double* pb = &object.positions[3 * firstUse[b]];
+        const double* pc = &object.positions[3 * firstUse[c]];
+        if (a == b || b == c || a == c || triangleArea(pa, pb, pc) <= areaEpsilon) {
+            ++degenerate;
+            continue;
+        }
+        for (uint32_t w : {a, b, c}) {
+            if (newIndex[w] == UINT32_MAX) {
+                newIndex[w] = next++;
+                const double* p = &object.positions[3 * firstUse[w]];
+                out.positions.insert(out.positions.end(), p, p + 3);
+            }
+            out.triangles.push_back(newIndex[w]);
+        }
+    }
+    if (degenerate > 0) {
+        addDiagnostic(diagnostics, Diagnostic::Severity::Note, name,
+                      "dropped " + std::to_string(degenerate) + " degenerate triangle(s)");
+    }
+    if (out.triangles.empty()) {
+        addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                      "has no non-degenerate triangles; object skipped");
+        return;
+    }
+    out.usable = true;
+    const size_t n = out.positions.size() / 3;
+    for (int k = 0; k < 3; ++k) {
+        out.bounds[k] = INFINITY;
+        out.bounds[3 + k] = -INFINITY;
+    }
+    for (size_t v = 0; v < n; ++v)
+        for (int k = 0; k < 3; ++k) {
+            out.bounds[k] = std::min(out.bounds[k], out.positions[3 * v + k]);
+            out.bounds[3 + k] = std::max(out.bounds[3 + k], out.positions[3 * v + k]);
+        }
+
+    // Edge analysis: directed edges sorted by (min, max, direction).
+    const size_t triCount = out.triangles.size() / 3;
+    struct HalfEdge {
+        uint32_t lo, hi, tri;
+        bool forward;  // lo -> hi
+    };
+    std::vector<HalfEdge> edges;
+    edges.reserve(out.triangles.size());
+    for (size_t t = 0; t < triCount; ++t)
+        for (int k = 0; k < 3; ++k) {
+            uint32_t a = out.triangles[3 * t + k], b = out.triangles[3 * t + (k + 1) % 3];
+            edges.push_back({std::min(a, b), std::max(a, b), static_cast<uint32_t>(t), a < b});
+        }
+    std::sort(edges.begin(), edges.end(), [](const HalfEdge& x, const HalfEdge& y) {
+        return std::tie(x.lo, x.hi, x.tri) < std::tie(y.lo, y.hi, y.tri);
+    });
+    size_t boundaryEdges = 0, nonManifoldEdges = 0, misoriented = 0;
+    UnionFind shells(triCount);
+    std::vector<std::array<uint32_t, 2>> manifoldPairs;  // triangle pairs sharing a 2-use edge
+    std::vector<bool> sameDirection;
+    for (size_t i = 0; i < edges.size();) {
+        size_t j = i;
+        while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+        const size_t uses = j - i;
+        if (uses == 1) ++boundaryEdges;
+        else if (uses > 2) ++nonManifoldEdges;
+        else {
+            shells.unite(edges[i].tri, edges[i + 1].tri);
+            manifoldPairs.push_back({edges[i].tri, edges[i + 1].tri});
+            sameDirection.push_back(edges[i].forward == edges[i + 1].forward);
+            if (edges[i].forward == edges[i + 1].forward) ++misoriented;
+        }
+        i = j;
+    }
+    out.closed = boundaryEdges == 0 && nonManifoldEdges == 0;
+    if (boundaryEdges > 0)
+        addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                      "open mesh: " + std::to_string(boundaryEdges) + " boundary edge(s)");
+    if (nonManifoldEdges > 0)
+        addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name,
+                      "non-manifold mesh: " + std::to_string(nonManifoldEdges) + " edge(s) used by more than two triangles");
+
+    if (out.closed && misoriented > 0) {
+        // Try to make orientation consistent per shell by propagation (BFS over triangle pairs).
+        std::vector<std::vector<std::pair<uint32_t, bool>>> adjacency(triCount);
+        for (size_t e = 0; e < manifoldPairs.size(); ++e) {
+            adjacency[manifoldPairs[e][0]].push_back({manifoldPairs[e][1], sameDirection[e]});
+            adjacency[manifoldPairs[e][1]].push_back({manifoldPairs[e][0], sameDirection[e]});
+        }
+        std::vector<int> flip(triCount, -1);
+        bool orientable = true;
+        for (size_t seed = 0; seed < triCount && orientable; ++seed) {
+            if (flip[seed] >= 0) continue;
+            flip[seed] = 0;
+            std::vector<uint32_t> stack{static_cast<uint32_t>(seed)};
+            while (!stack.empty() && orientable) {
+                uint32_t t = stack.back();
+                stack.pop_back();
+                for (auto [u, same] : adjacency[t]) {
+                    int want = flip[t] ^ (same ? 1 : 0);
+                    if (flip[u] < 0) {
+                        flip[u] = want;
+                        stack.push_back(u);
+                    } else if (flip[u] != want) {
+                        orientable = false;
+                        break;
+                    }
+                }
+            }
+        }
+        if (orientable) {
+            for (size_t t = 0; t < triCount; ++t)
+                if (flip[t] == 1) std::swap(out.triangles[3 * t + 1], out.triangles[3 * t + 2]);
+            misoriented = 0;
+            addDiagnostic(diagnostics, Diagnostic::Severity::Note, name,
+                          "inconsistent triangle orientation repaired");
+        } else {
+            addDiagnostic(diagnostics, Diagnostic::Severity::Warning, name, "mesh is not orientable");
+        }
+    }
+    out.consistent = out.closed && misoriented == 0;
+
+    if (out.consistent) {
+        // Orient every shell outward: a shell with negative signed volume is inside-out.
+        std::vector<double> shellVolume(triCount, 0.0);
+        for (size_t t = 0; t < triCount; ++t) {
+            const double* a = &out.positions[3 * out.triangles[3 * t]];
+            const double* b = &out.positions[3 * out.triangles[3 * t + 1]];
+            const double* c = &out.positions[3 * out.triangles[3 * t + 2]];
+            // relative to the object's min corner for accuracy
+            double ra[3], rb[3], rc[3];
+            for (int k = 0; k < 3; ++k) {
+                ra[k] = a[k] - out.bounds[k];
+                rb[k] = b[k] - out.bounds[k];
+                rc[k] = c[k] - out.bounds[k];
+            }
+            shellVolume[shells.find(static_cast<uint32_t>(t))] +=
+                (ra[0] * (rb[1] * rc[2] - rb[2] * rc[1]) - ra[1] * (rb[0] * rc[2] - rb[2] * rc[0]) +
+                 ra[2] * (rb[0] * rc[1] - rb[1] * rc[0])) / 6.0;
+        }
+        size_t flipped = 0;
+        for (size_t t = 0; t < triCount; ++t) {
+            if (shellVolume[shells.find(static_cast<uint32_t>(t))] < 0) {
+                std::swap(out.triangles[3 * t + 1], out.triangles[3 * t + 2]);
+                ++flipped;
+            }
+        }
+        if (flipped > 0)
+            addDiagnostic(diagnostics, Diagnostic::Severity::Note, name,
+                          "inside-out mesh: " + std::to_string(flipped) + " triangle(s) flipped to face outward");
+    }
+    meshVolumeArea(out.positions, out.triangles, out.volume, out.area);
+    if (!out.consistent) out.volume = std::fabs(out.volume);
+}
+
+}  // namespace aggrelod::detail

@@ -1,0 +1,34 @@
+// Input clean-up and validation of one object (DESIGN 2, "Bad input"): weld, drop
+// degenerate triangles, reject NaN/inf, detect open, non-manifold and inside-out meshes.
+#pragma once
+
+#include <aggrelod/aggregate3d.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace aggrelod::detail {
+
+struct PreparedObject {
+    std::vector<double> positions;    ///< 3 * n, welded (exactly equal positions merged)
+    std::vector<uint32_t> triangles;  ///< 3 * m, non-degenerate, oriented outward when possible
+    bool usable = false;      ///< has at least one triangle and only finite coordinates
+    bool closed = false;      ///< every edge used by exactly two triangles
+    bool consistent = false;  ///< every edge used once in each direction (orientable, oriented)
+    double volume = 0;        ///< enclosed volume when closed and consistent, units^3
+    double area = 0;          ///< units^2
+    double bounds[6] = {0, 0, 0, 0, 0, 0};  ///< min xyz, max xyz
+    /// A valid piece of the triangulation's input: closed, edge-manifold, consistently oriented.
+    bool validSolid() const { return usable && closed && consistent && volume > 0; }
+};
+
+/// Cleans one object. Problems go to `diagnostics`, each naming the object.
+/// `areaEpsilon`: triangles with area below it are dropped as degenerate (units^2).
+void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject& out,
+                   std::vector<Diagnostic>& diagnostics);
+
+/// Signed volume (divergence theorem) and area of a triangle mesh.
+void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint32_t>& triangles,
+                    double& volume, double& area);
+
+}  // namespace aggrelod::detail

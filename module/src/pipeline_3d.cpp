@@ -1,0 +1,678 @@
+// The 3D bake (DESIGN 2): prepare objects, group touching objects into models, triangulate
+// the free space once, build the neighbourhood graph and dendrogram, then shape and measure
+// every level from that one triangulation.
+#include "convex_hull.h"
+#include "free_space.h"
+#include "mesh_distance.h"
+#include "mesh_preparation.h"
+#include "sculpt_3d.h"
+#include "tetgen_backend.h"
+
+#include <aggrelod/aggregate3d.h>
+#include <aggrelod/dendrogram.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numeric>
+#include <set>
+#include <string>
+#include <tuple>
+
+namespace aggrelod {
+namespace {
+
+using detail::FreeSpace;
+using detail::ModelPair;
+using detail::PreparedObject;
+using detail::TriangleBvh;
+
+using Clock = std::chrono::steady_clock;
+
+struct StageTimer {
+    Hierarchy3D& out;
+    const ProgressCallback& progress;
+    Clock::time_point start = Clock::now();
+    std::string name;
+    StageTimer(Hierarchy3D& o, const ProgressCallback& p) : out(o), progress(p) {}
+    void begin(const std::string& stage) {
+        end();
+        name = stage;
+        start = Clock::now();
+        report(0.0);
+    }
+    void report(double fraction) const {
+        if (progress && !name.empty()) progress(name.c_str(), fraction);
+    }
+    void end() {
+        if (name.empty()) return;
+        report(1.0);
+        out.timings.emplace_back(name, std::chrono::duration<double>(Clock::now() - start).count());
+        name.clear();
+    }
+};
+
+std::string fmt(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+void diag(Hierarchy3D& out, Diagnostic::Severity s, const std::string& object, const std::string& message) {
+    out.diagnostics.push_back(Diagnostic{s, object, message});
+}
+
+struct DisjointSets {
+    std::vector<uint32_t> parent;
+    explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+    uint32_t find(uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    }
+    bool unite(uint32_t a, uint32_t b) {
+        a = find(a);
+        b = find(b);
+        if (a == b) return false;
+        parent[std::max(a, b)] = std::min(a, b);
+        return true;
+    }
+};
+
+/// A vertex of the neighbourhood graph: one object, or objects that touch.
+struct Model {
+    std::vector<uint32_t> objects;    ///< ascending input indices
+    bool standIn = false;             ///< surface is the convex hull of its objects
+    std::vector<double> positions;    ///< the surface given to the triangulator
+    std::vector<uint32_t> triangles;
+    TriangleBvh bvh;
+    double bounds[6];
+    double volumeOriginal = 0;
+    std::vector<double> hullPoints;   ///< convex hull vertices (for the hull baseline)
+};
+
+std::string objectNames(const std::vector<InputObject>& objects, const std::vector<uint32_t>& ids, size_t limit = 6) {
+    std::string s;
+    for (size_t i = 0; i < ids.size() && i < limit; ++i) s += (i ? ", " : "") + objects[ids[i]].name;
+    if (ids.size() > limit) s += ", ... (" + std::to_string(ids.size()) + " objects)";
+    return s;
+}
+
+void computeBounds(const std::vector<double>& p, double b[6]) {
+    for (int k = 0; k < 3; ++k) {
+        b[k] = INFINITY;
+        b[3 + k] = -INFINITY;
+    }
+    for (size_t i = 0; i + 2 < p.size(); i += 3)
+        for (int k = 0; k < 3; ++k) {
+            b[k] = std::min(b[k], p[i + k]);
+            b[3 + k] = std::max(b[3 + k], p[i + k]);
+        }
+}
+
+bool boxesOverlap(const double* a, const double* b, double pad) {
+    for (int k = 0; k < 3; ++k)
+        if (a[k] > b[3 + k] + pad || b[k] > a[3 + k] + pad) return false;
+    return true;
+}
+
+// Candidate pairs whose boxes overlap after padding, sorted (i < j), by sweep on x.
+template <class BoxOf>
+std::vector<std::pair<uint32_t, uint32_t>> overlappingPairs(size_t n, BoxOf boxOf, double pad) {
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return std::make_pair(boxOf(a)[0], a) < std::make_pair(boxOf(b)[0], b);
+    });
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    for (size_t i = 0; i < n; ++i) {
+        const double* a = boxOf(order[i]);
+        for (size_t j = i + 1; j < n; ++j) {
+            const double* b = boxOf(order[j]);
+            if (b[0] > a[3] + pad) break;
+            if (boxesOverlap(a, b, pad)) pairs.emplace_back(std::min(order[i], order[j]), std::max(order[i], order[j]));
+        }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+bool pointInsideConvex(const std::vector<double>& hp, const std::vector<uint32_t>& ht, const double* q) {
+    for (size_t t = 0; t + 2 < ht.size(); t += 3) {
+        const double* a = &hp[3 * ht[t]];
+        const double* b = &hp[3 * ht[t + 1]];
+        const double* c = &hp[3 * ht[t + 2]];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        if (n[0] * (q[0] - a[0]) + n[1] * (q[1] - a[1]) + n[2] * (q[2] - a[2]) > 0) return false;
+    }
+    return true;
+}
+
+SolidMeasures measuresOf(double volume, double area) {
+    SolidMeasures m;
+    m.volume = volume;
+    m.area = area;
+    m.sphericity = area > 0 ? std::cbrt(M_PI) * std::pow(6.0 * std::max(volume, 0.0), 2.0 / 3.0) / area : 0.0;
+    return m;
+}
+
+// ---------------------------------------------------------------------------------------
+
+class Baker {
+public:
+    Baker(const std::vector<InputObject>& objects, const Settings3D& settings, Hierarchy3D& out)
+        : objects_(objects), settings_(settings), out_(out), timer_(out, settings.progress) {}
+
+    bool run();
+
+private:
+    const std::vector<InputObject>& objects_;
+    const Settings3D& settings_;
+    Hierarchy3D& out_;
+    StageTimer timer_;
+    std::vector<PreparedObject> prepared_;
+    std::vector<Model> models_;
+    double diagonal_ = 0;
+    double tolerance_ = 0;
+    FreeSpace space_;
+    AggregateFunction function_;
+
+    bool prepare();
+    void buildModels();
+    void makeStandIn(Model& m, const std::string& why);
+    bool resolveStandInOverlaps();
+    bool triangulate();
+    void analyseFreeSpace(const std::vector<int>& pointModel);
+    void buildGraph();
+    void buildLevels();
+};
+
+bool Baker::prepare() {
+    timer_.begin("prepare");
+    out_.diagnostics.clear();
+    // Scene size from finite coordinates, for relative tolerances.
+    double b[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (const InputObject& o : objects_)
+        for (size_t i = 0; i + 2 < o.positions.size(); i += 3) {
+            if (!std::isfinite(o.positions[i]) || !std::isfinite(o.positions[i + 1]) || !std::isfinite(o.positions[i + 2])) continue;
+            for (int k = 0; k < 3; ++k) {
+                b[k] = std::min(b[k], o.positions[i + k]);
+                b[3 + k] = std::max(b[3 + k], o.positions[i + k]);
+            }
+        }
+    diagonal_ = b[0] <= b[3] ? std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2])) : 0.0;
+    tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal_;
+    const double areaEpsilon = 1e-14 * diagonal_ * diagonal_;
+    prepared_.resize(objects_.size());
+    size_t usable = 0;
+    for (size_t i = 0; i < objects_.size(); ++i) {
+        detail::prepareObject(objects_[i], areaEpsilon, prepared_[i], out_.diagnostics);
+        if (prepared_[i].usable) {
+            ++usable;
+            out_.inputTriangleCount += prepared_[i].triangles.size() / 3;
+            out_.originals.volume += prepared_[i].volume;
+            out_.originals.area += prepared_[i].area;
+        }
+        timer_.report(double(i + 1) / objects_.size());
+    }
+    out_.originals = measuresOf(out_.originals.volume, out_.originals.area);
+    if (usable == 0) {
+        diag(out_, Diagnostic::Severity::Error, "", objects_.empty() ? "the scene has no objects" : "no usable object in the scene");
+        return false;
+    }
+    return true;
+}
+
+void Baker::makeStandIn(Model& m, const std::string& why) {
+    std::vector<double> pts;
+    for (uint32_t o : m.objects) pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
+    m.standIn = true;
+    m.positions.clear();
+    m.triangles.clear();
+    if (!detail::convexHull3(pts, m.positions, m.triangles)) {
+        diag(out_, Diagnostic::Severity::Warning, objectNames(objects_, m.objects),
+             why + "; it is flat, has no convex hull with volume, and is left out");
+        m.objects.clear();
+        return;
+    }
+    diag(out_, Diagnostic::Severity::Warning, objectNames(objects_, m.objects),
+         why + "; stood in for by its convex hull in the triangulation");
+}
+
+void Baker::buildModels() {
+    timer_.begin("models");
+    const size_t n = objects_.size();
+    std::vector<TriangleBvh> bvh(n);
+    for (size_t i = 0; i < n; ++i)
+        if (prepared_[i].usable)
+            bvh[i].build(prepared_[i].positions.data(), prepared_[i].positions.size() / 3, prepared_[i].triangles.data(),
+                         prepared_[i].triangles.size() / 3);
+    std::vector<uint32_t> usable;
+    for (uint32_t i = 0; i < n; ++i)
+        if (prepared_[i].usable) usable.push_back(i);
+    auto pairs = overlappingPairs(usable.size(), [&](uint32_t k) { return prepared_[usable[k]].bounds; }, tolerance_);
+    DisjointSets sets(n);
+    for (size_t p = 0; p < pairs.size(); ++p) {
+        uint32_t i = usable[pairs[p].first], j = usable[pairs[p].second];
+        if (i > j) std::swap(i, j);
+        detail::ClosestPair cp = detail::meshDistance(bvh[i], bvh[j], tolerance_, tolerance_);
+        if (cp.distance <= tolerance_) {
+            sets.unite(i, j);
+            diag(out_, Diagnostic::Severity::Note, objects_[i].name + ", " + objects_[j].name,
+                 cp.intersecting ? "objects intersect; aggregated as one model from the start"
+                                 : "objects touch (distance " + fmt(cp.distance) + " <= tolerance " + fmt(tolerance_) +
+                                       "); aggregated as one model from the start");
+        }
+        if (p % 64 == 0) timer_.report(double(p) / std::max<size_t>(pairs.size(), 1));
+    }
+    std::map<uint32_t, size_t> modelOfRoot;
+    for (uint32_t i : usable) {
+        uint32_t r = sets.find(i);
+        auto it = modelOfRoot.find(r);
+        if (it == modelOfRoot.end()) {
+            it = modelOfRoot.emplace(r, models_.size()).first;
+            models_.emplace_back();
+        }
+        models_[it->second].objects.push_back(i);
+    }
+    for (Model& m : models_) {
+        for (uint32_t o : m.objects) m.volumeOriginal += prepared_[o].volume;
+        if (m.objects.size() == 1 && prepared_[m.objects[0]].validSolid()) {
+            m.positions = prepared_[m.objects[0]].positions;
+            m.triangles = prepared_[m.objects[0]].triangles;
+        } else if (m.objects.size() == 1) {
+            makeStandIn(m, "not a closed, consistently oriented solid");
+        } else {
+            makeStandIn(m, "touching or intersecting objects form one model");
+        }
+    }
+}
+
+// A convex-hull stand-in may reach into another model: merge them (and re-hull) until no
+// stand-in touches or contains another model.
+bool Baker::resolveStandInOverlaps() {
+    bool changed = false;
+    for (int round = 0; round < 64; ++round) {
+        models_.erase(std::remove_if(models_.begin(), models_.end(), [](const Model& m) { return m.objects.empty(); }),
+                      models_.end());
+        for (Model& m : models_) {
+            computeBounds(m.positions, m.bounds);
+            m.bvh.build(m.positions.data(), m.positions.size() / 3, m.triangles.data(), m.triangles.size() / 3);
+        }
+        auto pairs = overlappingPairs(models_.size(), [&](uint32_t k) { return models_[k].bounds; }, tolerance_);
+        DisjointSets sets(models_.size());
+        bool merged = false;
+        for (auto [i, j] : pairs) {
+            Model& a = models_[i];
+            Model& b = models_[j];
+            if (!a.standIn && !b.standIn) continue;
+            bool joins = detail::meshDistance(a.bvh, b.bvh, tolerance_, tolerance_).distance <= tolerance_;
+            if (!joins && a.standIn) joins = pointInsideConvex(a.positions, a.triangles, &b.positions[0]);
+            if (!joins && b.standIn) joins = pointInsideConvex(b.positions, b.triangles, &a.positions[0]);
+            if (joins) merged |= sets.unite(i, j);
+        }
+        if (!merged) return changed;
+        changed = true;
+        std::vector<Model> next;
+        std::map<uint32_t, size_t> at;
+        for (uint32_t i = 0; i < models_.size(); ++i) {
+            uint32_t r = sets.find(i);
+            if (r == i) {
+                at[i] = next.size();
+                next.push_back(std::move(models_[i]));
+            } else {
+                Model& dst = next[at[r]];
+                dst.objects.insert(dst.objects.end(), models_[i].objects.begin(), models_[i].objects.end());
+                dst.volumeOriginal += models_[i].volumeOriginal;
+                dst.standIn = false;  // re-hulled below
+            }
+        }
+        for (Model& m : next) {
+            std::sort(m.objects.begin(), m.objects.end());
+            if (!m.standIn && m.objects.size() > 1) makeStandIn(m, "a convex-hull stand-in reaches other objects; merged");
+        }
+        models_ = std::move(next);
+    }
+    return changed;
+}
+
+bool Baker::triangulate() {
+    timer_.begin("tetrahedralize");
+    for (int attempt = 0; attempt < 6; ++attempt) {
+        resolveStandInOverlaps();
+        // Model order: by smallest object index (deterministic).
+        std::sort(models_.begin(), models_.end(), [](const Model& a, const Model& b) { return a.objects[0] < b.objects[0]; });
+        detail::PlcInput plc;
+        std::vector<int> pointModel;
+        for (size_t m = 0; m < models_.size(); ++m) {
+            const int base = static_cast<int>(plc.points.size() / 3);
+            plc.points.insert(plc.points.end(), models_[m].positions.begin(), models_[m].positions.end());
+            pointModel.insert(pointModel.end(), models_[m].positions.size() / 3, static_cast<int>(m));
+            for (uint32_t idx : models_[m].triangles) plc.triangles.push_back(base + static_cast<int>(idx));
+            plc.triangleMarkers.insert(plc.triangleMarkers.end(), models_[m].triangles.size() / 3, static_cast<int>(m) + 1);
+        }
+        space_ = FreeSpace{};
+        detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
+        if (outcome.status == detail::TetgenStatus::Ok) {
+            space_.modelCount = models_.size();
+            analyseFreeSpace(pointModel);
+            return true;
+        }
+        if (outcome.status == detail::TetgenStatus::SelfIntersection) {
+            std::vector<int> markers;
+            detail::TetgenOutcome found = detail::findIntersectingFacets(plc, markers);
+            bool repaired = false;
+            if (found.status == detail::TetgenStatus::Ok) {
+                for (int marker : markers) {
+                    if (marker <= 0 || static_cast<size_t>(marker) > models_.size()) continue;
+                    Model& m = models_[marker - 1];
+                    if (!m.standIn) {
+                        makeStandIn(m, "self-intersecting surface");
+                        repaired = true;
+                    }
+                }
+            }
+            if (repaired) continue;
+        }
+        diag(out_, Diagnostic::Severity::Error, "",
+             std::string("tetrahedralization failed: ") + detail::tetgenStatusName(outcome.status) + " (" + outcome.message + ")");
+        return false;
+    }
+    diag(out_, Diagnostic::Severity::Error, "", "tetrahedralization failed after repeated repairs of intersecting input");
+    return false;
+}
+
+void Baker::analyseFreeSpace(const std::vector<int>& pointModel) {
+    detail::TetMesh& mesh = space_.mesh;
+    const size_t tetCount = mesh.tetCount();
+    // Make every tet positively oriented (the sculptor's face tables assume it).
+    space_.tetVolume.assign(tetCount, 0.0);
+    for (size_t t = 0; t < tetCount; ++t) {
+        const double* a = &mesh.points[3 * mesh.tets[4 * t]];
+        const double* b = &mesh.points[3 * mesh.tets[4 * t + 1]];
+        const double* c = &mesh.points[3 * mesh.tets[4 * t + 2]];
+        const double* d = &mesh.points[3 * mesh.tets[4 * t + 3]];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+        double vol = ((u[1] * v[2] - u[2] * v[1]) * w[0] + (u[2] * v[0] - u[0] * v[2]) * w[1] + (u[0] * v[1] - u[1] * v[0]) * w[2]) / 6.0;
+        if (vol < 0) {
+            std::swap(mesh.tets[4 * t + 2], mesh.tets[4 * t + 3]);
+            std::swap(mesh.neighbors[4 * t + 2], mesh.neighbors[4 * t + 3]);
+            vol = -vol;
+        }
+        space_.tetVolume[t] = vol;
+    }
+    // Vertex owners: input points by construction; Steiner points on a model's surface
+    // through the constrained faces they lie on.
+    space_.vertexModel.assign(mesh.pointCount(), -1);
+    for (size_t v = 0; v < pointModel.size() && v < mesh.pointCount(); ++v) space_.vertexModel[v] = pointModel[v];
+    for (size_t f = 0; f < mesh.boundaryMarkers.size(); ++f) {
+        int marker = mesh.boundaryMarkers[f];
+        if (marker <= 0) continue;
+        for (int k = 0; k < 3; ++k) {
+            int v = mesh.boundaryFaces[3 * f + k];
+            if (v >= 0 && static_cast<size_t>(v) < mesh.pointCount() && space_.vertexModel[v] < 0) space_.vertexModel[v] = marker - 1;
+        }
+    }
+    // Interior tets: flood each enclosed region from a tet that faces free space through a
+    // model's surface.
+    space_.tetModel.assign(tetCount, -1);
+    std::vector<int> stack;
+    for (size_t t = 0; t < tetCount; ++t) {
+        if (mesh.regions[t] == -1.0 || space_.tetModel[t] >= 0) continue;
+        int model = -1;
+        for (int j = 0; j < 4 && model < 0; ++j) {
+            // the face opposite corner j: if all three corners belong to one model, it is on it
+            int owners[3], k = 0;
+            for (int c = 0; c < 4; ++c)
+                if (c != j) owners[k++] = space_.vertexModel[mesh.tets[4 * t + c]];
+            if (owners[0] >= 0 && owners[0] == owners[1] && owners[1] == owners[2]) {
+                int n = mesh.neighbors[4 * t + j];
+                if (n < 0 || mesh.regions[n] == -1.0) model = owners[0];
+            }
+        }
+        if (model < 0) continue;
+        stack.push_back(static_cast<int>(t));
+        space_.tetModel[t] = model;
+        while (!stack.empty()) {
+            int s = stack.back();
+            stack.pop_back();
+            for (int j = 0; j < 4; ++j) {
+                int n = mesh.neighbors[4 * s + j];
+                if (n >= 0 && mesh.regions[n] != -1.0 && space_.tetModel[n] < 0 && mesh.regions[n] == mesh.regions[s]) {
+                    space_.tetModel[n] = model;
+                    stack.push_back(n);
+                }
+            }
+        }
+    }
+    for (size_t t = 0; t < tetCount; ++t)
+        if (mesh.regions[t] != -1.0 && space_.tetModel[t] < 0) {
+            // An enclosed region no model surface faces (should not happen); treat as free.
+            mesh.regions[t] = -1.0;
+        }
+    out_.tetrahedronCount = tetCount;
+}
+
+void Baker::buildGraph() {
+    timer_.begin("graph");
+    const detail::TetMesh& mesh = space_.mesh;
+    constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    std::vector<std::pair<int, int>> edges;
+    for (size_t t = 0; t < mesh.tetCount(); ++t) {
+        if (space_.tetModel[t] >= 0) continue;
+        for (auto& e : kEdges) {
+            int u = mesh.tets[4 * t + e[0]], v = mesh.tets[4 * t + e[1]];
+            int mu = space_.vertexModel[u], mv = space_.vertexModel[v];
+            if (mu < 0 || mv < 0 || mu == mv) continue;
+            edges.emplace_back(std::min(u, v), std::max(u, v));
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    // Accumulate per model pair (u on a, v on b, a < b).
+    struct Acc {
+        uint32_t a, b;
+        double length;
+        int u, v;
+    };
+    std::vector<Acc> accs;
+    accs.reserve(edges.size());
+    for (auto [u, v] : edges) {
+        int mu = space_.vertexModel[u], mv = space_.vertexModel[v];
+        if (mu > mv) {
+            std::swap(mu, mv);
+            std::swap(u, v);
+        }
+        const double* p = &mesh.points[3 * u];
+        const double* q = &mesh.points[3 * v];
+        double len = std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+        accs.push_back({static_cast<uint32_t>(mu), static_cast<uint32_t>(mv), len, u, v});
+    }
+    std::sort(accs.begin(), accs.end(), [](const Acc& x, const Acc& y) {
+        return std::tie(x.a, x.b, x.length, x.u, x.v) < std::tie(y.a, y.b, y.length, y.u, y.v);
+    });
+    space_.pairs.clear();
+    for (size_t i = 0; i < accs.size();) {
+        size_t j = i;
+        double sum = 0, sumSq = 0;
+        while (j < accs.size() && accs[j].a == accs[i].a && accs[j].b == accs[i].b) {
+            sum += accs[j].length;
+            sumSq += accs[j].length * accs[j].length;
+            ++j;
+        }
+        ModelPair p;
+        p.a = accs[i].a;
+        p.b = accs[i].b;
+        p.edgeCount = static_cast<uint32_t>(j - i);
+        p.meanEdge = sum / p.edgeCount;
+        p.sigmaEdge = std::sqrt(std::max(0.0, sumSq / p.edgeCount - p.meanEdge * p.meanEdge));
+        p.shortestEdge = accs[i].length;  // sorted by length within the pair
+        p.shortestEdgeVertexA = accs[i].u;
+        p.shortestEdgeVertexB = accs[i].v;
+        space_.pairs.push_back(p);
+        i = j;
+    }
+    // Exact distances between neighbouring models (BVH closest pair).
+    timer_.begin("distances");
+    for (Model& m : models_)
+        m.bvh.build(m.positions.data(), m.positions.size() / 3, m.triangles.data(), m.triangles.size() / 3);
+    for (size_t i = 0; i < space_.pairs.size(); ++i) {
+        ModelPair& p = space_.pairs[i];
+        const double* ua = &mesh.points[3 * p.shortestEdgeVertexA];
+        const double* ub = &mesh.points[3 * p.shortestEdgeVertexB];
+        std::copy(ua, ua + 3, p.closestA);
+        std::copy(ub, ub + 3, p.closestB);
+        p.exactDistance = p.shortestEdge;
+        detail::ClosestPair cp = detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
+        if (cp.triangleA != ~0u && cp.distance <= p.shortestEdge) {
+            p.exactDistance = cp.distance;
+            std::copy(cp.pointA, cp.pointA + 3, p.closestA);
+            std::copy(cp.pointB, cp.pointB + 3, p.closestB);
+        }
+        p.weight = settings_.distance == DistanceMode::Exact ? p.exactDistance : p.shortestEdge;
+        if (i % 64 == 0) timer_.report(double(i) / space_.pairs.size());
+    }
+}
+
+void Baker::buildLevels() {
+    timer_.begin("hierarchy");
+    std::vector<GraphEdge> graph;
+    for (const ModelPair& p : space_.pairs) graph.push_back(GraphEdge{p.a, p.b, p.weight});
+    out_.merges = kruskalMerges(models_.size(), graph);
+    std::vector<double> deltas = settings_.deltas;
+    if (deltas.empty()) {
+        deltas = automaticDeltas(out_.merges, settings_.automaticLevelCount);
+        if (deltas.empty()) {
+            deltas.push_back(0.0);
+            diag(out_, Diagnostic::Severity::Note, "",
+                 models_.size() == 1 ? "only one model: nothing to aggregate; the single level holds it alone"
+                                     : "no two models are neighbours: nothing to aggregate");
+        }
+    }
+    std::sort(deltas.begin(), deltas.end());
+    deltas.erase(std::unique(deltas.begin(), deltas.end()), deltas.end());
+
+    AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
+    const bool isConstant = !settings_.customFunction && settings_.function == AggregateFunctionKind::Constant;
+    timer_.begin("levels");
+    for (size_t li = 0; li < deltas.size(); ++li) {
+        Level level;
+        level.delta = deltas[li];
+        size_t groupCount = 0;
+        std::vector<uint32_t> modelGroup = groupsAtThreshold(models_.size(), out_.merges, level.delta, &groupCount);
+        detail::LevelShapeRequest request;
+        request.modelGroup = &modelGroup;
+        request.groupCount = groupCount;
+        request.delta = level.delta;
+        request.function = &function_;
+        request.distance = settings_.distance;
+        for (const Merge& m : out_.merges) {
+            if (!(m.height < level.delta)) break;
+            int p = space_.findPair(m.modelA, m.modelB);
+            if (p < 0) continue;
+            const ModelPair& pair = space_.pairs[p];
+            detail::ProtectedConnection c;
+            c.modelA = pair.a;
+            c.modelB = pair.b;
+            const double* pa = pair.closestA;
+            const double* pb = pair.closestB;
+            if (settings_.distance == DistanceMode::Cdt) {
+                pa = &space_.mesh.points[3 * pair.shortestEdgeVertexA];
+                pb = &space_.mesh.points[3 * pair.shortestEdgeVertexB];
+            }
+            std::copy(pa, pa + 3, c.pointA);
+            std::copy(pb, pb + 3, c.pointB);
+            request.connections.push_back(c);
+        }
+        std::vector<int> label;
+        detail::sculptLevel(space_, request, label);
+        std::vector<Aggregate> aggregates;
+        detail::extractSurfaces(space_, label, groupCount, aggregates);
+        for (size_t m = 0; m < models_.size(); ++m) {
+            Aggregate& agg = aggregates[modelGroup[m]];
+            agg.sourceObjects.insert(agg.sourceObjects.end(), models_[m].objects.begin(), models_[m].objects.end());
+            agg.volumeOriginal += models_[m].volumeOriginal;
+        }
+        double totalVolume = 0, totalArea = 0;
+        for (Aggregate& agg : aggregates) {
+            std::sort(agg.sourceObjects.begin(), agg.sourceObjects.end());
+            double v = 0, a = 0;
+            detail::meshVolumeArea(agg.positions, agg.indices, v, a);
+            agg.measures = measuresOf(v, a);
+            totalVolume += v;
+            totalArea += a;
+            level.triangleCount += agg.indices.size() / 3;
+        }
+        level.measures = measuresOf(totalVolume, totalArea);
+        level.volumeOriginal = out_.originals.volume;
+        if (settings_.computeHullBaseline) {
+            std::vector<std::vector<double>> groupPoints(groupCount);
+            for (size_t m = 0; m < models_.size(); ++m)
+                groupPoints[modelGroup[m]].insert(groupPoints[modelGroup[m]].end(), models_[m].hullPoints.begin(),
+                                                  models_[m].hullPoints.end());
+            for (size_t g = 0; g < groupCount; ++g) {
+                aggregates[g].volumeHull = detail::convexHullVolume(groupPoints[g]);
+                level.volumeHull += aggregates[g].volumeHull;
+            }
+        }
+        if (isConstant) {
+            level.volumeConstant = totalVolume;
+        } else if (settings_.computeConstantBaseline) {
+            detail::LevelShapeRequest constantRequest = request;
+            constantRequest.function = &constant;
+            std::vector<int> constantLabel;
+            detail::sculptLevel(space_, constantRequest, constantLabel);
+            for (size_t t = 0; t < constantLabel.size(); ++t)
+                if (constantLabel[t] >= 0) level.volumeConstant += space_.tetVolume[t];
+        }
+        level.aggregates = std::move(aggregates);
+        out_.levels.push_back(std::move(level));
+        timer_.report(double(li + 1) / deltas.size());
+    }
+}
+
+bool Baker::run() {
+    out_ = Hierarchy3D{};
+    function_ = settings_.customFunction ? settings_.customFunction : makeAggregateFunction(settings_.function);
+    if (!prepare()) {
+        timer_.end();
+        return false;
+    }
+    buildModels();
+    if (!triangulate()) {
+        timer_.end();
+        return false;
+    }
+    out_.modelCount = models_.size();
+    out_.objectModel.assign(objects_.size(), UINT32_MAX);
+    for (size_t m = 0; m < models_.size(); ++m) {
+        for (uint32_t o : models_[m].objects) out_.objectModel[o] = static_cast<uint32_t>(m);
+        std::vector<uint32_t> unusedTriangles;
+        std::vector<double> hullPositions;
+        if (detail::convexHull3(models_[m].positions, hullPositions, unusedTriangles)) models_[m].hullPoints = hullPositions;
+        else models_[m].hullPoints = models_[m].positions;
+    }
+    buildGraph();
+    buildLevels();
+    timer_.end();
+    return true;
+}
+
+}  // namespace
+
+bool buildHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, Hierarchy3D& out) {
+    try {
+        Baker baker(objects, settings, out);
+        return baker.run();
+    } catch (const std::exception& e) {
+        out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", std::string("internal error: ") + e.what()});
+        return false;
+    }
+}
+
+}  // namespace aggrelod

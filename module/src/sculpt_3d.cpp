@@ -1,0 +1,377 @@
+// Sculpting (DESIGN 2.4; paper Section 3.3 "Aggregated Approximation", 3D as Section 4.4)
+// and surface extraction of the aggregates.
+//
+// Step 1 drops free tets whose owned vertices belong to several groups (or to none).
+// Step 2 carves from the outside: a kept free tet with an exposed facet (on the hull or
+// facing a tet outside its group's solid) is removed when an edge of such a facet is
+// longer than F(m1, m2). Carving is monotone (removing a tet only exposes more), so the
+// result does not depend on visiting order; the queue is still processed longest edge
+// first, with the tet index as tie-break.
+// Step 4 keeps, for every pair joined at this level, a face-connected chain of tets from
+// one model's surface to the other's along the shortest connection (A* over tet
+// adjacency, Euclidean costs), so joined models always come out as one solid.
+#include "sculpt_3d.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <queue>
+#include <tuple>
+
+namespace aggrelod::detail {
+namespace {
+
+// Corners of the face opposite corner j, ordered so the normal points out of a
+// positively oriented tet.
+constexpr int kFaceCorners[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+double distance3(const double* a, const double* b) {
+    const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+struct Sculptor {
+    const FreeSpace& space;
+    const LevelShapeRequest& request;
+    std::vector<int>& label;
+    const TetMesh& mesh;
+    std::vector<char> isProtected;
+
+    Sculptor(const FreeSpace& s, const LevelShapeRequest& r, std::vector<int>& l)
+        : space(s), request(r), label(l), mesh(s.mesh) {}
+
+    const double* point(int v) const { return &mesh.points[3 * static_cast<size_t>(v)]; }
+
+    int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>((*request.modelGroup)[m]); }
+
+    // Step 1: object interiors take their model's group; a free tet takes the single group
+    // of its owned vertices, or -1.
+    void initialLabels() {
+        const size_t tetCount = mesh.tetCount();
+        label.assign(tetCount, -1);
+        for (size_t t = 0; t < tetCount; ++t) {
+            if (space.tetModel[t] >= 0) {
+                label[t] = groupOfModel(space.tetModel[t]);
+                continue;
+            }
+            int group = -1;
+            bool mixed = false;
+            for (int k = 0; k < 4; ++k) {
+                int g = groupOfModel(space.vertexModel[mesh.tets[4 * t + k]]);
+                if (g < 0) continue;
+                if (group < 0) group = g;
+                else if (g != group) mixed = true;
+            }
+            label[t] = mixed ? -1 : group;
+        }
+    }
+
+    bool isKeptFree(int t, int group) const { return t >= 0 && space.tetModel[t] < 0 && label[t] == group; }
+
+    double edgeLimit(int u, int v) const {
+        int mu = space.vertexModel[u], mv = space.vertexModel[v];
+        if (mu < 0) mu = mv;
+        if (mv < 0) mv = mu;
+        AggregateFunctionInput in;
+        in.delta = request.delta;
+        if (mu < 0 || mu == mv) {
+            in.sameModel = true;
+            return (*request.function)(in);
+        }
+        int p = space.findPair(static_cast<uint32_t>(mu), static_cast<uint32_t>(mv));
+        if (p < 0) {
+            in.sameModel = false;
+            return (*request.function)(in);
+        }
+        const ModelPair& pair = space.pairs[p];
+        in.minDistance = request.distance == DistanceMode::Exact ? pair.exactDistance : pair.shortestEdge;
+        in.sigma = pair.sigmaEdge;
+        in.meanEdgeLength = pair.meanEdge;
+        return (*request.function)(in);
+    }
+
+    // Longest exposed edge of tet t longer than its limit (0 if none).
+    double carvePriority(int t) const {
+        const int group = label[t];
+        double worst = 0;
+        for (int j = 0; j < 4; ++j) {
+            int n = mesh.neighbors[4 * t + j];
+            if (n >= 0 && label[n] == group) continue;  // facet not exposed
+            for (int e = 0; e < 3; ++e) {
+                int u = mesh.tets[4 * t + kFaceCorners[j][e]];
+                int v = mesh.tets[4 * t + kFaceCorners[j][(e + 1) % 3]];
+                double len = distance3(point(u), point(v));
+                if (len > worst && len > edgeLimit(u, v)) worst = len;
+            }
+        }
+        return worst;
+    }
+
+    // Step 4: face-connected chain of kept tets from model a's surface to model b's surface.
+    void protectConnection(const ProtectedConnection& c) {
+        const int group = groupOfModel(static_cast<int>(c.modelA));
+        if (group < 0 || group != groupOfModel(static_cast<int>(c.modelB))) return;
+        const size_t tetCount = mesh.tetCount();
+        auto centroid = [&](int t, double out[3]) {
+            out[0] = out[1] = out[2] = 0;
+            for (int k = 0; k < 4; ++k)
+                for (int d = 0; d < 3; ++d) out[d] += 0.25 * point(mesh.tets[4 * t + k])[d];
+        };
+        auto touchesModel = [&](int t, int model) {
+            for (int j = 0; j < 4; ++j) {
+                int n = mesh.neighbors[4 * t + j];
+                if (n >= 0 && space.tetModel[n] == model) return true;
+            }
+            return false;
+        };
+        // Sources: kept free tets with a facet on a's surface, found by scanning the
+        // interior tets of a (their free neighbours).
+        using Entry = std::tuple<double, double, int>;  // f = g + h, g, tet
+        std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+        std::vector<double>& best = scratchBest;
+        std::vector<int>& from = scratchFrom;
+        if (best.size() != tetCount) {
+            best.assign(tetCount, INFINITY);
+            from.assign(tetCount, -1);
+        }
+        std::vector<int>& touched = scratchTouched;
+        touched.clear();
+        const std::vector<int>& surfaceTets = modelSurfaceTets(static_cast<int>(c.modelA));
+        for (int t : surfaceTets) {
+            if (!isKeptFree(t, group)) continue;
+            double cen[3];
+            centroid(t, cen);
+            double g = distance3(cen, c.pointA);
+            if (g < best[t]) {
+                if (best[t] == INFINITY) touched.push_back(t);
+                best[t] = g;
+                from[t] = -1;
+                open.emplace(g + distance3(cen, c.pointB), g, t);
+            }
+        }
+        int reached = -1;
+        size_t expansions = 0;
+        while (!open.empty()) {
+            auto [f, g, t] = open.top();
+            open.pop();
+            if (g > best[t]) continue;
+            if (touchesModel(t, static_cast<int>(c.modelB))) {
+                reached = t;
+                break;
+            }
+            if (++expansions > 4 * tetCount + 16) break;  // cannot happen; guards against a hang
+            double ct[3];
+            centroid(t, ct);
+            for (int j = 0; j < 4; ++j) {
+                int n = mesh.neighbors[4 * t + j];
+                if (!isKeptFree(n, group)) continue;
+                double cn[3];
+                centroid(n, cn);
+                double gn = g + distance3(ct, cn);
+                if (gn < best[n]) {
+                    if (best[n] == INFINITY) touched.push_back(n);
+                    best[n] = gn;
+                    from[n] = t;
+                    open.emplace(gn + distance3(cn, c.pointB), gn, n);
+                }
+            }
+        }
+        for (int t = reached; t >= 0; t = from[t]) isProtected[t] = 1;
+        for (int t : touched) {
+            best[t] = INFINITY;
+            from[t] = -1;
+        }
+    }
+
+    std::vector<double> scratchBest;
+    std::vector<int> scratchFrom, scratchTouched;
+    std::vector<std::vector<int>> surfaceTetsOfModel;
+    bool surfaceTetsBuilt = false;
+
+    const std::vector<int>& modelSurfaceTets(int model) {
+        if (!surfaceTetsBuilt) {
+            surfaceTetsOfModel.assign(space.modelCount, {});
+            for (size_t t = 0; t < mesh.tetCount(); ++t) {
+                if (space.tetModel[t] >= 0) continue;
+                for (int j = 0; j < 4; ++j) {
+                    int n = mesh.neighbors[4 * t + j];
+                    if (n >= 0 && space.tetModel[n] >= 0) {
+                        auto& list = surfaceTetsOfModel[space.tetModel[n]];
+                        if (list.empty() || list.back() != static_cast<int>(t)) list.push_back(static_cast<int>(t));
+                    }
+                }
+            }
+            surfaceTetsBuilt = true;
+        }
+        return surfaceTetsOfModel[model];
+    }
+
+    void carve() {
+        const size_t tetCount = mesh.tetCount();
+        using Entry = std::pair<double, int>;  // priority (longest bad edge), -tet for tie-break
+        auto cmp = [](const Entry& x, const Entry& y) {
+            if (x.first != y.first) return x.first < y.first;  // max-heap on length
+            return x.second > y.second;                        // then smaller tet first
+        };
+        std::priority_queue<Entry, std::vector<Entry>, decltype(cmp)> queue(cmp);
+        for (size_t t = 0; t < tetCount; ++t) {
+            if (space.tetModel[t] >= 0 || label[t] < 0 || isProtected[t]) continue;
+            double p = carvePriority(static_cast<int>(t));
+            if (p > 0) queue.emplace(p, static_cast<int>(t));
+        }
+        while (!queue.empty()) {
+            auto [p, t] = queue.top();
+            queue.pop();
+            if (label[t] < 0) continue;  // already removed
+            const int group = label[t];
+            label[t] = -1;
+            for (int j = 0; j < 4; ++j) {
+                int n = mesh.neighbors[4 * t + j];
+                if (!isKeptFree(n, group) || isProtected[n]) continue;
+                double pn = carvePriority(n);
+                if (pn > 0) queue.emplace(pn, n);
+            }
+        }
+    }
+};
+
+}  // namespace
+
+int FreeSpace::findPair(uint32_t a, uint32_t b) const {
+    if (a > b) std::swap(a, b);
+    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(a, b),
+                               [](const ModelPair& p, const std::pair<uint32_t, uint32_t>& key) {
+                                   return std::tie(p.a, p.b) < std::tie(key.first, key.second);
+                               });
+    if (it == pairs.end() || it->a != a || it->b != b) return -1;
+    return static_cast<int>(it - pairs.begin());
+}
+
+void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel) {
+    Sculptor sculptor(space, request, tetLabel);
+    sculptor.initialLabels();
+    sculptor.isProtected.assign(space.mesh.tetCount(), 0);
+    for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
+    sculptor.carve();
+}
+
+// ---- surface extraction ----------------------------------------------------------------
+
+namespace {
+struct Corners {
+    std::vector<uint32_t> parent;
+    uint32_t find(uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    }
+    void unite(uint32_t a, uint32_t b) {
+        a = find(a);
+        b = find(b);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+};
+}  // namespace
+
+void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size_t groupCount,
+                     std::vector<Aggregate>& aggregates) {
+    const TetMesh& mesh = space.mesh;
+    const size_t tetCount = mesh.tetCount();
+    aggregates.resize(groupCount);
+    // Surface faces per group: (tet, face) with the tet in the group's solid and the
+    // neighbour outside it.
+    std::vector<std::vector<std::pair<int, int>>> faces(groupCount);
+    for (size_t t = 0; t < tetCount; ++t) {
+        const int g = label[t];
+        if (g < 0) continue;
+        for (int j = 0; j < 4; ++j) {
+            int n = mesh.neighbors[4 * t + j];
+            if (n < 0 || label[n] != g) faces[g].emplace_back(static_cast<int>(t), j);
+        }
+    }
+    std::vector<int> faceIndexOf(4 * tetCount, -1);
+    for (size_t g = 0; g < groupCount; ++g) {
+        const auto& list = faces[g];
+        Aggregate& agg = aggregates[g];
+        agg.positions.clear();
+        agg.indices.clear();
+        agg.componentCount = 0;
+        if (list.empty()) continue;
+        for (size_t f = 0; f < list.size(); ++f) faceIndexOf[4 * list[f].first + list[f].second] = static_cast<int>(f);
+        auto vertexAt = [&](int t, int corner) { return mesh.tets[4 * t + corner]; };
+        auto localCorner = [&](int t, int v) {
+            for (int k = 0; k < 4; ++k)
+                if (mesh.tets[4 * t + k] == v) return k;
+            return -1;
+        };
+        Corners corners;
+        corners.parent.resize(3 * list.size());
+        std::iota(corners.parent.begin(), corners.parent.end(), 0u);
+        Corners shells;
+        shells.parent.resize(list.size());
+        std::iota(shells.parent.begin(), shells.parent.end(), 0u);
+        for (size_t f = 0; f < list.size(); ++f) {
+            const auto [t0, j0] = list[f];
+            for (int e = 0; e < 3; ++e) {
+                const int u = vertexAt(t0, kFaceCorners[j0][e]);
+                const int v = vertexAt(t0, kFaceCorners[j0][(e + 1) % 3]);
+                // Rotate around edge uv through the group's solid tets until leaving it.
+                int t = t0;
+                int lu = localCorner(t, u), lv = localCorner(t, v);
+                int cross = 6 - lu - lv - j0;  // the other face of t containing uv
+                int twinFace = -1;
+                for (int guard = 0; guard < 4096; ++guard) {
+                    int n = mesh.neighbors[4 * t + cross];
+                    if (n < 0 || label[n] != static_cast<int>(g)) {
+                        twinFace = faceIndexOf[4 * t + cross];
+                        break;
+                    }
+                    // Enter n through the face shared with t.
+                    int entered = -1;
+                    for (int k = 0; k < 4; ++k)
+                        if (mesh.neighbors[4 * n + k] == t) {
+                            // the shared face must contain u and v
+                            int a = localCorner(n, u), b = localCorner(n, v);
+                            if (a >= 0 && b >= 0 && k != a && k != b) entered = k;
+                        }
+                    if (entered < 0) break;
+                    t = n;
+                    lu = localCorner(t, u);
+                    lv = localCorner(t, v);
+                    cross = 6 - lu - lv - entered;
+                }
+                if (twinFace < 0) continue;  // cannot happen on a valid mesh
+                // In the twin face the edge runs v -> u: join the corners at u and at v.
+                const auto [t1, j1] = list[twinFace];
+                for (int e1 = 0; e1 < 3; ++e1) {
+                    int c = vertexAt(t1, kFaceCorners[j1][e1]);
+                    if (c == u) corners.unite(static_cast<uint32_t>(3 * f + e), static_cast<uint32_t>(3 * twinFace + e1));
+                    if (c == v) corners.unite(static_cast<uint32_t>(3 * f + (e + 1) % 3), static_cast<uint32_t>(3 * twinFace + e1));
+                }
+                shells.unite(static_cast<uint32_t>(f), static_cast<uint32_t>(twinFace));
+            }
+        }
+        // One output vertex per corner class, numbered by first use.
+        std::vector<uint32_t> outIndex(3 * list.size(), UINT32_MAX);
+        uint32_t next = 0;
+        agg.indices.resize(3 * list.size());
+        for (size_t f = 0; f < list.size(); ++f) {
+            const auto [t, j] = list[f];
+            for (int e = 0; e < 3; ++e) {
+                uint32_t root = corners.find(static_cast<uint32_t>(3 * f + e));
+                if (outIndex[root] == UINT32_MAX) {
+                    outIndex[root] = next++;
+                    const double* p = &mesh.points[3 * static_cast<size_t>(vertexAt(t, kFaceCorners[j][e]))];
+                    agg.positions.insert(agg.positions.end(), p, p + 3);
+                }
+                agg.indices[3 * f + e] = outIndex[root];
+            }
+        }
+        int components = 0;
+        for (size_t f = 0; f < list.size(); ++f)
+            if (shells.find(static_cast<uint32_t>(f)) == f) ++components;
+        agg.componentCount = components;
+        for (const auto& [t, j] : list) faceIndexOf[4 * t + j] = -1;
+    }
+}
+
+}  // namespace aggrelod::detail

@@ -1,0 +1,58 @@
+// The one place that calls TetGen 1.5 (AGPL-3+). Swap this file to change triangulator.
+//
+// TetGen runs in a forked child process: the Debian build keeps its assert()s and
+// its error path double-frees (NOTES-deps.md), so a bad input must not be able to
+// take the baking process down. Results come back through a pipe.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace aggrelod::detail {
+
+/// Piecewise linear complex: triangles of every model surface.
+struct PlcInput {
+    std::vector<double> points;         ///< 3 * pointCount
+    std::vector<int> triangles;         ///< 3 * triangleCount, indices into points
+    std::vector<int> triangleMarkers;   ///< per triangle: model index + 1 (> 0)
+};
+
+/// Tetrahedral mesh of the convex hull of the input.
+struct TetMesh {
+    std::vector<double> points;         ///< 3 * pointCount; input points first, in input order
+    std::vector<int> tets;              ///< 4 * tetCount
+    std::vector<int> neighbors;         ///< 4 * tetCount; neighbor j is across the face opposite corner j; -1 = hull
+    std::vector<double> regions;        ///< per tet: -1 in free space, > 0 inside a closed surface
+    std::vector<int> boundaryFaces;     ///< 3 * faceCount: constrained faces (object surfaces, hull)
+    std::vector<int> boundaryMarkers;   ///< per face: marker of the input facet (0 = hull)
+    size_t tetCount() const { return tets.size() / 4; }
+    size_t pointCount() const { return points.size() / 3; }
+};
+
+enum class TetgenStatus {
+    Ok,
+    SelfIntersection,  ///< input facets intersect (TetGen code 3)
+    InputError,        ///< code 10, or bad PLC
+    ToleranceError,    ///< codes 4/5: points or facets too close for TetGen's tolerance
+    OutOfMemory,       ///< code 1
+    InternalError,     ///< code 2, or anything else TetGen reported
+    Crashed            ///< the child process died (assert, signal)
+};
+
+struct TetgenOutcome {
+    TetgenStatus status = TetgenStatus::Ok;
+    std::string message;
+};
+
+/// Constrained Delaunay tetrahedralization of the PLC, keeping its convex hull
+/// (switches "pczQn", no hole points: free space is region -1).
+TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out);
+
+/// Finds intersecting input triangles (TetGen switch d). `intersectingMarkers` gets the
+/// sorted, unique markers of every triangle involved in an intersection.
+TetgenOutcome findIntersectingFacets(const PlcInput& input, std::vector<int>& intersectingMarkers);
+
+const char* tetgenStatusName(TetgenStatus status);
+
+}  // namespace aggrelod::detail
