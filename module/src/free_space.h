@@ -22,7 +22,10 @@ struct ModelPair {
     double exactDistance = 0;       ///< exact mesh-to-mesh minimum distance
     double closestA[3] = {0, 0, 0}; ///< closest point on a
     double closestB[3] = {0, 0, 0}; ///< closest point on b
+    uint32_t closestTriangleA = ~0u; ///< triangle of a's surface holding closestA (~0u: unknown)
+    uint32_t closestTriangleB = ~0u;
     double weight = 0;              ///< the one used for grouping (exact or cdt)
+    uint32_t firstLength = 0;       ///< this pair's edge lengths: FreeSpace::lengths[firstLength .. + edgeCount)
 };
 
 struct FreeSpace {
@@ -32,6 +35,13 @@ struct FreeSpace {
     std::vector<double> tetVolume;  ///< per tet, units^3 (positive)
     std::vector<ModelPair> pairs;   ///< sorted by (a, b)
     size_t modelCount = 0;
+    std::vector<double> lengths;        ///< per pair, ascending free-space edge lengths (see ModelPair)
+    std::vector<double> lengthPrefix;   ///< running sum of lengths within each pair
+    std::vector<double> lengthSqPrefix; ///< running sum of squared lengths within each pair
+
+    /// Mean and population standard deviation of pair p's edge lengths shorter than `limit`
+    /// (0, 0 when there is none). Returns how many edges were counted.
+    uint32_t edgeStatsBelow(const ModelPair& p, double limit, double& mean, double& sigma) const;
 
     /// Index into `pairs` of (a, b) in any order, or -1.
     int findPair(uint32_t a, uint32_t b) const;

@@ -319,11 +319,6 @@ inline bool pairLess(uint32_t a0, uint32_t b0, uint32_t a1, uint32_t b1) {
 constexpr uint32_t kLeafSize = 4;
 constexpr int kBins = 16;
 
-inline int binOf(double c, double cmin, double scale) {
-    int b = int((c - cmin) * scale);
-    return b < 0 ? 0 : (b >= kBins ? kBins - 1 : b);
-}
-
 }  // namespace
 
 // ---- BVH build ---------------------------------------------------------------------------
@@ -345,111 +340,143 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
                                         " >= vertex count " + std::to_string(vertexCount));
 
     const size_t nt = triangleCount;
-    std::vector<double> tbox(nt * 6), cent(nt * 3);
+    // Exact root box; its centre is the origin of the float records below.
+    double rootLo[3] = {kInf, kInf, kInf}, rootHi[3] = {-kInf, -kInf, -kInf};
+    for (size_t i = 0; i < 3 * nt; ++i) {
+        const double* v = positions + 3 * size_t(indices[i]);
+        for (int k = 0; k < 3; ++k) {
+            rootLo[k] = std::min(rootLo[k], v[k]);
+            rootHi[k] = std::max(rootHi[k], v[k]);
+        }
+    }
+    for (int k = 0; k < 3; ++k)
+        if (!std::isfinite(rootLo[k]) || !std::isfinite(rootHi[k]))
+            throw std::invalid_argument("TriangleBvh: non-finite vertex coordinate");
+    double centre[3];
+    for (int k = 0; k < 3; ++k) {
+        centre[k] = 0.5 * (rootLo[k] + rootHi[k]);
+        maxAbs_ = std::max(maxAbs_, std::max(std::fabs(rootLo[k]), std::fabs(rootHi[k])));
+    }
+    auto toFloat = [&](double v, int k) {
+        double r = v - centre[k];
+        return float(std::min(std::max(r, -1e37), 1e37));  // finite, in float range
+    };
+
+    // Build records in float, relative to the centre: they only choose the splits (SAH
+    // estimates, partition); the node boxes are recomputed exactly in double at the end.
+    struct Prim {
+        float lo[4], hi[4];  // [3] is padding (0) so that min/max run as 4-wide vector ops
+        float c[3];
+        uint32_t index;
+    };
+    std::vector<Prim> prims(nt);
+    float rootClo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, rootChi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (size_t t = 0; t < nt; ++t) {
         const double* v0 = positions + 3 * size_t(indices[3 * t]);
         const double* v1 = positions + 3 * size_t(indices[3 * t + 1]);
         const double* v2 = positions + 3 * size_t(indices[3 * t + 2]);
+        Prim& p = prims[t];
         for (int k = 0; k < 3; ++k) {
-            double lo = std::min(v0[k], std::min(v1[k], v2[k]));
-            double hi = std::max(v0[k], std::max(v1[k], v2[k]));
-            tbox[6 * t + k] = lo;
-            tbox[6 * t + 3 + k] = hi;
-            cent[3 * t + k] = (v0[k] + v1[k] + v2[k]) * (1.0 / 3.0);
-            maxAbs_ = std::max(maxAbs_, std::max(std::fabs(lo), std::fabs(hi)));
+            p.lo[k] = toFloat(std::min(v0[k], std::min(v1[k], v2[k])), k);
+            p.hi[k] = toFloat(std::max(v0[k], std::max(v1[k], v2[k])), k);
+            p.c[k] = toFloat((v0[k] + v1[k] + v2[k]) * (1.0 / 3.0), k);
+            rootClo[k] = std::min(rootClo[k], p.c[k]);
+            rootChi[k] = std::max(rootChi[k], p.c[k]);
         }
+        p.lo[3] = p.hi[3] = 0;
+        p.index = uint32_t(t);
     }
-    std::vector<uint32_t> order(nt);
-    for (size_t t = 0; t < nt; ++t) order[t] = uint32_t(t);
 
-    nodes_.reserve(2 * (nt / 2 + 1));
+    nodes_.reserve(nt);
     nodes_.push_back(Node{});
     struct Work {
         uint32_t node, begin, end;
+        float clo[3], chi[3];  // centroid bounds of the range
     };
     std::vector<Work> stack;
-    stack.push_back({0, 0, uint32_t(nt)});
+    stack.push_back({0, 0, uint32_t(nt), {rootClo[0], rootClo[1], rootClo[2]},
+                     {rootChi[0], rootChi[1], rootChi[2]}});
 
     struct Bin {
-        double lo[3], hi[3];
+        float lo[4], hi[4];
         uint32_t count;
     };
-    Bin bins[kBins];
+    Bin bins[3][kBins];
     double rightArea[kBins];
     uint32_t rightCount[kBins];
+    auto binOf = [](float c, float cmin, float scale, int nb) {
+        float f = std::max(0.0f, (c - cmin) * scale);  // NaN -> 0
+        return int(std::min(float(nb - 1), f));
+    };
+    auto area = [](const float* lo, const float* hi) {
+        double dx = double(hi[0]) - lo[0], dy = double(hi[1]) - lo[1], dz = double(hi[2]) - lo[2];
+        return dx * dy + dy * dz + dz * dx;
+    };
 
     while (!stack.empty()) {
-        Work w = stack.back();
+        const Work w = stack.back();
         stack.pop_back();
-        double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-        double clo[3] = {kInf, kInf, kInf}, chi[3] = {-kInf, -kInf, -kInf};
-        for (uint32_t i = w.begin; i < w.end; ++i) {
-            const double* b = &tbox[6 * size_t(order[i])];
-            const double* c = &cent[3 * size_t(order[i])];
-            for (int k = 0; k < 3; ++k) {
-                lo[k] = std::min(lo[k], b[k]);
-                hi[k] = std::max(hi[k], b[3 + k]);
-                clo[k] = std::min(clo[k], c[k]);
-                chi[k] = std::max(chi[k], c[k]);
-            }
-        }
-        Node& node = nodes_[w.node];
-        for (int k = 0; k < 3; ++k) {
-            node.lo[k] = lo[k];
-            node.hi[k] = hi[k];
-        }
         const uint32_t count = w.end - w.begin;
         if (count <= kLeafSize) {
-            node.first = w.begin;
-            node.count = count;
+            nodes_[w.node].first = w.begin;
+            nodes_[w.node].count = count;
             continue;
         }
 
-        // Binned SAH over centroids, all three axes; first minimum wins (deterministic).
+        // Binned SAH over centroids, three axes binned in one pass (Wald 2007); the first
+        // minimum (lowest axis, lowest split) wins, so the choice is deterministic.
+        const int nb = count >= 64 ? kBins : kBins / 2;  // fewer bins for small nodes
+        float scale[3];
+        bool active[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            float extent = w.chi[axis] - w.clo[axis];
+            active[axis] = extent > 0 && extent <= FLT_MAX;
+            scale[axis] = active[axis] ? float(nb) / extent : 0.0f;
+            for (int i = 0; i < nb; ++i) {
+                Bin& b = bins[axis][i];
+                b.count = 0;
+                for (int k = 0; k < 4; ++k) {
+                    b.lo[k] = FLT_MAX;
+                    b.hi[k] = -FLT_MAX;
+                }
+            }
+        }
+        auto addToBin = [&](const Prim& p, int axis) {
+            Bin& b = bins[axis][binOf(p.c[axis], w.clo[axis], scale[axis], nb)];
+            ++b.count;
+            for (int k = 0; k < 4; ++k) {
+                b.lo[k] = std::min(b.lo[k], p.lo[k]);
+                b.hi[k] = std::max(b.hi[k], p.hi[k]);
+            }
+        };
+        for (uint32_t i = w.begin; i < w.end; ++i)
+            for (int axis = 0; axis < 3; ++axis) addToBin(prims[i], axis);
         int bestAxis = -1, bestSplit = -1;
         double bestCost = kInf;
         for (int axis = 0; axis < 3; ++axis) {
-            double extent = chi[axis] - clo[axis];
-            if (!(extent > 0)) continue;
-            double scale = kBins / extent;
-            for (Bin& b : bins) {
-                b.count = 0;
-                for (int k = 0; k < 3; ++k) {
-                    b.lo[k] = kInf;
-                    b.hi[k] = -kInf;
-                }
-            }
-            for (uint32_t i = w.begin; i < w.end; ++i) {
-                uint32_t t = order[i];
-                Bin& b = bins[binOf(cent[3 * size_t(t) + axis], clo[axis], scale)];
-                const double* tb = &tbox[6 * size_t(t)];
-                ++b.count;
-                for (int k = 0; k < 3; ++k) {
-                    b.lo[k] = std::min(b.lo[k], tb[k]);
-                    b.hi[k] = std::max(b.hi[k], tb[3 + k]);
-                }
-            }
-            double rlo[3] = {kInf, kInf, kInf}, rhi[3] = {-kInf, -kInf, -kInf};
+            if (!active[axis]) continue;
+            const Bin* bs = bins[axis];
+            float rlo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, rhi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
             uint32_t rc = 0;
-            for (int i = kBins - 1; i > 0; --i) {
-                rc += bins[i].count;
+            for (int i = nb - 1; i > 0; --i) {
+                rc += bs[i].count;
                 for (int k = 0; k < 3; ++k) {
-                    rlo[k] = std::min(rlo[k], bins[i].lo[k]);
-                    rhi[k] = std::max(rhi[k], bins[i].hi[k]);
+                    rlo[k] = std::min(rlo[k], bs[i].lo[k]);
+                    rhi[k] = std::max(rhi[k], bs[i].hi[k]);
                 }
                 rightCount[i] = rc;
-                rightArea[i] = rc ? halfArea(rlo, rhi) : 0;
+                rightArea[i] = rc ? area(rlo, rhi) : 0;
             }
-            double llo[3] = {kInf, kInf, kInf}, lhi[3] = {-kInf, -kInf, -kInf};
+            float llo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, lhi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
             uint32_t lc = 0;
-            for (int i = 0; i < kBins - 1; ++i) {
-                lc += bins[i].count;
+            for (int i = 0; i < nb - 1; ++i) {
+                lc += bs[i].count;
                 for (int k = 0; k < 3; ++k) {
-                    llo[k] = std::min(llo[k], bins[i].lo[k]);
-                    lhi[k] = std::max(lhi[k], bins[i].hi[k]);
+                    llo[k] = std::min(llo[k], bs[i].lo[k]);
+                    lhi[k] = std::max(lhi[k], bs[i].hi[k]);
                 }
                 if (lc == 0 || rightCount[i + 1] == 0) continue;
-                double cost = lc * halfArea(llo, lhi) + rightCount[i + 1] * rightArea[i + 1];
+                double cost = lc * area(llo, lhi) + rightCount[i + 1] * rightArea[i + 1];
                 if (cost < bestCost) {
                     bestCost = cost;
                     bestAxis = axis;
@@ -458,35 +485,85 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
             }
         }
 
-        uint32_t mid = w.begin + count / 2;
+        // Partition (two-pointer, deterministic), gathering each side's centroid bounds.
+        Work L{0, w.begin, 0, {FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}};
+        Work R{0, 0, w.end, {FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}};
+        auto grow = [](Work& s, const Prim& p) {
+            for (int k = 0; k < 3; ++k) {
+                s.clo[k] = std::min(s.clo[k], p.c[k]);
+                s.chi[k] = std::max(s.chi[k], p.c[k]);
+            }
+        };
+        uint32_t mid = w.begin;
         if (bestAxis >= 0) {
-            const int axis = bestAxis, split = bestSplit;
-            const double cmin = clo[axis], scale = kBins / (chi[axis] - clo[axis]);
-            auto it = std::partition(order.begin() + w.begin, order.begin() + w.end,
-                                     [&](uint32_t t) {
-                                         return binOf(cent[3 * size_t(t) + axis], cmin, scale) <=
-                                                split;
-                                     });
-            uint32_t m = uint32_t(it - order.begin());
-            if (m > w.begin && m < w.end) mid = m;
+            const int axis = bestAxis;
+            const float cmin = w.clo[axis], sc = scale[axis];
+            auto left = [&](const Prim& p) { return binOf(p.c[axis], cmin, sc, nb) <= bestSplit; };
+            uint32_t i = w.begin, j = w.end;
+            for (;;) {
+                while (i < j && left(prims[i])) grow(L, prims[i++]);
+                while (i < j && !left(prims[j - 1])) grow(R, prims[--j]);
+                if (i >= j) break;
+                std::swap(prims[i], prims[j - 1]);
+                grow(L, prims[i++]);
+                grow(R, prims[--j]);
+            }
+            mid = i;
         }
-        // else: every centroid coincides - split by position in `order` (deterministic).
+        if (mid <= w.begin || mid >= w.end) {
+            // No usable split (all centroids coincide): halve by position (deterministic).
+            mid = w.begin + count / 2;
+            for (int k = 0; k < 3; ++k) {
+                L.clo[k] = R.clo[k] = w.clo[k];
+                L.chi[k] = R.chi[k] = w.chi[k];
+            }
+        }
 
-        uint32_t left = uint32_t(nodes_.size());
-        nodes_[w.node].first = left;
+        const uint32_t first = uint32_t(nodes_.size());
+        nodes_[w.node].first = first;
         nodes_[w.node].count = 0;
         nodes_.push_back(Node{});
         nodes_.push_back(Node{});
-        stack.push_back({left + 1, mid, w.end});
-        stack.push_back({left, w.begin, mid});
+        L.node = first;
+        L.end = mid;
+        R.node = first + 1;
+        R.begin = mid;
+        stack.push_back(R);
+        stack.push_back(L);
     }
 
     corners_.resize(nt * 9);
-    triangleIndex_ = order;
+    triangleIndex_.resize(nt);
     for (size_t s = 0; s < nt; ++s) {
-        const uint32_t* tri = indices + 3 * size_t(order[s]);
+        triangleIndex_[s] = prims[s].index;
+        const uint32_t* tri = indices + 3 * size_t(prims[s].index);
         for (int c = 0; c < 3; ++c)
             for (int k = 0; k < 3; ++k) corners_[9 * s + 3 * c + k] = positions[3 * size_t(tri[c]) + k];
+    }
+    // Exact node boxes, bottom-up (children always follow their parent in the array).
+    for (size_t n = nodes_.size(); n-- > 0;) {
+        Node& node = nodes_[n];
+        if (node.count) {
+            for (int k = 0; k < 3; ++k) {
+                node.lo[k] = kInf;
+                node.hi[k] = -kInf;
+            }
+            for (uint32_t s = node.first; s < node.first + node.count; ++s) {
+                double lo[3], hi[3];
+                triangleBox(&corners_[9 * size_t(s)], lo, hi);
+                for (int k = 0; k < 3; ++k) {
+                    node.lo[k] = std::min(node.lo[k], lo[k]);
+                    node.hi[k] = std::max(node.hi[k], hi[k]);
+                }
+            }
+        } else {
+            const Node& a = nodes_[node.first];
+            const Node& b = nodes_[node.first + 1];
+            for (int k = 0; k < 3; ++k) {
+                node.lo[k] = std::min(a.lo[k], b.lo[k]);
+                node.hi[k] = std::max(a.hi[k], b.hi[k]);
+            }
+        }
     }
 }
 

@@ -187,6 +187,7 @@ private:
     bool triangulate();
     void analyseFreeSpace(const std::vector<int>& pointModel);
     void buildGraph();
+    bool refineCoarseConnections();
     void buildLevels();
 };
 
@@ -388,8 +389,10 @@ bool Baker::triangulate() {
 void Baker::analyseFreeSpace(const std::vector<int>& pointModel) {
     detail::TetMesh& mesh = space_.mesh;
     const size_t tetCount = mesh.tetCount();
-    // Make every tet positively oriented (the sculptor's face tables assume it).
+    // TetGen orients all tets alike; make them positive (the sculptor's face tables assume
+    // it). Decide once from the total, never per tet: a sliver's rounded sign can lie.
     space_.tetVolume.assign(tetCount, 0.0);
+    double signedTotal = 0;
     for (size_t t = 0; t < tetCount; ++t) {
         const double* a = &mesh.points[3 * mesh.tets[4 * t]];
         const double* b = &mesh.points[3 * mesh.tets[4 * t + 1]];
@@ -399,12 +402,14 @@ void Baker::analyseFreeSpace(const std::vector<int>& pointModel) {
         const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
         const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
         double vol = ((u[1] * v[2] - u[2] * v[1]) * w[0] + (u[2] * v[0] - u[0] * v[2]) * w[1] + (u[0] * v[1] - u[1] * v[0]) * w[2]) / 6.0;
-        if (vol < 0) {
+        signedTotal += vol;
+        space_.tetVolume[t] = std::fabs(vol);
+    }
+    if (signedTotal < 0) {
+        for (size_t t = 0; t < tetCount; ++t) {
             std::swap(mesh.tets[4 * t + 2], mesh.tets[4 * t + 3]);
             std::swap(mesh.neighbors[4 * t + 2], mesh.neighbors[4 * t + 3]);
-            vol = -vol;
         }
-        space_.tetVolume[t] = vol;
     }
     // Vertex owners: input points by construction; Steiner points on a model's surface
     // through the constrained faces they lie on.
@@ -497,6 +502,9 @@ void Baker::buildGraph() {
         return std::tie(x.a, x.b, x.length, x.u, x.v) < std::tie(y.a, y.b, y.length, y.u, y.v);
     });
     space_.pairs.clear();
+    space_.lengths.clear();
+    space_.lengthPrefix.clear();
+    space_.lengthSqPrefix.clear();
     for (size_t i = 0; i < accs.size();) {
         size_t j = i;
         double sum = 0, sumSq = 0;
@@ -514,6 +522,15 @@ void Baker::buildGraph() {
         p.shortestEdge = accs[i].length;  // sorted by length within the pair
         p.shortestEdgeVertexA = accs[i].u;
         p.shortestEdgeVertexB = accs[i].v;
+        p.firstLength = static_cast<uint32_t>(space_.lengthPrefix.size());
+        double run = 0, runSq = 0;
+        for (size_t k = i; k < j; ++k) {
+            run += accs[k].length;
+            runSq += accs[k].length * accs[k].length;
+            space_.lengths.push_back(accs[k].length);
+            space_.lengthPrefix.push_back(run);
+            space_.lengthSqPrefix.push_back(runSq);
+        }
         space_.pairs.push_back(p);
         i = j;
     }
@@ -533,10 +550,114 @@ void Baker::buildGraph() {
             p.exactDistance = cp.distance;
             std::copy(cp.pointA, cp.pointA + 3, p.closestA);
             std::copy(cp.pointB, cp.pointB + 3, p.closestB);
+            p.closestTriangleA = cp.triangleA;
+            p.closestTriangleB = cp.triangleB;
         }
         p.weight = settings_.distance == DistanceMode::Exact ? p.exactDistance : p.shortestEdge;
         if (i % 64 == 0) timer_.report(double(i) / space_.pairs.size());
     }
+}
+
+// DESIGN 2.4 step 4: where large input triangles leave no short triangulation edge between
+// two models the dendrogram joins (shortest edge much longer than the exact distance),
+// insert the closest points into both surfaces as Steiner vertices and triangulate again,
+// so that gap-spanning edges approach the true distance. One extra pass, only when needed.
+bool Baker::refineCoarseConnections() {
+    std::vector<GraphEdge> graph;
+    for (const ModelPair& p : space_.pairs) graph.push_back(GraphEdge{p.a, p.b, p.weight});
+    std::vector<Merge> merges = kruskalMerges(models_.size(), graph);
+    struct Insertion {
+        uint32_t model, triangle;
+        double point[3];
+    };
+    std::vector<Insertion> insertions;
+    for (const Merge& m : merges) {
+        int idx = space_.findPair(m.modelA, m.modelB);
+        if (idx < 0) continue;
+        const ModelPair& p = space_.pairs[idx];
+        if (p.closestTriangleA == ~0u || p.closestTriangleB == ~0u) continue;
+        if (!(p.shortestEdge > 1.5 * p.exactDistance + tolerance_)) continue;
+        Insertion a{p.a, p.closestTriangleA, {p.closestA[0], p.closestA[1], p.closestA[2]}};
+        Insertion b{p.b, p.closestTriangleB, {p.closestB[0], p.closestB[1], p.closestB[2]}};
+        insertions.push_back(a);
+        insertions.push_back(b);
+    }
+    if (insertions.empty()) return false;
+    timer_.begin("refine");
+    std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
+        return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
+    });
+    size_t inserted = 0;
+    for (size_t i = 0; i < insertions.size();) {
+        size_t j = i;
+        while (j < insertions.size() && insertions[j].model == insertions[i].model) ++j;
+        Model& model = models_[insertions[i].model];
+        // children[t]: current triangles covering original triangle t (split 1 -> 3 in place).
+        std::map<uint32_t, std::vector<uint32_t>> children;
+        for (size_t k = i; k < j; ++k) {
+            const Insertion& ins = insertions[k];
+            if (3 * static_cast<size_t>(ins.triangle) + 2 >= model.triangles.size()) continue;
+            auto& list = children[ins.triangle];
+            if (list.empty()) list.push_back(ins.triangle);
+            // Locate the child with the largest smallest barycentric coordinate.
+            int bestChild = -1;
+            double bestMin = -INFINITY, bary[3] = {0, 0, 0};
+            for (size_t c = 0; c < list.size(); ++c) {
+                const uint32_t* tri = &model.triangles[3 * list[c]];
+                const double* A = &model.positions[3 * tri[0]];
+                const double* B = &model.positions[3 * tri[1]];
+                const double* C = &model.positions[3 * tri[2]];
+                double v0[3], v1[3], v2[3];
+                for (int d = 0; d < 3; ++d) {
+                    v0[d] = B[d] - A[d];
+                    v1[d] = C[d] - A[d];
+                    v2[d] = ins.point[d] - A[d];
+                }
+                double d00 = v0[0] * v0[0] + v0[1] * v0[1] + v0[2] * v0[2];
+                double d01 = v0[0] * v1[0] + v0[1] * v1[1] + v0[2] * v1[2];
+                double d11 = v1[0] * v1[0] + v1[1] * v1[1] + v1[2] * v1[2];
+                double d20 = v2[0] * v0[0] + v2[1] * v0[1] + v2[2] * v0[2];
+                double d21 = v2[0] * v1[0] + v2[1] * v1[1] + v2[2] * v1[2];
+                double den = d00 * d11 - d01 * d01;
+                if (!(den > 0)) continue;
+                double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den, u = 1 - v - w;
+                double mn = std::min(u, std::min(v, w));
+                if (mn > bestMin) {
+                    bestMin = mn;
+                    bestChild = static_cast<int>(c);
+                    bary[0] = u;
+                    bary[1] = v;
+                    bary[2] = w;
+                }
+            }
+            if (bestChild < 0) continue;
+            // Keep the new vertex strictly inside (no sliver, no degenerate triangle).
+            const double floorBary = 0.02;
+            double sum = 0;
+            for (double& b : bary) {
+                b = std::max(b, floorBary);
+                sum += b;
+            }
+            for (double& b : bary) b /= sum;
+            const uint32_t t = list[bestChild];
+            const uint32_t a = model.triangles[3 * t], b = model.triangles[3 * t + 1], c = model.triangles[3 * t + 2];
+            const uint32_t nv = static_cast<uint32_t>(model.positions.size() / 3);
+            for (int d = 0; d < 3; ++d)
+                model.positions.push_back(bary[0] * model.positions[3 * a + d] + bary[1] * model.positions[3 * b + d] +
+                                          bary[2] * model.positions[3 * c + d]);
+            model.triangles[3 * t + 2] = nv;  // (a, b, nv)
+            const uint32_t t1 = static_cast<uint32_t>(model.triangles.size() / 3);
+            model.triangles.insert(model.triangles.end(), {b, c, nv, c, a, nv});
+            list.push_back(t1);
+            list.push_back(t1 + 1);
+            ++inserted;
+        }
+        i = j;
+    }
+    diag(out_, Diagnostic::Severity::Note, "",
+         "refined " + std::to_string(inserted) + " surface point(s) where the triangulation had no short connection "
+         "between joined models; triangulating again");
+    return inserted > 0;
 }
 
 void Baker::buildLevels() {
@@ -658,6 +779,13 @@ bool Baker::run() {
         else models_[m].hullPoints = models_[m].positions;
     }
     buildGraph();
+    if (settings_.distance == DistanceMode::Exact && refineCoarseConnections()) {
+        if (!triangulate()) {
+            timer_.end();
+            return false;
+        }
+        buildGraph();
+    }
     buildLevels();
     timer_.end();
     return true;

@@ -85,8 +85,11 @@ struct Sculptor {
         }
         const ModelPair& pair = space.pairs[p];
         in.minDistance = request.distance == DistanceMode::Exact ? pair.exactDistance : pair.shortestEdge;
-        in.sigma = pair.sigmaEdge;
-        in.meanEdgeLength = pair.meanEdge;
+        double mean = 0, sigma = 0;
+        space.edgeStatsBelow(pair, request.delta, mean, sigma);
+        in.sigma = sigma;
+        in.meanEdgeLength = mean;
+        in.sigmaAllEdges = pair.sigmaEdge;
         return (*request.function)(in);
     }
 
@@ -206,6 +209,166 @@ struct Sculptor {
         return surfaceTetsOfModel[model];
     }
 
+    // Kept free tets that cannot reach an object of their group through faces of the
+    // group's solid are removed (they would touch it only along an edge or at a vertex).
+    bool removeIslands() {
+        const size_t tetCount = mesh.tetCount();
+        std::vector<char> reached(tetCount, 0);
+        std::vector<int> stack;
+        for (size_t t = 0; t < tetCount; ++t)
+            if (space.tetModel[t] >= 0 && label[t] >= 0) {
+                reached[t] = 1;
+                stack.push_back(static_cast<int>(t));
+            }
+        while (!stack.empty()) {
+            int t = stack.back();
+            stack.pop_back();
+            for (int j = 0; j < 4; ++j) {
+                int n = mesh.neighbors[4 * t + j];
+                if (n >= 0 && !reached[n] && label[n] == label[t]) {
+                    reached[n] = 1;
+                    stack.push_back(n);
+                }
+            }
+        }
+        bool changed = false;
+        for (size_t t = 0; t < tetCount; ++t)
+            if (label[t] >= 0 && !reached[t]) {
+                label[t] = -1;
+                changed = true;
+            }
+        return changed;
+    }
+
+    // Closed cavities: connected free space no exposed to the outside (hull) and bordered
+    // by one group only is filled, so every aggregate is one shell without inner voids.
+    bool fillVoids() {
+        const size_t tetCount = mesh.tetCount();
+        std::vector<int> component(tetCount, -1);
+        std::vector<int> stack, members;
+        bool changed = false;
+        for (size_t s = 0; s < tetCount; ++s) {
+            if (label[s] >= 0 || component[s] >= 0) continue;
+            members.clear();
+            stack.push_back(static_cast<int>(s));
+            component[s] = static_cast<int>(s);
+            int border = -1;  // the single bordering group, -2 when several or the hull
+            while (!stack.empty()) {
+                int t = stack.back();
+                stack.pop_back();
+                members.push_back(t);
+                for (int j = 0; j < 4; ++j) {
+                    int n = mesh.neighbors[4 * t + j];
+                    if (n < 0) {
+                        border = -2;
+                        continue;
+                    }
+                    if (label[n] < 0) {
+                        if (component[n] < 0) {
+                            component[n] = static_cast<int>(s);
+                            stack.push_back(n);
+                        }
+                        continue;
+                    }
+                    if (border == -1) border = label[n];
+                    else if (border != label[n]) border = -2;
+                }
+            }
+            if (border >= 0) {
+                for (int t : members) label[t] = border;
+                changed = true;
+            }
+        }
+        return changed;
+    }
+
+    // Tets around edge (u, v), starting from tet t0 which contains it. When the ring
+    // reaches the hull it is open and holds the tets of both sides.
+    void edgeRing(int t0, int u, int v, std::vector<int>& ring) const {
+        auto local = [&](int t, int w) {
+            for (int k = 0; k < 4; ++k)
+                if (mesh.tets[4 * t + k] == w) return k;
+            return -1;
+        };
+        ring.clear();
+        ring.push_back(t0);
+        int others[2], k = 0;
+        for (int c = 0; c < 4; ++c)
+            if (c != local(t0, u) && c != local(t0, v)) others[k++] = c;
+        for (int direction = 0; direction < 2; ++direction) {
+            int t = t0;
+            int cross = others[direction];
+            for (int guard = 0; guard < 1024; ++guard) {
+                int n = mesh.neighbors[4 * t + cross];
+                if (n < 0) break;       // open ring: walk the other way too
+                if (n == t0) return;    // closed ring complete
+                int lu = local(n, u), lv = local(n, v), entered = -1;
+                for (int c = 0; c < 4; ++c)
+                    if (mesh.neighbors[4 * n + c] == t && c != lu && c != lv) entered = c;
+                if (lu < 0 || lv < 0 || entered < 0) return;
+                ring.push_back(n);
+                t = n;
+                cross = 6 - lu - lv - entered;
+            }
+        }
+    }
+
+    // Edges where the group's solid meets itself only along the edge (more than two
+    // surface faces): fill the gap tets when they are all unclaimed free space, else
+    // remove the free unprotected solid tets around the edge.
+    bool repairNonManifoldEdges() {
+        const size_t tetCount = mesh.tetCount();
+        struct EdgeUse {
+            int u, v, group, tet;
+        };
+        std::vector<EdgeUse> uses;
+        for (size_t t = 0; t < tetCount; ++t) {
+            const int g = label[t];
+            if (g < 0) continue;
+            for (int j = 0; j < 4; ++j) {
+                int n = mesh.neighbors[4 * t + j];
+                if (n >= 0 && label[n] == g) continue;
+                for (int e = 0; e < 3; ++e) {
+                    int u = mesh.tets[4 * t + kFaceCorners[j][e]];
+                    int v = mesh.tets[4 * t + kFaceCorners[j][(e + 1) % 3]];
+                    uses.push_back({std::min(u, v), std::max(u, v), g, static_cast<int>(t)});
+                }
+            }
+        }
+        std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
+            return std::tie(a.group, a.u, a.v, a.tet) < std::tie(b.group, b.u, b.v, b.tet);
+        });
+        bool changed = false;
+        std::vector<int> ring;
+        for (size_t i = 0; i < uses.size();) {
+            size_t j = i;
+            while (j < uses.size() && uses[j].group == uses[i].group && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+            if (j - i > 2) {
+                const int g = uses[i].group;
+                edgeRing(uses[i].tet, uses[i].u, uses[i].v, ring);
+                bool canFill = true, canOpen = true;
+                for (int t : ring) {
+                    if (label[t] == g) {
+                        if (space.tetModel[t] >= 0 || isProtected[t]) canOpen = false;
+                    } else if (space.tetModel[t] >= 0 || label[t] >= 0) {
+                        canFill = false;
+                    }
+                }
+                for (int t : ring) {
+                    if (canFill && label[t] != g) {
+                        label[t] = g;
+                        changed = true;
+                    } else if (!canFill && canOpen && label[t] == g) {
+                        label[t] = -1;
+                        changed = true;
+                    }
+                }
+            }
+            i = j;
+        }
+        return changed;
+    }
+
     void carve() {
         const size_t tetCount = mesh.tetCount();
         using Entry = std::pair<double, int>;  // priority (longest bad edge), -tet for tie-break
@@ -247,12 +410,34 @@ int FreeSpace::findPair(uint32_t a, uint32_t b) const {
     return static_cast<int>(it - pairs.begin());
 }
 
+uint32_t FreeSpace::edgeStatsBelow(const ModelPair& p, double limit, double& mean, double& sigma) const {
+    const double* begin = lengths.data() + p.firstLength;
+    const double* end = begin + p.edgeCount;
+    const uint32_t n = static_cast<uint32_t>(std::lower_bound(begin, end, limit) - begin);
+    mean = sigma = 0;
+    if (n == 0) return 0;
+    const double sum = lengthPrefix[p.firstLength + n - 1];
+    const double sumSq = lengthSqPrefix[p.firstLength + n - 1];
+    mean = sum / n;
+    sigma = std::sqrt(std::max(0.0, sumSq / n - mean * mean));
+    return n;
+}
+
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel) {
     Sculptor sculptor(space, request, tetLabel);
     sculptor.initialLabels();
     sculptor.isProtected.assign(space.mesh.tetCount(), 0);
     for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
     sculptor.carve();
+    // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
+    // and open or fill the tets around edges where a solid touches itself only along an
+    // edge. Each round only changes free tets; a few rounds settle it.
+    for (int round = 0; round < 8; ++round) {
+        bool changed = sculptor.removeIslands();
+        changed |= sculptor.repairNonManifoldEdges();
+        changed |= sculptor.fillVoids();
+        if (!changed) break;
+    }
 }
 
 // ---- surface extraction ----------------------------------------------------------------

@@ -51,8 +51,9 @@ enum class AggregateFunctionKind {
 struct AggregateFunctionInput {
     double delta = 0;            ///< level threshold
     double minDistance = 0;      ///< minimum distance between m1 and m2 (0 when m1 == m2)
-    double sigma = 0;            ///< std deviation of free-space edge lengths joining m1, m2
+    double sigma = 0;            ///< std deviation of the free-space edge lengths joining m1, m2 that are shorter than delta
     double meanEdgeLength = 0;   ///< mean of those lengths
+    double sigmaAllEdges = 0;    ///< std deviation of all free-space edge lengths joining m1, m2
     bool sameModel = false;      ///< m1 == m2
 };
 /// Pluggable aggregate function: returns the longest exposed edge length kept (world units).
