@@ -346,23 +346,40 @@ struct Sculptor {
             if (j - i > 2) {
                 const int g = uses[i].group;
                 edgeRing(uses[i].tet, uses[i].u, uses[i].v, ring);
-                bool canFill = true, canOpen = true;
-                for (int t : ring) {
-                    if (label[t] == g) {
-                        if (space.tetModel[t] >= 0 || isProtected[t]) canOpen = false;
-                    } else if (space.tetModel[t] >= 0 || label[t] >= 0) {
-                        canFill = false;
-                    }
+                // Runs of consecutive tets in or out of the solid around the edge. A closed
+                // ring starts at a solid tet, so the last run may continue the first.
+                std::vector<std::pair<size_t, size_t>> runs;  // [begin, end) in ring
+                for (size_t k = 0; k < ring.size();) {
+                    size_t e = k;
+                    const bool in = label[ring[k]] == g;
+                    while (e < ring.size() && (label[ring[e]] == g) == in) ++e;
+                    runs.emplace_back(k, e);
+                    k = e;
                 }
-                for (int t : ring) {
-                    if (canFill && label[t] != g) {
-                        label[t] = g;
-                        changed = true;
-                    } else if (!canFill && canOpen && label[t] == g) {
-                        label[t] = -1;
-                        changed = true;
+                auto fillable = [&](std::pair<size_t, size_t> r) {
+                    for (size_t k = r.first; k < r.second; ++k)
+                        if (label[ring[k]] == g || space.tetModel[ring[k]] >= 0 || label[ring[k]] >= 0) return false;
+                    return true;
+                };
+                auto openable = [&](std::pair<size_t, size_t> r) {
+                    for (size_t k = r.first; k < r.second; ++k)
+                        if (label[ring[k]] != g || space.tetModel[ring[k]] >= 0 || isProtected[ring[k]]) return false;
+                    return true;
+                };
+                bool acted = false;
+                for (auto r : runs)
+                    if (label[ring[r.first]] != g && fillable(r)) {
+                        for (size_t k = r.first; k < r.second; ++k) label[ring[k]] = g;
+                        acted = changed = true;
+                        break;  // one gap at a time; the next round re-examines the edge
                     }
-                }
+                if (!acted)
+                    for (auto r : runs)
+                        if (label[ring[r.first]] == g && openable(r)) {
+                            for (size_t k = r.first; k < r.second; ++k) label[ring[k]] = -1;
+                            changed = true;
+                            break;
+                        }
             }
             i = j;
         }
@@ -432,7 +449,7 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
-    for (int round = 0; round < 8; ++round) {
+    for (int round = 0; round < 16; ++round) {
         bool changed = sculptor.removeIslands();
         changed |= sculptor.repairNonManifoldEdges();
         changed |= sculptor.fillVoids();
