@@ -344,14 +344,14 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
     double rootLo[3] = {kInf, kInf, kInf}, rootHi[3] = {-kInf, -kInf, -kInf};
     for (size_t i = 0; i < 3 * nt; ++i) {
         const double* v = positions + 3 * size_t(indices[i]);
+        if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])))
+            throw std::invalid_argument("TriangleBvh: vertex " + std::to_string(indices[i]) +
+                                        " has a non-finite coordinate");
         for (int k = 0; k < 3; ++k) {
             rootLo[k] = std::min(rootLo[k], v[k]);
             rootHi[k] = std::max(rootHi[k], v[k]);
         }
     }
-    for (int k = 0; k < 3; ++k)
-        if (!std::isfinite(rootLo[k]) || !std::isfinite(rootHi[k]))
-            throw std::invalid_argument("TriangleBvh: non-finite vertex coordinate");
     double centre[3];
     for (int k = 0; k < 3; ++k) {
         centre[k] = 0.5 * (rootLo[k] + rootHi[k]);
@@ -365,8 +365,7 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
     // Build records in float, relative to the centre: they only choose the splits (SAH
     // estimates, partition); the node boxes are recomputed exactly in double at the end.
     struct Prim {
-        float lo[4], hi[4];  // [3] is padding (0) so that min/max run as 4-wide vector ops
-        float c[3];
+        float lo[4], hi[4], c[4];  // [3] is padding (0): min/max run as 4-wide vector ops
         uint32_t index;
     };
     std::vector<Prim> prims(nt);
@@ -383,7 +382,7 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
             rootClo[k] = std::min(rootClo[k], p.c[k]);
             rootChi[k] = std::max(rootChi[k], p.c[k]);
         }
-        p.lo[3] = p.hi[3] = 0;
+        p.lo[3] = p.hi[3] = p.c[3] = 0;
         p.index = uint32_t(t);
     }
 
@@ -391,11 +390,11 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
     nodes_.push_back(Node{});
     struct Work {
         uint32_t node, begin, end;
-        float clo[3], chi[3];  // centroid bounds of the range
+        float clo[4], chi[4];  // centroid bounds of the range ([3] unused)
     };
     std::vector<Work> stack;
-    stack.push_back({0, 0, uint32_t(nt), {rootClo[0], rootClo[1], rootClo[2]},
-                     {rootChi[0], rootChi[1], rootChi[2]}});
+    stack.push_back({0, 0, uint32_t(nt), {rootClo[0], rootClo[1], rootClo[2], 0},
+                     {rootChi[0], rootChi[1], rootChi[2], 0}});
 
     struct Bin {
         float lo[4], hi[4];
@@ -456,22 +455,24 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
         for (int axis = 0; axis < 3; ++axis) {
             if (!active[axis]) continue;
             const Bin* bs = bins[axis];
-            float rlo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, rhi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+            float rlo[4] = {FLT_MAX, FLT_MAX, FLT_MAX, FLT_MAX};
+            float rhi[4] = {-FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX};
             uint32_t rc = 0;
             for (int i = nb - 1; i > 0; --i) {
                 rc += bs[i].count;
-                for (int k = 0; k < 3; ++k) {
+                for (int k = 0; k < 4; ++k) {
                     rlo[k] = std::min(rlo[k], bs[i].lo[k]);
                     rhi[k] = std::max(rhi[k], bs[i].hi[k]);
                 }
                 rightCount[i] = rc;
                 rightArea[i] = rc ? area(rlo, rhi) : 0;
             }
-            float llo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, lhi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+            float llo[4] = {FLT_MAX, FLT_MAX, FLT_MAX, FLT_MAX};
+            float lhi[4] = {-FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX};
             uint32_t lc = 0;
             for (int i = 0; i < nb - 1; ++i) {
                 lc += bs[i].count;
-                for (int k = 0; k < 3; ++k) {
+                for (int k = 0; k < 4; ++k) {
                     llo[k] = std::min(llo[k], bs[i].lo[k]);
                     lhi[k] = std::max(lhi[k], bs[i].hi[k]);
                 }
@@ -486,10 +487,10 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
         }
 
         // Partition (two-pointer, deterministic), gathering each side's centroid bounds.
-        Work L{0, w.begin, 0, {FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}};
-        Work R{0, 0, w.end, {FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}};
+        Work L{0, w.begin, 0, {FLT_MAX, FLT_MAX, FLT_MAX, 0}, {-FLT_MAX, -FLT_MAX, -FLT_MAX, 0}};
+        Work R{0, 0, w.end, {FLT_MAX, FLT_MAX, FLT_MAX, 0}, {-FLT_MAX, -FLT_MAX, -FLT_MAX, 0}};
         auto grow = [](Work& s, const Prim& p) {
-            for (int k = 0; k < 3; ++k) {
+            for (int k = 0; k < 4; ++k) {
                 s.clo[k] = std::min(s.clo[k], p.c[k]);
                 s.chi[k] = std::max(s.chi[k], p.c[k]);
             }

@@ -357,12 +357,27 @@ bool Baker::triangulate() {
         }
         space_ = FreeSpace{};
         detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
+        for (const char* fallback : {"Y", "M"}) {
+            if (outcome.status != detail::TetgenStatus::Crashed && outcome.status != detail::TetgenStatus::InternalError) break;
+            std::vector<int> markers;
+            detail::TetgenOutcome found = detail::findIntersectingFacets(plc, markers);
+            if (found.status != detail::TetgenStatus::Ok || !markers.empty()) break;  // repaired below
+            space_ = FreeSpace{};
+            detail::TetgenOutcome retry = detail::tetrahedralizePlc(plc, space_.mesh, fallback);
+            if (retry.status == detail::TetgenStatus::Ok)
+                diag(out_, Diagnostic::Severity::Note, "",
+                     std::string("TetGen's boundary recovery failed (") + outcome.message + "); succeeded with switch " + fallback);
+            outcome = retry;
+        }
         if (outcome.status == detail::TetgenStatus::Ok) {
             space_.modelCount = models_.size();
             analyseFreeSpace(pointModel);
             return true;
         }
-        if (outcome.status == detail::TetgenStatus::SelfIntersection) {
+        // Intersecting input makes TetGen report code 3 or trip one of its assertions:
+        // find the facets that intersect (switch d) and stand in for their models.
+        if (outcome.status == detail::TetgenStatus::SelfIntersection || outcome.status == detail::TetgenStatus::Crashed ||
+            outcome.status == detail::TetgenStatus::InternalError) {
             std::vector<int> markers;
             detail::TetgenOutcome found = detail::findIntersectingFacets(plc, markers);
             bool repaired = false;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <csignal>
 #include <cstring>
 #include <fcntl.h>
@@ -160,14 +161,18 @@ const char* tetgenStatusName(TetgenStatus status) {
     return "unknown";
 }
 
-TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out) {
+TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out, const char* extraSwitches) {
     ByteReader reader;
     TetgenOutcome outcome = runIsolated(
         [&](int fd) -> int {
             tetgenio in, result;
             fillTetgenInput(input, in);
-            char switches[] = "pczQn";
-            tetrahedralize(switches, &in, &result);
+            if (const char* dump = std::getenv("AGGRELOD_DUMP_PLC")) {  // debugging aid
+                in.save_nodes(const_cast<char*>(dump));
+                in.save_poly(const_cast<char*>(dump));
+            }
+            std::string switches = std::string("pczQn") + (extraSwitches ? extraSwitches : "");
+            tetrahedralize(&switches[0], &in, &result);
             int32_t ok = 0;
             writeAll(fd, &ok, sizeof ok);
             writeArray(fd, result.pointlist, static_cast<size_t>(result.numberofpoints) * 3);

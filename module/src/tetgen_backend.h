@@ -46,8 +46,9 @@ struct TetgenOutcome {
 };
 
 /// Constrained Delaunay tetrahedralization of the PLC, keeping its convex hull
-/// (switches "pczQn", no hole points: free space is region -1).
-TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out);
+/// (switches "pczQn", no hole points: free space is region -1). `extraSwitches` are
+/// appended (the fallbacks "Y", "M" help where TetGen's boundary recovery trips).
+TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out, const char* extraSwitches = "");
 
 /// Finds intersecting input triangles (TetGen switch d). `intersectingMarkers` gets the
 /// sorted, unique markers of every triangle involved in an intersection.
