@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Installs what aggrelod needs to build and test, on Debian bookworm. Idempotent: apt runs
+# only when a package is missing, npm only when tests/validator/node_modules is missing or
+# older than its package-lock.json. Runs as root, or through sudo otherwise.
+set -euo pipefail
+
+repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+
+if [ "$(id -u)" -eq 0 ]; then
+  SUDO=()
+else
+  SUDO=(sudo)
+fi
+
+packages=(
+  build-essential cmake pkg-config ccache git
+  libglm-dev libtinygltf-dev libembree-dev libtet1.5-dev
+  libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev
+  libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
+)
+# node and npm run the glTF validator in the tests. Take them from Debian only when they are
+# missing: a node installed otherwise (e.g. a vendor repack) conflicts with Debian's npm.
+if ! command -v node >/dev/null 2>&1; then packages+=(nodejs); fi
+if ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ "${#missing[@]}" -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  "${SUDO[@]}" apt-get update
+  "${SUDO[@]}" apt-get install -y --no-install-recommends "${missing[@]}"
+else
+  echo "install-deps: all Debian packages present"
+fi
+
+# glTF validator for the tests (pinned by tests/validator/package-lock.json).
+validator_dir="$repo_root/tests/validator"
+stamp="$validator_dir/node_modules/.package-lock.json"
+if [ ! -d "$validator_dir/node_modules/gltf-validator" ] || [ ! -f "$stamp" ] ||
+   [ "$validator_dir/package-lock.json" -nt "$stamp" ]; then
+  echo "install-deps: npm ci in tests/validator"
+  (cd "$validator_dir" && npm ci --no-audit --no-fund)
+else
+  echo "install-deps: gltf-validator present"
+fi

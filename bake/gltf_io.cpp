@@ -1,0 +1,1207 @@
+// aggrelod bake: glTF in and out. The only translation unit that includes tiny_gltf.h
+// (Debian ships tinygltf's implementation compiled in libtinygltf.so, so no
+// TINYGLTF_IMPLEMENTATION here).
+//
+// Reading: geometry only. Images are never decoded (a loader callback that accepts
+// anything), materials and unknown extensions are ignored, every accessor and
+// buffer view is range-checked here before a byte is read, and a bad object is
+// skipped with a diagnostic so that the rest of the scene can still be baked.
+#include "scene_io.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <new>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <utility>
+
+namespace aggrelod::io {
+namespace {
+
+using Severity = Diagnostic::Severity;
+
+// ---------------------------------------------------------------------------
+// Small double-precision 4x4 matrix (column-major, as glTF).
+
+struct Mat4 {
+    double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+};
+
+Mat4 multiply(const Mat4& a, const Mat4& b) {
+    Mat4 r;
+    for (int col = 0; col < 4; ++col) {
+        for (int row = 0; row < 4; ++row) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a.m[k * 4 + row] * b.m[col * 4 + k];
+            r.m[col * 4 + row] = s;
+        }
+    }
+    return r;
+}
+
+double determinant3(const Mat4& a) {
+    const double* m = a.m;
+    // Upper-left 3x3, element (row, col) = m[col * 4 + row].
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+           m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+/// Local transform of a node: `matrix` if given, else T * R * S.
+Mat4 localTransform(const tinygltf::Node& node, std::string& problem) {
+    Mat4 r;
+    if (!node.matrix.empty()) {
+        if (node.matrix.size() == 16) {
+            for (int i = 0; i < 16; ++i) r.m[i] = node.matrix[size_t(i)];
+            return r;
+        }
+        problem = "matrix has " + std::to_string(node.matrix.size()) +
+                  " numbers instead of 16; identity used";
+        return r;
+    }
+    double t[3] = {0, 0, 0}, s[3] = {1, 1, 1}, q[4] = {0, 0, 0, 1};
+    if (node.translation.size() == 3) {
+        for (int i = 0; i < 3; ++i) t[i] = node.translation[size_t(i)];
+    } else if (!node.translation.empty()) {
+        problem = "translation does not have 3 numbers; ignored";
+    }
+    if (node.scale.size() == 3) {
+        for (int i = 0; i < 3; ++i) s[i] = node.scale[size_t(i)];
+    } else if (!node.scale.empty()) {
+        problem = "scale does not have 3 numbers; ignored";
+    }
+    if (node.rotation.size() == 4) {
+        for (int i = 0; i < 4; ++i) q[i] = node.rotation[size_t(i)];
+        const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (n > 0 && std::isfinite(n)) {
+            for (double& c : q) c /= n;
+        }
+    } else if (!node.rotation.empty()) {
+        problem = "rotation does not have 4 numbers; ignored";
+    }
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    const double R[3][3] = {
+        {1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+        {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+        {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)},
+    };
+    for (int col = 0; col < 3; ++col) {
+        for (int row = 0; row < 3; ++row) r.m[col * 4 + row] = R[row][col] * s[col];
+        r.m[col * 4 + 3] = 0;
+    }
+    r.m[12] = t[0];
+    r.m[13] = t[1];
+    r.m[14] = t[2];
+    r.m[15] = 1;
+    return r;
+}
+
+// ---------------------------------------------------------------------------
+// Accessor reading with full range checks.
+
+int componentSize(int componentType) {
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+        case TINYGLTF_COMPONENT_TYPE_INT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE: return 8;
+        default: return 0;
+    }
+}
+
+const char* componentName(int componentType) {
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_INT: return "INT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "DOUBLE";
+        default: return "unknown";
+    }
+}
+
+/// One component at `p` converted to double (normalized integers mapped as the spec says).
+double readComponent(const unsigned char* p, int componentType, bool normalized) {
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            int8_t v;
+            std::memcpy(&v, p, 1);
+            return normalized ? std::max(double(v) / 127.0, -1.0) : double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+            uint8_t v;
+            std::memcpy(&v, p, 1);
+            return normalized ? double(v) / 255.0 : double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            int16_t v;
+            std::memcpy(&v, p, 2);
+            return normalized ? std::max(double(v) / 32767.0, -1.0) : double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t v;
+            std::memcpy(&v, p, 2);
+            return normalized ? double(v) / 65535.0 : double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_INT: {
+            int32_t v;
+            std::memcpy(&v, p, 4);
+            return normalized ? std::max(double(v) / 2147483647.0, -1.0) : double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+            uint32_t v;
+            std::memcpy(&v, p, 4);
+            return normalized ? double(v) / 4294967295.0 : double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+            float v;
+            std::memcpy(&v, p, 4);
+            return double(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE: {
+            double v;
+            std::memcpy(&v, p, 8);
+            return v;
+        }
+        default: return 0;
+    }
+}
+
+/// a * b + c without overflow, or false.
+bool mulAdd(uint64_t a, uint64_t b, uint64_t c, uint64_t& out) {
+    uint64_t prod;
+    if (__builtin_mul_overflow(a, b, &prod)) return false;
+    return !__builtin_add_overflow(prod, c, &out);
+}
+
+/// Bytes of buffer view `viewIndex`, checked against its buffer. Returns nullptr with `why`.
+const unsigned char* viewBytes(const tinygltf::Model& model, int viewIndex, size_t& length,
+                               size_t& stride, std::string& why) {
+    if (viewIndex < 0 || size_t(viewIndex) >= model.bufferViews.size()) {
+        why = "bufferView " + std::to_string(viewIndex) + " does not exist (" +
+              std::to_string(model.bufferViews.size()) + " buffer views)";
+        return nullptr;
+    }
+    const tinygltf::BufferView& view = model.bufferViews[size_t(viewIndex)];
+    if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size()) {
+        why = "bufferView " + std::to_string(viewIndex) + " refers to buffer " +
+              std::to_string(view.buffer) + ", which does not exist";
+        return nullptr;
+    }
+    const tinygltf::Buffer& buffer = model.buffers[size_t(view.buffer)];
+    uint64_t end;
+    if (!mulAdd(1, view.byteOffset, view.byteLength, end) || end > buffer.data.size()) {
+        why = "bufferView " + std::to_string(viewIndex) + " (offset " +
+              std::to_string(view.byteOffset) + ", length " + std::to_string(view.byteLength) +
+              ") lies outside buffer " + std::to_string(view.buffer) + " of " +
+              std::to_string(buffer.data.size()) + " bytes (truncated file?)";
+        return nullptr;
+    }
+    length = view.byteLength;
+    stride = view.byteStride;
+    return buffer.data.data() + view.byteOffset;
+}
+
+/// Reads accessor `index` into doubles (count * components values). `indices`: a SCALAR
+/// index accessor (unsigned integer types only); otherwise a VEC3 position accessor.
+bool readAccessor(const tinygltf::Model& model, int index, bool indices,
+                  std::vector<double>& out, std::string& why) {
+    if (index < 0 || size_t(index) >= model.accessors.size()) {
+        why = "accessor " + std::to_string(index) + " does not exist (" +
+              std::to_string(model.accessors.size()) + " accessors)";
+        return false;
+    }
+    const tinygltf::Accessor& acc = model.accessors[size_t(index)];
+    const std::string name = "accessor " + std::to_string(index);
+    const int components = indices ? 1 : 3;
+    if (indices && acc.type != TINYGLTF_TYPE_SCALAR) {
+        why = name + " of indices is not SCALAR";
+        return false;
+    }
+    if (!indices && acc.type != TINYGLTF_TYPE_VEC3) {
+        why = name + " of positions is not VEC3";
+        return false;
+    }
+    const int csize = componentSize(acc.componentType);
+    if (csize == 0) {
+        why = name + " has invalid componentType " + std::to_string(acc.componentType);
+        return false;
+    }
+    if (indices && acc.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        acc.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        acc.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+        why = name + " of indices has component type " + componentName(acc.componentType) +
+              " (must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT)";
+        return false;
+    }
+    const size_t count = acc.count;
+    if (count > size_t(std::numeric_limits<uint32_t>::max())) {
+        why = name + " has too many elements (" + std::to_string(count) + ")";
+        return false;
+    }
+    const size_t elementSize = size_t(csize) * size_t(components);
+
+    if (acc.bufferView < 0) {
+        if (!acc.sparse.isSparse) {
+            // Spec: without a buffer view the accessor is all zeros. Geometry compressed by
+            // an extension (Draco, meshopt) also looks like this; the caller reports that.
+            why = name + " has no bufferView (all zeros)";
+            return false;
+        }
+        out.assign(count * size_t(components), 0.0);
+    } else {
+        size_t length = 0, stride = 0;
+        const unsigned char* base = viewBytes(model, acc.bufferView, length, stride, why);
+        if (!base) {
+            why = name + ": " + why;
+            return false;
+        }
+        if (stride == 0) stride = elementSize;
+        if (stride < elementSize) {
+            why = name + ": bufferView " + std::to_string(acc.bufferView) + " byteStride " +
+                  std::to_string(stride) + " is smaller than one element (" +
+                  std::to_string(elementSize) + " bytes)";
+            return false;
+        }
+        if (count > 0) {
+            uint64_t end;
+            if (!mulAdd(count - 1, stride, uint64_t(acc.byteOffset) + elementSize, end) ||
+                acc.byteOffset > length || end > length) {
+                why = name + " (" + std::to_string(count) + " elements, offset " +
+                      std::to_string(acc.byteOffset) + ", stride " + std::to_string(stride) +
+                      ") does not fit in bufferView " + std::to_string(acc.bufferView) + " of " +
+                      std::to_string(length) + " bytes";
+                return false;
+            }
+        }
+        out.resize(count * size_t(components));
+        for (size_t i = 0; i < count; ++i) {
+            const unsigned char* e = base + acc.byteOffset + i * stride;
+            for (int c = 0; c < components; ++c) {
+                out[i * size_t(components) + size_t(c)] =
+                    readComponent(e + size_t(c) * size_t(csize), acc.componentType, acc.normalized);
+            }
+        }
+    }
+
+    if (acc.sparse.isSparse) {
+        const auto& sp = acc.sparse;
+        if (sp.count < 0 || size_t(sp.count) > count) {
+            why = name + ": sparse count " + std::to_string(sp.count) + " is out of range";
+            return false;
+        }
+        const int icType = sp.indices.componentType;
+        if (icType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            icType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            icType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+            why = name + ": sparse indices have invalid component type";
+            return false;
+        }
+        const size_t icSize = size_t(componentSize(icType));
+        size_t ilen = 0, istride = 0, vlen = 0, vstride = 0;
+        const unsigned char* ib = viewBytes(model, sp.indices.bufferView, ilen, istride, why);
+        if (!ib) {
+            why = name + ": sparse indices: " + why;
+            return false;
+        }
+        const unsigned char* vb = viewBytes(model, sp.values.bufferView, vlen, vstride, why);
+        if (!vb) {
+            why = name + ": sparse values: " + why;
+            return false;
+        }
+        const size_t n = size_t(sp.count);
+        if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0 ||
+            size_t(sp.indices.byteOffset) + n * icSize > ilen ||
+            size_t(sp.values.byteOffset) + n * elementSize > vlen) {
+            why = name + ": sparse data does not fit in its buffer views";
+            return false;
+        }
+        for (size_t k = 0; k < n; ++k) {
+            const double target =
+                readComponent(ib + size_t(sp.indices.byteOffset) + k * icSize, icType, false);
+            if (target >= double(count)) {
+                why = name + ": sparse index " + std::to_string(uint64_t(target)) +
+                      " is out of range (count " + std::to_string(count) + ")";
+                return false;
+            }
+            const size_t t = size_t(target);
+            const unsigned char* e = vb + size_t(sp.values.byteOffset) + k * elementSize;
+            for (int c = 0; c < components; ++c) {
+                out[t * size_t(components) + size_t(c)] =
+                    readComponent(e + size_t(c) * size_t(csize), acc.componentType, acc.normalized);
+            }
+        }
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------
+// Scene reading.
+
+/// Extensions that change geometry and that aggrelod cannot decode.
+bool isUnsupportedGeometryExtension(const std::string& ext) {
+    return ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression" ||
+           ext == "EXT_mesh_gpu_instancing";
+}
+
+/// Extensions that change geometry and that aggrelod reads.
+bool isSupportedGeometryExtension(const std::string& ext) {
+    return ext == "KHR_mesh_quantization";
+}
+
+/// Image loader that accepts any image without decoding it: only geometry is read.
+bool acceptImageWithoutDecoding(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                                const unsigned char*, int, void*) {
+    return true;
+}
+
+const char* modeName(int mode) {
+    switch (mode) {
+        case TINYGLTF_MODE_POINTS: return "POINTS";
+        case TINYGLTF_MODE_LINE: return "LINES";
+        case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
+        case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
+        case TINYGLTF_MODE_TRIANGLES: return "TRIANGLES";
+        case TINYGLTF_MODE_TRIANGLE_STRIP: return "TRIANGLE_STRIP";
+        case TINYGLTF_MODE_TRIANGLE_FAN: return "TRIANGLE_FAN";
+        default: return "unknown";
+    }
+}
+
+std::string displayName(const tinygltf::Model& model, int node) {
+    const std::string& n = model.nodes[size_t(node)].name;
+    return n.empty() ? "node" + std::to_string(node) : n;
+}
+
+/// An object being assembled from one or more mesh nodes.
+struct ObjectBuilder {
+    std::string name;        ///< before de-duplication
+    int topNode = -1;
+    bool hadMesh = false;    ///< at least one node with a mesh contributed
+    bool failed = false;     ///< a data error: the object is skipped
+    std::vector<double> positions;
+    std::vector<uint32_t> indices;
+};
+
+class SceneReader {
+public:
+    SceneReader(const tinygltf::Model& model, const SceneReadOptions& options,
+                std::vector<Diagnostic>& diagnostics)
+        : model_(model), options_(options), diags_(diagnostics) {}
+
+    bool run(std::vector<InputObject>& objects, std::string& error);
+
+private:
+    void note(Severity severity, const std::string& object, const std::string& message) {
+        diags_.push_back(Diagnostic{severity, object, message});
+    }
+    bool excluded(int node) const {
+        return hasRegex_ && std::regex_search(displayName(model_, node), regex_);
+    }
+    void addMeshOfNode(int node, const Mat4& world, ObjectBuilder& object);
+    bool addPrimitive(int node, int meshIndex, int primIndex, const Mat4& world, bool flip,
+                      ObjectBuilder& object);
+    void fail(ObjectBuilder& object, int node, const std::string& why) {
+        if (!object.failed) {
+            note(Severity::Warning, object.name,
+                 why + " (node " + std::to_string(node) + " '" + displayName(model_, node) +
+                     "'); object skipped");
+        }
+        object.failed = true;
+    }
+
+    const tinygltf::Model& model_;
+    const SceneReadOptions& options_;
+    std::vector<Diagnostic>& diags_;
+    std::regex regex_;
+    bool hasRegex_ = false;
+};
+
+bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat4& world,
+                               bool flip, ObjectBuilder& object) {
+    const tinygltf::Primitive& prim = model_.meshes[size_t(meshIndex)].primitives[size_t(primIndex)];
+    const std::string where = "mesh " + std::to_string(meshIndex) + " primitive " +
+                              std::to_string(primIndex);
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        const bool known = mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP;
+        note(known ? Severity::Note : Severity::Warning, object.name,
+             "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+                 ": mode " + (known ? std::string(modeName(mode)) : std::to_string(mode)) +
+                 " is not triangles; primitive skipped");
+        return true;
+    }
+    const auto pos = prim.attributes.find("POSITION");
+    if (pos == prim.attributes.end()) {
+        note(Severity::Warning, object.name,
+             "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+                 ": no POSITION attribute; primitive skipped");
+        return true;
+    }
+    for (const auto& ext : prim.extensions) {
+        if (isUnsupportedGeometryExtension(ext.first) &&
+            pos->second >= 0 && size_t(pos->second) < model_.accessors.size() &&
+            model_.accessors[size_t(pos->second)].bufferView < 0 &&
+            !model_.accessors[size_t(pos->second)].sparse.isSparse) {
+            fail(object, node, where + " is compressed with " + ext.first +
+                                   ", which aggrelod cannot decode");
+            return false;
+        }
+    }
+
+    std::vector<double> p;
+    std::string why;
+    if (!readAccessor(model_, pos->second, false, p, why)) {
+        fail(object, node, where + ": POSITION: " + why);
+        return false;
+    }
+    const size_t vertexCount = p.size() / 3;
+    std::vector<double> idx;
+    if (prim.indices >= 0) {
+        if (!readAccessor(model_, prim.indices, true, idx, why)) {
+            fail(object, node, where + ": indices: " + why);
+            return false;
+        }
+        for (double v : idx) {
+            if (v >= double(vertexCount)) {
+                fail(object, node,
+                     where + ": index out of range: index " + std::to_string(uint64_t(v)) +
+                         " >= vertex count " + std::to_string(vertexCount));
+                return false;
+            }
+        }
+    } else {
+        idx.resize(vertexCount);
+        for (size_t i = 0; i < vertexCount; ++i) idx[i] = double(i);
+    }
+
+    // Corner triples in the primitive's own vertex numbering.
+    std::vector<uint32_t> tri;
+    const size_t n = idx.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (n % 3 != 0) {
+            note(Severity::Warning, object.name,
+                 "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+                     ": " + std::to_string(n) + " indices is not a multiple of 3; last " +
+                     std::to_string(n % 3) + " ignored");
+        }
+        tri.reserve(n - n % 3);
+        for (size_t i = 0; i + 2 < n; i += 3) {
+            tri.push_back(uint32_t(idx[i]));
+            tri.push_back(uint32_t(idx[i + 1]));
+            tri.push_back(uint32_t(idx[i + 2]));
+        }
+    } else {
+        // Strips and fans: the degenerate triangles a strip uses as joints are dropped.
+        for (size_t i = 0; i + 2 < n; ++i) {
+            uint32_t a, b, c;
+            if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                a = uint32_t(idx[i]);
+                b = uint32_t(idx[i + 1 + (i % 2)]);
+                c = uint32_t(idx[i + 2 - (i % 2)]);
+            } else {
+                a = uint32_t(idx[i + 1]);
+                b = uint32_t(idx[i + 2]);
+                c = uint32_t(idx[0]);
+            }
+            if (a == b || b == c || a == c) continue;
+            tri.push_back(a);
+            tri.push_back(b);
+            tri.push_back(c);
+        }
+    }
+    if (tri.empty()) return true;
+
+    const size_t base = object.positions.size() / 3;
+    if (base + vertexCount > size_t(std::numeric_limits<uint32_t>::max())) {
+        fail(object, node, "more than 2^32 vertices");
+        return false;
+    }
+    object.positions.reserve(object.positions.size() + p.size());
+    const double* m = world.m;
+    for (size_t v = 0; v < vertexCount; ++v) {
+        const double x = p[3 * v], y = p[3 * v + 1], z = p[3 * v + 2];
+        object.positions.push_back(m[0] * x + m[4] * y + m[8] * z + m[12]);
+        object.positions.push_back(m[1] * x + m[5] * y + m[9] * z + m[13]);
+        object.positions.push_back(m[2] * x + m[6] * y + m[10] * z + m[14]);
+    }
+    object.indices.reserve(object.indices.size() + tri.size());
+    for (size_t t = 0; t < tri.size(); t += 3) {
+        object.indices.push_back(uint32_t(base) + tri[t]);
+        object.indices.push_back(uint32_t(base) + tri[t + (flip ? 2 : 1)]);
+        object.indices.push_back(uint32_t(base) + tri[t + (flip ? 1 : 2)]);
+    }
+    return true;
+}
+
+void SceneReader::addMeshOfNode(int node, const Mat4& world, ObjectBuilder& object) {
+    const tinygltf::Node& n = model_.nodes[size_t(node)];
+    if (n.mesh < 0) return;
+    object.hadMesh = true;
+    if (object.failed) return;
+    if (size_t(n.mesh) >= model_.meshes.size()) {
+        fail(object, node, "mesh " + std::to_string(n.mesh) + " does not exist (" +
+                               std::to_string(model_.meshes.size()) + " meshes)");
+        return;
+    }
+    if (n.skin >= 0) {
+        note(Severity::Note, object.name,
+             "node " + std::to_string(node) + " '" + displayName(model_, node) +
+                 "' is skinned; its bind pose is used");
+    }
+    const bool flip = determinant3(world) < 0;
+    const tinygltf::Mesh& mesh = model_.meshes[size_t(n.mesh)];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+        if (!addPrimitive(node, n.mesh, int(p), world, flip, object)) return;
+    }
+}
+
+bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
+    if (!options_.excludeRegex.empty()) {
+        try {
+            regex_ = std::regex(options_.excludeRegex, std::regex::ECMAScript);
+            hasRegex_ = true;
+        } catch (const std::regex_error& e) {
+            error = "invalid --exclude regular expression '" + options_.excludeRegex +
+                    "': " + e.what();
+            return false;
+        }
+    }
+
+    // File-level extension checks.
+    for (const std::string& ext : model_.extensionsRequired) {
+        if (isUnsupportedGeometryExtension(ext)) {
+            note(Severity::Warning, "",
+                 "the file requires extension " + ext +
+                     ", which aggrelod cannot decode; geometry that uses it is skipped");
+        } else if (!isSupportedGeometryExtension(ext)) {
+            note(Severity::Note, "",
+                 "the file requires extension " + ext +
+                     "; ignored, since aggrelod reads geometry only");
+        }
+    }
+    for (const std::string& ext : model_.extensionsUsed) {
+        if (ext == "EXT_mesh_gpu_instancing" &&
+            std::find(model_.extensionsRequired.begin(), model_.extensionsRequired.end(), ext) ==
+                model_.extensionsRequired.end()) {
+            note(Severity::Warning, "",
+                 "the file uses EXT_mesh_gpu_instancing, which aggrelod does not read: "
+                 "only one instance of each instanced mesh is taken");
+        }
+    }
+
+    // Roots of the scene to read.
+    std::vector<int> roots;
+    const int nodeCount = int(std::min(model_.nodes.size(), size_t(std::numeric_limits<int>::max())));
+    if (!model_.scenes.empty()) {
+        int scene = model_.defaultScene;
+        if (scene < 0 || size_t(scene) >= model_.scenes.size()) {
+            if (scene >= 0) {
+                note(Severity::Warning, "",
+                     "default scene " + std::to_string(scene) + " does not exist; scene 0 used");
+            }
+            scene = 0;
+        }
+        if (model_.scenes.size() > 1) {
+            note(Severity::Note, "",
+                 "the file has " + std::to_string(model_.scenes.size()) + " scenes; only scene " +
+                     std::to_string(scene) + " is read");
+        }
+        for (int r : model_.scenes[size_t(scene)].nodes) {
+            if (r < 0 || r >= nodeCount) {
+                note(Severity::Warning, "",
+                     "scene " + std::to_string(scene) + " refers to node " + std::to_string(r) +
+                         ", which does not exist; ignored");
+                continue;
+            }
+            roots.push_back(r);
+        }
+    } else {
+        std::vector<char> isChild(size_t(nodeCount), 0);
+        for (const auto& n : model_.nodes) {
+            for (int c : n.children) {
+                if (c >= 0 && c < nodeCount) isChild[size_t(c)] = 1;
+            }
+        }
+        for (int i = 0; i < nodeCount; ++i) {
+            if (!isChild[size_t(i)]) roots.push_back(i);
+        }
+        note(Severity::Note, "",
+             "the file has no scene; all " + std::to_string(roots.size()) + " root nodes are read");
+    }
+
+    // Depth-first traversal with an explicit stack (no recursion: a crafted file may nest
+    // nodes very deeply). Each node is visited at most once, even if the file (invalidly)
+    // gives it several parents or a cycle.
+    std::vector<ObjectBuilder> builders;
+    std::vector<char> visited(size_t(nodeCount), 0);
+    std::vector<std::string> excludedNames;
+    struct Item {
+        int node;
+        Mat4 parent;
+        int group;  ///< builder index of the enclosing subtree object, -1 if none
+        int depth;  ///< 0 for a scene root
+    };
+    std::vector<Item> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back(Item{*it, Mat4{}, -1, 0});
+
+    while (!stack.empty()) {
+        const Item item = stack.back();
+        stack.pop_back();
+        const int node = item.node;
+        if (visited[size_t(node)]) {
+            note(Severity::Warning, displayName(model_, node),
+                 "node " + std::to_string(node) +
+                     " is reached more than once (invalid glTF: several parents or a cycle); "
+                     "read only the first time");
+            continue;
+        }
+        visited[size_t(node)] = 1;
+        if (excluded(node)) {
+            excludedNames.push_back(displayName(model_, node));
+            continue;
+        }
+        const tinygltf::Node& n = model_.nodes[size_t(node)];
+        std::string problem;
+        const Mat4 world = multiply(item.parent, localTransform(n, problem));
+        if (!problem.empty()) {
+            note(Severity::Warning, displayName(model_, node),
+                 "node " + std::to_string(node) + ": " + problem);
+        }
+
+        int group = item.group;
+        if (options_.objectUnit == ObjectUnit::Node) {
+            if (n.mesh >= 0) {
+                builders.push_back(ObjectBuilder{});
+                builders.back().name = displayName(model_, node);
+                builders.back().topNode = node;
+                addMeshOfNode(node, world, builders.back());
+            }
+        } else if (item.depth == 0) {
+            // Subtree unit: a scene root's own mesh is an object by itself; each of its
+            // children opens an object gathering every mesh below it.
+            if (n.mesh >= 0) {
+                builders.push_back(ObjectBuilder{});
+                builders.back().name = displayName(model_, node);
+                builders.back().topNode = node;
+                addMeshOfNode(node, world, builders.back());
+            }
+            group = -1;
+        } else {
+            if (item.depth == 1) {
+                builders.push_back(ObjectBuilder{});
+                builders.back().name = displayName(model_, node);
+                builders.back().topNode = node;
+                group = int(builders.size()) - 1;
+            }
+            addMeshOfNode(node, world, builders[size_t(group)]);
+        }
+
+        for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) {
+            if (*c < 0 || *c >= nodeCount) {
+                note(Severity::Warning, displayName(model_, node),
+                     "node " + std::to_string(node) + " has child " + std::to_string(*c) +
+                         ", which does not exist; ignored");
+                continue;
+            }
+            stack.push_back(Item{*c, world, group, item.depth + 1});
+        }
+    }
+
+    if (hasRegex_) {
+        std::string list;
+        const size_t shown = std::min<size_t>(excludedNames.size(), 20);
+        for (size_t i = 0; i < shown; ++i) list += (i ? ", " : "") + excludedNames[i];
+        if (excludedNames.size() > shown) list += ", ...";
+        note(Severity::Note, "",
+             excludedNames.empty()
+                 ? "--exclude '" + options_.excludeRegex + "' matched no node"
+                 : "excluded " + std::to_string(excludedNames.size()) + " node(s) matching '" +
+                       options_.excludeRegex + "' with their subtrees: " + list);
+    }
+
+    // Keep the objects with triangles, in order of appearance; make names unique.
+    std::vector<ObjectBuilder*> kept;
+    for (ObjectBuilder& b : builders) {
+        if (b.failed || !b.hadMesh) continue;
+        if (b.indices.empty()) {
+            note(Severity::Note, b.name,
+                 "node " + std::to_string(b.topNode) + " has no triangles; not an object");
+            continue;
+        }
+        kept.push_back(&b);
+    }
+    std::set<std::string> taken;
+    for (const ObjectBuilder* b : kept) taken.insert(b->name);
+    std::set<std::string> used;
+    objects.clear();
+    objects.reserve(kept.size());
+    for (ObjectBuilder* b : kept) {
+        std::string name = b->name;
+        if (used.count(name)) {
+            for (int k = 2;; ++k) {
+                std::string candidate = b->name + "#" + std::to_string(k);
+                if (!taken.count(candidate) && !used.count(candidate)) {
+                    name = candidate;
+                    break;
+                }
+            }
+        }
+        used.insert(name);
+        InputObject obj;
+        obj.name = std::move(name);
+        obj.id = uint32_t(objects.size());
+        obj.positions = std::move(b->positions);
+        obj.indices = std::move(b->indices);
+        objects.push_back(std::move(obj));
+    }
+    return true;
+}
+
+bool readWholeFile(const std::string& path, std::vector<unsigned char>& bytes, std::string& error) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        error = "is a directory, not a glTF file";
+        return false;
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        error = std::string("cannot open: ") + std::strerror(errno);
+        return false;
+    }
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (size < 0) {
+        error = "cannot read";
+        return false;
+    }
+    if (uint64_t(size) >= uint64_t(std::numeric_limits<uint32_t>::max())) {
+        error = "file is 4 GB or larger, which glTF loading does not support";
+        return false;
+    }
+    in.seekg(0, std::ios::beg);
+    // A few zero bytes past the end, so that nothing can read outside the allocation.
+    bytes.assign(size_t(size) + 16, 0);
+    if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
+        error = "read error";
+        return false;
+    }
+    bytes.resize(size_t(size));
+    return true;
+}
+
+uint32_t readLe32(const unsigned char* p) {
+    return uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24);
+}
+
+/// Stricter GLB header check than tinygltf's; returns the declared total length.
+bool checkGlbHeader(const std::vector<unsigned char>& b, uint32_t& length, std::string& error) {
+    const size_t size = b.size();
+    if (size < 20) {
+        error = "truncated GLB: " + std::to_string(size) + " bytes, shorter than a GLB header";
+        return false;
+    }
+    const uint32_t version = readLe32(&b[4]);
+    length = readLe32(&b[8]);
+    const uint32_t jsonLength = readLe32(&b[12]);
+    const uint32_t jsonType = readLe32(&b[16]);
+    if (version != 2) {
+        error = "unsupported GLB version " + std::to_string(version) + " (only glTF 2.0 is read)";
+        return false;
+    }
+    if (length > size) {
+        error = "truncated GLB: header says " + std::to_string(length) + " bytes, file has " +
+                std::to_string(size);
+        return false;
+    }
+    if (jsonType != 0x4E4F534Au) {
+        error = "invalid GLB: first chunk is not JSON";
+        return false;
+    }
+    const uint64_t jsonEnd = 20ull + jsonLength;
+    if (jsonLength == 0 || jsonEnd > length) {
+        error = "truncated GLB: JSON chunk of " + std::to_string(jsonLength) +
+                " bytes does not fit in " + std::to_string(length) + " bytes";
+        return false;
+    }
+    if (jsonEnd < length) {
+        if (jsonEnd + 8 > length) {
+            error = "invalid GLB: incomplete chunk header after the JSON chunk";
+            return false;
+        }
+        const uint32_t binLength = readLe32(&b[size_t(jsonEnd)]);
+        const uint32_t binType = readLe32(&b[size_t(jsonEnd) + 4]);
+        if (binType == 0x004E4942u && jsonEnd + 8 + binLength > length) {
+            error = "truncated GLB: BIN chunk of " + std::to_string(binLength) +
+                    " bytes does not fit in " + std::to_string(length) + " bytes";
+            return false;
+        }
+    }
+    return true;
+}
+
+std::string lowerExtension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+/// One line, at most a few hundred characters (tinygltf may quote a whole data URI).
+std::string tidyMessage(std::string s) {
+    while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
+    for (char& c : s) {
+        if (c == '\n' || c == '\r') c = ' ';
+    }
+    const size_t maxLength = 300;
+    if (s.size() > maxLength) s = s.substr(0, maxLength) + "...";
+    return s;
+}
+
+bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diagnostic>& diags,
+               std::string& error) {
+    std::vector<unsigned char> bytes;
+    if (!readWholeFile(path, bytes, error)) return false;
+    const bool magicGlb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    const std::string ext = lowerExtension(path);
+    if (ext == ".glb" && !magicGlb) {
+        error = bytes.size() < 4 ? "truncated GLB: " + std::to_string(bytes.size()) + " bytes"
+                                 : "not a GLB file (no 'glTF' magic bytes)";
+        return false;
+    }
+    std::string baseDir = std::filesystem::path(path).parent_path().string();
+    if (baseDir.empty()) baseDir = ".";
+
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(&acceptImageWithoutDecoding, nullptr);
+    std::string err, warn;
+    bool ok = false;
+    try {
+        if (magicGlb) {
+            uint32_t length = 0;
+            if (!checkGlbHeader(bytes, length, error)) return false;
+            ok = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), length, baseDir);
+        } else {
+            if (bytes.empty()) {
+                error = "empty file";
+                return false;
+            }
+            ok = loader.LoadASCIIFromString(&model, &err, &warn,
+                                            reinterpret_cast<const char*>(bytes.data()),
+                                            unsigned(bytes.size()), baseDir);
+        }
+    } catch (const std::bad_alloc&) {
+        error = "out of memory while parsing";
+        return false;
+    } catch (const std::exception& e) {
+        error = std::string("invalid glTF: ") + e.what();
+        return false;
+    } catch (...) {
+        error = "invalid glTF (the glTF parser failed)";
+        return false;
+    }
+    if (!ok) {
+        err = tidyMessage(err);
+        error = "invalid glTF: " + (err.empty() ? std::string("the glTF parser failed") : err);
+        return false;
+    }
+    if (!err.empty()) {
+        diags.push_back(Diagnostic{Severity::Warning, "", "glTF loader: " + tidyMessage(err)});
+    }
+    // tinygltf's warnings are about images and other non-geometry data: kept as notes.
+    std::istringstream lines(warn);
+    std::string line;
+    while (std::getline(lines, line)) {
+        line = tidyMessage(line);
+        if (!line.empty()) diags.push_back(Diagnostic{Severity::Note, "", "glTF loader: " + line});
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------
+// Writing.
+
+/// Builds one GLB model; meshes share one buffer, one buffer view per accessor.
+class GlbBuilder {
+public:
+    GlbBuilder() {
+        model_.asset.version = "2.0";
+        model_.asset.generator = "aggrelod";
+    }
+
+    /// Adds a mesh with one triangle primitive; returns its index, or -1 when there is
+    /// nothing to draw. Positions are converted to float32.
+    int addMesh(const std::string& name, const std::vector<double>& positions,
+                const std::vector<uint32_t>& indices, int material) {
+        const size_t vertexCount = positions.size() / 3;
+        if (vertexCount == 0 || indices.empty()) return -1;
+
+        std::vector<float> p(vertexCount * 3);
+        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+        bool any = false;
+        for (size_t v = 0; v < vertexCount; ++v) {
+            bool finite = true;
+            for (int c = 0; c < 3; ++c) {
+                p[3 * v + size_t(c)] = float(positions[3 * v + size_t(c)]);
+                finite = finite && std::isfinite(p[3 * v + size_t(c)]);
+            }
+            if (!finite) continue;
+            for (int c = 0; c < 3; ++c) {
+                const double x = double(p[3 * v + size_t(c)]);
+                if (!any || x < lo[c]) lo[c] = x;
+                if (!any || x > hi[c]) hi[c] = x;
+            }
+            any = true;
+        }
+
+        tinygltf::Accessor pos;
+        pos.bufferView = addView(p.data(), p.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+        pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+        pos.type = TINYGLTF_TYPE_VEC3;
+        pos.count = vertexCount;
+        pos.minValues.assign(lo, lo + 3);
+        pos.maxValues.assign(hi, hi + 3);
+        model_.accessors.push_back(std::move(pos));
+        const int posIndex = int(model_.accessors.size()) - 1;
+
+        tinygltf::Accessor idx;
+        idx.bufferView = addView(indices.data(), indices.size() * sizeof(uint32_t),
+                                 TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+        idx.type = TINYGLTF_TYPE_SCALAR;
+        idx.count = indices.size();
+        model_.accessors.push_back(std::move(idx));
+        const int idxIndex = int(model_.accessors.size()) - 1;
+
+        tinygltf::Primitive prim;
+        prim.attributes["POSITION"] = posIndex;
+        prim.indices = idxIndex;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        prim.material = material;
+        tinygltf::Mesh mesh;
+        mesh.name = name;
+        mesh.primitives.push_back(std::move(prim));
+        model_.meshes.push_back(std::move(mesh));
+        return int(model_.meshes.size()) - 1;
+    }
+
+    int addNode(tinygltf::Node node) {
+        model_.nodes.push_back(std::move(node));
+        return int(model_.nodes.size()) - 1;
+    }
+
+    tinygltf::Model& model() { return model_; }
+
+    bool write(const std::string& path, const std::vector<int>& sceneRoots, std::string& error) {
+        tinygltf::Scene scene;
+        scene.nodes = sceneRoots;
+        model_.scenes.push_back(std::move(scene));
+        model_.defaultScene = 0;
+        if (!bin_.empty()) {
+            tinygltf::Buffer buffer;
+            buffer.data = std::move(bin_);
+            model_.buffers.push_back(std::move(buffer));
+        }
+        std::ofstream out(path, std::ios::binary | std::ios::trunc);
+        if (!out) {
+            error = path + ": cannot create: " + std::strerror(errno);
+            return false;
+        }
+        tinygltf::TinyGLTF writer;
+        bool ok = false;
+        try {
+            ok = writer.WriteGltfSceneToStream(&model_, out, false, true);
+        } catch (const std::exception& e) {
+            error = path + ": cannot write glTF: " + e.what();
+            return false;
+        }
+        out.close();
+        if (!ok || !out) {
+            error = path + ": write error (disk full?)";
+            return false;
+        }
+        return true;
+    }
+
+private:
+    int addView(const void* data, size_t bytes, int target) {
+        while (bin_.size() % 4) bin_.push_back(0);
+        tinygltf::BufferView view;
+        view.buffer = 0;
+        view.byteOffset = bin_.size();
+        view.byteLength = bytes;
+        view.target = target;
+        const auto* b = static_cast<const unsigned char*>(data);
+        bin_.insert(bin_.end(), b, b + bytes);
+        model_.bufferViews.push_back(std::move(view));
+        return int(model_.bufferViews.size()) - 1;
+    }
+
+    tinygltf::Model model_;
+    std::vector<unsigned char> bin_;
+};
+
+tinygltf::Value intValue(uint64_t v) {
+    if (v <= uint64_t(std::numeric_limits<int>::max())) return tinygltf::Value(int(v));
+    return tinygltf::Value(double(v));
+}
+
+/// Distinct, deterministic colour per level: from warm (fine levels) to cool (coarse).
+std::vector<double> levelColour(size_t level, size_t levelCount) {
+    const double t = levelCount > 1 ? double(level) / double(levelCount - 1) : 0.0;
+    const double hue = (1.0 - t) * 30.0 + t * 220.0;  // degrees
+    const double s = 0.55, v = 0.9;
+    const double c = v * s, h = hue / 60.0;
+    const double x = c * (1 - std::fabs(std::fmod(h, 2.0) - 1));
+    double r = 0, g = 0, b = 0;
+    if (h < 1) { r = c; g = x; }
+    else if (h < 2) { r = x; g = c; }
+    else if (h < 3) { g = c; b = x; }
+    else if (h < 4) { g = x; b = c; }
+    else if (h < 5) { r = x; b = c; }
+    else { r = c; b = x; }
+    const double m = v - c;
+    return {r + m, g + m, b + m, 1.0};
+}
+
+}  // namespace
+
+bool readGltfScene(const std::string& path, const SceneReadOptions& options,
+                   SceneReadResult& out, std::string& error) {
+    out.objects.clear();
+    out.diagnostics.clear();
+    error.clear();
+    try {
+        tinygltf::Model model;
+        if (!loadModel(path, model, out.diagnostics, error)) {
+            error = path + ": " + error;
+            return false;
+        }
+        SceneReader reader(model, options, out.diagnostics);
+        if (!reader.run(out.objects, error)) {
+            error = path + ": " + error;
+            return false;
+        }
+        return true;
+    } catch (const std::bad_alloc&) {
+        error = path + ": out of memory while reading the scene";
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+    }
+    out.objects.clear();
+    return false;
+}
+
+bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string& path,
+                     std::string& error) {
+    try {
+        GlbBuilder glb;
+        std::vector<int> roots;
+        for (const InputObject& o : objects) {
+            if (o.positions.size() % 3 != 0 || o.indices.size() % 3 != 0) {
+                error = path + ": object '" + o.name +
+                        "': positions or indices size is not a multiple of 3";
+                return false;
+            }
+            tinygltf::Node node;
+            node.name = o.name;
+            node.mesh = glb.addMesh(o.name, o.positions, o.indices, -1);
+            tinygltf::Value::Object extras;
+            extras["id"] = intValue(o.id);
+            node.extras = tinygltf::Value(std::move(extras));
+            roots.push_back(glb.addNode(std::move(node)));
+        }
+        return glb.write(path, roots, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                    const std::string& path, std::string& error) {
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        std::vector<int> roots;
+        const size_t levelCount = hierarchy.levels.size();
+        for (size_t k = 0; k < levelCount; ++k) {
+            const Level& level = hierarchy.levels[k];
+            const std::string levelName = "level" + std::to_string(k);
+
+            tinygltf::Material material;
+            material.name = levelName;
+            material.pbrMetallicRoughness.baseColorFactor = levelColour(k, levelCount);
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.8;
+            model.materials.push_back(std::move(material));
+            const int materialIndex = int(model.materials.size()) - 1;
+
+            tinygltf::Node levelNode;
+            levelNode.name = levelName;
+            tinygltf::Value::Object levelExtras;
+            levelExtras["level"] = intValue(k);
+            levelExtras["delta"] = tinygltf::Value(level.delta);
+            levelNode.extras = tinygltf::Value(std::move(levelExtras));
+            const int levelIndex = glb.addNode(std::move(levelNode));
+            roots.push_back(levelIndex);
+
+            std::vector<int> children;
+            for (size_t g = 0; g < level.aggregates.size(); ++g) {
+                const Aggregate& agg = level.aggregates[g];
+                const std::string name = levelName + "_group" + std::to_string(g);
+                if (agg.positions.size() % 3 != 0 || agg.indices.size() % 3 != 0) {
+                    error = path + ": " + name + ": positions or indices size is not a multiple of 3";
+                    return false;
+                }
+                tinygltf::Value::Array sources, sourceIds;
+                for (uint32_t s : agg.sourceObjects) {
+                    if (s >= objects.size()) {
+                        error = path + ": " + name + " refers to object " + std::to_string(s) +
+                                " but there are " + std::to_string(objects.size()) + " objects";
+                        return false;
+                    }
+                    sources.push_back(tinygltf::Value(objects[s].name));
+                    sourceIds.push_back(intValue(objects[s].id));
+                }
+                tinygltf::Node node;
+                node.name = name;
+                node.mesh = glb.addMesh(name, agg.positions, agg.indices, materialIndex);
+                tinygltf::Value::Object extras;
+                extras["level"] = intValue(k);
+                extras["group"] = intValue(g);
+                extras["delta"] = tinygltf::Value(level.delta);
+                extras["sources"] = tinygltf::Value(std::move(sources));
+                extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+                extras["components"] = tinygltf::Value(agg.componentCount);
+                extras["volume"] = tinygltf::Value(agg.measures.volume);
+                extras["volume_original"] = tinygltf::Value(agg.volumeOriginal);
+                node.extras = tinygltf::Value(std::move(extras));
+                children.push_back(glb.addNode(std::move(node)));
+            }
+            model.nodes[size_t(levelIndex)].children = std::move(children);
+        }
+        return glb.write(path, roots, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+}  // namespace aggrelod::io

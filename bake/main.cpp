@@ -1,0 +1,253 @@
+// aggrelod: the command-line tool. The only translation unit that includes CLI11.
+//
+// Exit codes: 0 success, 1 usage error, 2 input or output file problem,
+// 3 baking failed (nothing written), 4 internal error.
+//
+// Each subcommand has an options struct, an add<Name>Command() that declares its
+// options, and a run<Name>() that does the work; add new subcommands the same way.
+#include "scene_io.h"
+#include "terminal.h"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#ifndef AGGRELOD_VERSION
+#define AGGRELOD_VERSION "unknown"
+#endif
+
+namespace {
+
+using namespace aggrelod;
+namespace fs = std::filesystem;
+
+enum ExitCode { kOk = 0, kUsage = 1, kFileError = 2, kBakeFailed = 3, kInternal = 4 };
+
+void printError(const std::string& message) {
+    std::fprintf(stderr, "aggrelod: error: %s\n", message.c_str());
+}
+
+/// Removes a temporary file if it exists (best effort).
+void removeQuietly(const fs::path& p) {
+    std::error_code ec;
+    fs::remove(p, ec);
+}
+
+/// Renames `from` to `to`, replacing `to` (atomic on POSIX within one file system).
+bool renameOver(const fs::path& from, const fs::path& to, std::string& error) {
+    std::error_code ec;
+    fs::rename(from, to, ec);
+    if (ec) {
+        error = to.string() + ": cannot replace: " + ec.message();
+        return false;
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------
+// bake
+
+struct BakeOptions {
+    std::string scene;
+    std::string outDir;
+    std::vector<double> deltas;
+    int levels = 8;
+    std::string function = "adaptive";  ///< adaptive | constant
+    std::string distance = "exact";     ///< exact | cdt
+    std::string exclude;
+    std::string objectUnit = "node";    ///< node | subtree
+    std::string statsPath;
+    double touchTolerance = -1;
+    bool quiet = false;
+};
+
+CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "bake", "Bake a glTF scene (.glb or .gltf) into a level-of-detail hierarchy of aggregates");
+    cmd->add_option("scene", o.scene, "Input scene, .glb or .gltf")->required();
+    cmd->add_option("-o,--output", o.outDir, "Output directory (created if missing); receives levels.glb")
+        ->required();
+    CLI::Option* delta =
+        cmd->add_option("--delta", o.deltas,
+                        "Explicit thresholds, comma-separated, in scene units (e.g. 0.5,1,2)")
+            ->delimiter(',')
+            ->allow_extra_args(false);
+    CLI::Option* levels =
+        cmd->add_option("--levels", o.levels, "Number of automatic levels (default 8)")
+            ->check(CLI::Range(1, 1000));
+    delta->excludes(levels);
+    cmd->add_option("--function", o.function, "Aggregate function: adaptive (default) or constant")
+        ->transform(CLI::IsMember({"adaptive", "constant"}, CLI::ignore_case));
+    cmd->add_option("--distance", o.distance,
+                    "Distance between objects: exact (default, mesh to mesh) or cdt "
+                    "(shortest triangulation edge, as in the paper)")
+        ->transform(CLI::IsMember({"exact", "cdt"}, CLI::ignore_case));
+    cmd->add_option("--exclude", o.exclude,
+                    "Leave out nodes whose name matches this ECMAScript regex (with their subtree), "
+                    "e.g. 'Ground|Sky'");
+    cmd->add_option("--object", o.objectUnit,
+                    "What one object is: node (default: each node with a mesh) or subtree "
+                    "(each child of a scene root, with all meshes below it)")
+        ->transform(CLI::IsMember({"node", "subtree"}, CLI::ignore_case));
+    cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
+    cmd->add_option("--touch-tolerance", o.touchTolerance,
+                    "Objects closer than this are one model (default: 1e-6 x scene diagonal)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
+    return cmd;
+}
+
+int runBake(BakeOptions o) {
+    for (double d : o.deltas) {
+        if (!std::isfinite(d) || d < 0) {
+            printError("--delta: every threshold must be a finite number >= 0");
+            return kUsage;
+        }
+    }
+    std::sort(o.deltas.begin(), o.deltas.end());
+    o.deltas.erase(std::unique(o.deltas.begin(), o.deltas.end()), o.deltas.end());
+    if (!o.exclude.empty()) {
+        try {
+            std::regex check(o.exclude, std::regex::ECMAScript);
+        } catch (const std::regex_error& e) {
+            printError("--exclude: invalid regular expression '" + o.exclude + "': " + e.what());
+            return kUsage;
+        }
+    }
+
+    // Read.
+    io::SceneReadOptions readOptions;
+    readOptions.excludeRegex = o.exclude;
+    readOptions.objectUnit = o.objectUnit == "subtree" ? io::ObjectUnit::Subtree : io::ObjectUnit::Node;
+    io::SceneReadResult scene;
+    std::string error;
+    if (!io::readGltfScene(o.scene, readOptions, scene, error)) {
+        printError(error);
+        return kFileError;
+    }
+    cli::printDiagnostics(scene.diagnostics, o.quiet);
+    if (scene.objects.empty()) {
+        printError(o.scene + ": no objects to aggregate (all excluded or none with triangles)");
+        return kFileError;
+    }
+
+    // Bake.
+    cli::ProgressLine progress(!o.quiet && cli::stderrIsTerminal());
+    Settings3D settings;
+    settings.deltas = o.deltas;
+    settings.automaticLevelCount = o.levels;
+    settings.function = o.function == "constant" ? AggregateFunctionKind::Constant
+                                                 : AggregateFunctionKind::Adaptive;
+    settings.distance = o.distance == "cdt" ? DistanceMode::Cdt : DistanceMode::Exact;
+    settings.touchTolerance = o.touchTolerance;
+    settings.progress = [&progress](const char* stage, double fraction) {
+        progress.update(stage, fraction);
+    };
+    Hierarchy3D hierarchy;
+    const bool ok = buildHierarchy3D(scene.objects, settings, hierarchy);
+    progress.finish();
+    cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
+    if (!ok) {
+        printError(o.scene + ": baking failed; nothing was written");
+        return kBakeFailed;
+    }
+
+    // Write: temporary files first, then rename over the old outputs, so that a failure
+    // never leaves a half-written or mixed result behind.
+    const fs::path outDir(o.outDir);
+    std::error_code ec;
+    fs::create_directories(outDir, ec);
+    if (ec || !fs::is_directory(outDir)) {
+        printError(o.outDir + ": cannot create the output directory" +
+                   (ec ? ": " + ec.message() : std::string()));
+        return kFileError;
+    }
+    const fs::path levelsPath = outDir / "levels.glb";
+    const fs::path levelsTmp = outDir / "levels.glb.tmp";
+    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error)) {
+        removeQuietly(levelsTmp);
+        printError(error);
+        return kFileError;
+    }
+    fs::path statsPath, statsTmp;
+    if (!o.statsPath.empty()) {
+        statsPath = fs::path(o.statsPath);
+        statsTmp = fs::path(o.statsPath + ".tmp");
+        if (statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
+        if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, statsTmp.string(),
+                                error)) {
+            removeQuietly(levelsTmp);
+            removeQuietly(statsTmp);
+            printError(error);
+            return kFileError;
+        }
+    }
+    if (!renameOver(levelsTmp, levelsPath, error)) {
+        removeQuietly(levelsTmp);
+        if (!statsTmp.empty()) removeQuietly(statsTmp);
+        printError(error);
+        return kFileError;
+    }
+    if (!statsTmp.empty() && !renameOver(statsTmp, statsPath, error)) {
+        removeQuietly(statsTmp);
+        printError(error);
+        return kFileError;
+    }
+
+    if (!o.quiet) {
+        std::printf("%zu objects, %zu models, %zu triangles; originals: volume %s, sphericity %s\n",
+                    scene.objects.size(), hierarchy.modelCount, hierarchy.inputTriangleCount,
+                    cli::formatNumber(hierarchy.originals.volume).c_str(),
+                    cli::formatNumber(hierarchy.originals.sphericity).c_str());
+        std::fputs(cli::formatLevelTable(hierarchy).c_str(), stdout);
+        std::printf("wrote %s%s%s\n", levelsPath.string().c_str(),
+                    statsPath.empty() ? "" : " and ", statsPath.string().c_str());
+        std::fflush(stdout);
+    }
+    return kOk;
+}
+
+// ---------------------------------------------------------------------------
+
+int run(int argc, char** argv) {
+    CLI::App app{"aggrelod: aggregate separate objects into a level-of-detail hierarchy"};
+    app.set_version_flag("--version", std::string("aggrelod ") + AGGRELOD_VERSION);
+    app.require_subcommand(1);
+
+    BakeOptions bake;
+    CLI::App* bakeCommand = addBakeCommand(app, bake);
+
+    if (argc <= 1) {
+        std::fputs(app.help().c_str(), stderr);
+        return kUsage;
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);  // prints help, version or the error
+        return code == 0 ? kOk : kUsage;
+    }
+    if (bakeCommand->parsed()) return runBake(bake);
+    return kUsage;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "aggrelod: internal error: %s\n", e.what());
+    } catch (...) {
+        std::fprintf(stderr, "aggrelod: internal error\n");
+    }
+    return kInternal;
+}

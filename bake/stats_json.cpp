@@ -1,0 +1,255 @@
+// aggrelod bake: the stats JSON file, with a small hand-written JSON writer
+// (deterministic: shortest round-trip doubles, locale-independent; NaN/inf as null).
+#include "scene_io.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+namespace aggrelod::io {
+namespace {
+
+/// Minimal streaming JSON writer with two-space indentation. The caller keeps the
+/// structure valid; commas and indentation are handled here.
+class JsonWriter {
+public:
+    explicit JsonWriter(std::string& out) : out_(out) {}
+
+    void beginObject() { open('{'); }
+    void endObject() { close('}'); }
+    void beginArray() { open('['); }
+    void endArray() { close(']'); }
+
+    /// Arrays whose elements stay on one line (small records): `{"a": 1, "b": 2}`.
+    void beginInlineObject() {
+        value();
+        out_ += '{';
+        inlineDepth_++;
+        first_ = true;
+    }
+    void endInlineObject() {
+        out_ += '}';
+        inlineDepth_--;
+        first_ = false;
+    }
+
+    void key(const std::string& k) {
+        separator();
+        string(k);
+        out_ += ": ";
+        afterKey_ = true;
+    }
+
+    void number(double v) {
+        value();
+        if (!std::isfinite(v)) {
+            out_ += "null";
+            return;
+        }
+        if (v == 0) v = 0;  // no "-0"
+        char buf[64];
+        const auto r = std::to_chars(buf, buf + sizeof buf, v);
+        out_.append(buf, r.ptr);
+    }
+    void integer(long long v) {
+        value();
+        out_ += std::to_string(v);
+    }
+    void unsignedInteger(unsigned long long v) {
+        value();
+        out_ += std::to_string(v);
+    }
+    void str(const std::string& s) {
+        value();
+        string(s);
+    }
+
+    // key + value shorthands
+    void field(const std::string& k, double v) { key(k); number(v); }
+    void fieldInt(const std::string& k, unsigned long long v) { key(k); unsignedInteger(v); }
+    void fieldSigned(const std::string& k, long long v) { key(k); integer(v); }
+    void fieldStr(const std::string& k, const std::string& v) { key(k); str(v); }
+
+    void finish() { out_ += '\n'; }
+
+private:
+    void open(char c) {
+        value();
+        out_ += c;
+        depth_++;
+        first_ = true;
+    }
+    void close(char c) {
+        depth_--;
+        if (!first_) newline();
+        out_ += c;
+        first_ = false;
+    }
+    void newline() {
+        out_ += '\n';
+        out_.append(size_t(depth_) * 2, ' ');
+    }
+    void separator() {
+        if (!first_) out_ += inlineDepth_ > 0 ? ", " : ",";
+        if (inlineDepth_ == 0) newline();
+        first_ = false;
+    }
+    /// Before a value: separator unless it follows a key.
+    void value() {
+        if (afterKey_) {
+            afterKey_ = false;
+            return;
+        }
+        if (depth_ == 0 && inlineDepth_ == 0 && out_.empty()) return;
+        separator();
+    }
+    void string(const std::string& s) {
+        out_ += '"';
+        for (unsigned char c : s) {
+            switch (c) {
+                case '"': out_ += "\\\""; break;
+                case '\\': out_ += "\\\\"; break;
+                case '\b': out_ += "\\b"; break;
+                case '\f': out_ += "\\f"; break;
+                case '\n': out_ += "\\n"; break;
+                case '\r': out_ += "\\r"; break;
+                case '\t': out_ += "\\t"; break;
+                default:
+                    if (c < 0x20 || c == 0x7f) {
+                        char buf[8];
+                        std::snprintf(buf, sizeof buf, "\\u%04x", unsigned(c));
+                        out_ += buf;
+                    } else {
+                        out_ += char(c);  // UTF-8 passes through
+                    }
+            }
+        }
+        out_ += '"';
+    }
+
+    std::string& out_;
+    int depth_ = 0;
+    int inlineDepth_ = 0;
+    bool first_ = true;
+    bool afterKey_ = false;
+};
+
+const char* severityName(Diagnostic::Severity s) {
+    switch (s) {
+        case Diagnostic::Severity::Note: return "note";
+        case Diagnostic::Severity::Warning: return "warning";
+        case Diagnostic::Severity::Error: return "error";
+    }
+    return "warning";
+}
+
+void writeMeasures(JsonWriter& w, const SolidMeasures& m) {
+    w.beginInlineObject();
+    w.field("volume", m.volume);
+    w.field("area", m.area);
+    w.field("sphericity", m.sphericity);
+    w.endInlineObject();
+}
+
+void writeDiagnostic(JsonWriter& w, const Diagnostic& d) {
+    w.beginInlineObject();
+    w.fieldStr("severity", severityName(d.severity));
+    w.fieldStr("object", d.object);
+    w.fieldStr("message", d.message);
+    w.endInlineObject();
+}
+
+std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& objects,
+                          const std::vector<Diagnostic>& readDiagnostics) {
+    std::string text;
+    JsonWriter w(text);
+    w.beginObject();
+    w.fieldInt("objects", objects.size());
+    w.fieldInt("models", h.modelCount);
+    w.fieldInt("input_triangles", h.inputTriangleCount);
+    w.fieldInt("tetrahedra", h.tetrahedronCount);
+    w.key("originals");
+    writeMeasures(w, h.originals);
+
+    w.key("levels");
+    w.beginArray();
+    for (size_t k = 0; k < h.levels.size(); ++k) {
+        const Level& l = h.levels[k];
+        long long components = 0;
+        for (const Aggregate& a : l.aggregates) components += a.componentCount;
+        w.beginInlineObject();
+        w.fieldInt("level", k);
+        w.field("delta", l.delta);
+        w.fieldInt("groups", l.aggregates.size());
+        w.fieldInt("triangles", l.triangleCount);
+        w.field("volume_original", l.volumeOriginal);
+        w.field("volume_aggregate", l.measures.volume);
+        w.field("volume_hull", l.volumeHull);
+        w.field("volume_constant", l.volumeConstant);
+        w.field("added_volume", l.measures.volume - l.volumeOriginal);
+        w.field("added_volume_hull", l.volumeHull - l.volumeOriginal);
+        w.field("added_volume_constant", l.volumeConstant - l.volumeOriginal);
+        w.field("area", l.measures.area);
+        w.field("sphericity", l.measures.sphericity);
+        w.fieldSigned("components", components);
+        w.endInlineObject();
+    }
+    w.endArray();
+
+    w.key("merges");
+    w.beginArray();
+    for (const Merge& m : h.merges) {
+        w.beginInlineObject();
+        w.field("height", m.height);
+        w.fieldInt("a", m.modelA);
+        w.fieldInt("b", m.modelB);
+        w.endInlineObject();
+    }
+    w.endArray();
+
+    w.key("warnings");
+    w.beginArray();
+    for (const Diagnostic& d : readDiagnostics) writeDiagnostic(w, d);
+    for (const Diagnostic& d : h.diagnostics) writeDiagnostic(w, d);
+    w.endArray();
+
+    // Last, so that determinism checks can drop it.
+    w.key("timings");
+    w.beginObject();
+    for (const auto& t : h.timings) w.field(t.first, t.second);
+    w.endObject();
+    w.endObject();
+    w.finish();
+    return text;
+}
+
+}  // namespace
+
+bool writeStatsJson(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                    const std::vector<Diagnostic>& readDiagnostics, const std::string& path,
+                    std::string& error) {
+    try {
+        const std::string text = statsJsonText(hierarchy, objects, readDiagnostics);
+        std::ofstream out(path, std::ios::binary | std::ios::trunc);
+        if (!out) {
+            error = path + ": cannot create: " + std::strerror(errno);
+            return false;
+        }
+        out.write(text.data(), std::streamsize(text.size()));
+        out.close();
+        if (!out) {
+            error = path + ": write error (disk full?)";
+            return false;
+        }
+        return true;
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+}  // namespace aggrelod::io

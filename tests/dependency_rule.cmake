@@ -1,0 +1,127 @@
+# Checks the dependency rule of DESIGN section 1. Run as
+#   cmake -DSOURCE_DIR=<repo root> [-DLINK_INFO=<generated file>] -P dependency_rule.cmake
+#
+# - no file under runtime/ includes TetGen, CGAL, tinygltf, meshoptimizer, GEOS, GLM or any
+#   header of module/;
+# - no file under module/ includes tinygltf or any header of runtime/;
+# - (with LINK_INFO, written by tests/CMakeLists.txt at generate time) no target defined under
+#   runtime/ links TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS, GLM or the module, and
+#   no target under module/ links tinygltf or the runtime.
+# Prints every violation and fails (FATAL_ERROR) when there is one.
+cmake_minimum_required(VERSION 3.22)
+
+if(NOT SOURCE_DIR)
+  message(FATAL_ERROR "dependency_rule: pass -DSOURCE_DIR=<repository root>")
+endif()
+
+set(_source_globs *.h *.hh *.hpp *.hxx *.inl *.ipp *.c *.cc *.cpp *.cxx)
+set(violations 0)
+
+# Headers of a part, as they could be named in an #include: path relative to the include
+# directory (e.g. aggrelod/aggregate3d.h) and bare file name.
+function(collect_header_names part out_var)
+  set(names "")
+  foreach(pattern *.h *.hh *.hpp *.hxx *.inl)
+    file(GLOB_RECURSE headers "${SOURCE_DIR}/${part}/${pattern}")
+    foreach(h IN LISTS headers)
+      get_filename_component(base "${h}" NAME)
+      list(APPEND names "${base}")
+      file(RELATIVE_PATH rel "${SOURCE_DIR}/${part}/include" "${h}")
+      if(NOT rel MATCHES "^\\.\\.")
+        list(APPEND names "${rel}")
+      endif()
+    endforeach()
+  endforeach()
+  list(REMOVE_DUPLICATES names)
+  set(${out_var} "${names}" PARENT_SCOPE)
+endfunction()
+
+# Checks every #include of every source file under SOURCE_DIR/<part>.
+#   forbidden_regex: included names that are not allowed
+#   forbidden_names: exact included names (or names ending in /<name>) that are not allowed
+function(check_includes part forbidden_regex forbidden_names)
+  set(count 0)
+  set(files "")
+  foreach(pattern IN LISTS _source_globs)
+    file(GLOB_RECURSE found "${SOURCE_DIR}/${part}/${pattern}")
+    list(APPEND files ${found})
+  endforeach()
+  list(REMOVE_DUPLICATES files)
+  list(SORT files)
+  list(LENGTH files nfiles)
+  foreach(f IN LISTS files)
+    file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
+    foreach(line IN LISTS lines)
+      if(NOT line MATCHES "^[ \t]*#[ \t]*include[ \t]*[<\"]([^>\"]+)[>\"]")
+        continue()
+      endif()
+      set(name "${CMAKE_MATCH_1}")
+      set(bad FALSE)
+      if(name MATCHES "${forbidden_regex}")
+        set(bad TRUE)
+      endif()
+      get_filename_component(base "${name}" NAME)
+      foreach(n IN LISTS forbidden_names)
+        if(name STREQUAL n OR (NOT n MATCHES "/" AND base STREQUAL n))
+          set(bad TRUE)
+        endif()
+      endforeach()
+      if(bad)
+        file(RELATIVE_PATH rel "${SOURCE_DIR}" "${f}")
+        message("VIOLATION: ${rel} includes <${name}> (not allowed in ${part}/)")
+        math(EXPR count "${count} + 1")
+      endif()
+    endforeach()
+  endforeach()
+  message("dependency_rule: ${part}/: ${nfiles} source files checked, ${count} forbidden includes")
+  math(EXPR total "${violations} + ${count}")
+  set(violations ${total} PARENT_SCOPE)
+endfunction()
+
+collect_header_names(module module_headers)
+collect_header_names(runtime runtime_headers)
+# A header that exists in both parts under the same name cannot tell them apart: leave it out.
+set(module_only ${module_headers})
+set(runtime_only ${runtime_headers})
+if(module_headers AND runtime_headers)
+  list(REMOVE_ITEM module_only ${runtime_headers})
+  list(REMOVE_ITEM runtime_only ${module_headers})
+endif()
+
+check_includes(runtime
+  "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|(^|/)module/"
+  "${module_only}")
+check_includes(module
+  "(^|/)tiny_gltf\\.h$|(^|/)runtime/"
+  "${runtime_only}")
+
+if(LINK_INFO)
+  if(NOT EXISTS "${LINK_INFO}")
+    message(FATAL_ERROR "dependency_rule: ${LINK_INFO} is missing (re-run cmake)")
+  endif()
+  include("${LINK_INFO}")
+  set(_forbidden_runtime "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples")
+  set(_forbidden_module "tinygltf|aggrelod_runtime|aggrelod::runtime|aggrelod_io")
+  foreach(part runtime module)
+    set(count 0)
+    foreach(t IN LISTS TARGETS_${part})
+      set(links "${LINKS_${t}}")
+      list(REMOVE_ITEM links "")
+      list(REMOVE_DUPLICATES links)
+      message("dependency_rule: ${part}/ target ${t} links: ${links}")
+      foreach(l IN LISTS links)
+        string(TOLOWER "${l}" lower)
+        if(lower MATCHES "${_forbidden_${part}}")
+          message("VIOLATION: ${part}/ target ${t} links ${l}")
+          math(EXPR count "${count} + 1")
+        endif()
+      endforeach()
+    endforeach()
+    math(EXPR violations "${violations} + ${count}")
+  endforeach()
+endif()
+
+if(violations GREATER 0)
+  message(FATAL_ERROR "dependency_rule: ${violations} violation(s) of the dependency rule (DESIGN section 1)")
+endif()
+message("dependency_rule: OK")

@@ -1,0 +1,4 @@
+// Violations: tinygltf and a runtime header in the module.
+#include <aggrelod/fixture_module.h>
+#include <tiny_gltf.h>
+#include <aggrelod/fixture_runtime.h>
