@@ -953,21 +953,19 @@ public:
         if (vertexCount == 0 || indices.empty()) return -1;
 
         std::vector<float> p(vertexCount * 3);
+        // min/max (required for POSITION) over the finite values of each component.
         double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-        bool any = false;
+        bool any[3] = {false, false, false};
         for (size_t v = 0; v < vertexCount; ++v) {
-            bool finite = true;
-            for (int c = 0; c < 3; ++c) {
-                p[3 * v + size_t(c)] = float(positions[3 * v + size_t(c)]);
-                finite = finite && std::isfinite(p[3 * v + size_t(c)]);
+            for (size_t c = 0; c < 3; ++c) {
+                const float f = float(positions[3 * v + c]);
+                p[3 * v + c] = f;
+                if (!std::isfinite(f)) continue;
+                const double x = double(f);
+                if (!any[c] || x < lo[c]) lo[c] = x;
+                if (!any[c] || x > hi[c]) hi[c] = x;
+                any[c] = true;
             }
-            if (!finite) continue;
-            for (int c = 0; c < 3; ++c) {
-                const double x = double(p[3 * v + size_t(c)]);
-                if (!any || x < lo[c]) lo[c] = x;
-                if (!any || x > hi[c]) hi[c] = x;
-            }
-            any = true;
         }
 
         tinygltf::Accessor pos;

@@ -2,6 +2,7 @@
 // (deterministic: shortest round-trip doubles, locale-independent; NaN/inf as null).
 #include "scene_io.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -9,6 +10,8 @@
 #include <cstring>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace aggrelod::io {
 namespace {
@@ -218,9 +221,21 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
     w.endArray();
 
     // Last, so that determinism checks can drop it.
+    // A stage run more than once (e.g. triangulating again after a refinement) is summed,
+    // so that every key appears once, in order of first appearance.
+    std::vector<std::pair<std::string, double>> timings;
+    for (const auto& t : h.timings) {
+        auto it = std::find_if(timings.begin(), timings.end(),
+                               [&](const auto& e) { return e.first == t.first; });
+        if (it == timings.end()) {
+            timings.push_back(t);
+        } else {
+            it->second += t.second;
+        }
+    }
     w.key("timings");
     w.beginObject();
-    for (const auto& t : h.timings) w.field(t.first, t.second);
+    for (const auto& t : timings) w.field(t.first, t.second);
     w.endObject();
     w.endObject();
     w.finish();

@@ -538,8 +538,8 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
     for (size_t s = 0; s < nt; ++s) {
         triangleIndex_[s] = prims[s].index;
         const uint32_t* tri = indices + 3 * size_t(prims[s].index);
-        for (int c = 0; c < 3; ++c)
-            for (int k = 0; k < 3; ++k) corners_[9 * s + 3 * c + k] = positions[3 * size_t(tri[c]) + k];
+        for (size_t c = 0; c < 3; ++c)
+            for (size_t k = 0; k < 3; ++k) corners_[9 * s + 3 * c + k] = positions[3 * size_t(tri[c]) + k];
     }
     // Exact node boxes, bottom-up (children always follow their parent in the array).
     for (size_t n = nodes_.size(); n-- > 0;) {
@@ -699,7 +699,7 @@ ClosestPair meshDistance(const TriangleBvh& a, const TriangleBvh& b, double maxD
             }
             continue;
         }
-        // Descend the larger box (Ericson 6.3.2); a leaf is never split.
+        // Descend the larger box (Ericson 6.3.1); a leaf is never split.
         bool splitA = B.count != 0 || (A.count == 0 && halfArea(A.lo, A.hi) >= halfArea(B.lo, B.hi));
         Item c0, c1;
         if (splitA) {

@@ -11,9 +11,11 @@
 //   intersection test (an edge of one triangle crossing the other, Ericson 5.3.4 scalar
 //   triple products; coplanar overlap by a 2D separating-axis test), giving 0 when the
 //   triangles intersect or touch;
-// - a binned-SAH BVH over triangle centroids (leaves <= 4 triangles, flattened node array)
-//   and BVH-vs-BVH / point-vs-BVH best-first depth-first traversal with pruning by box
-//   distance against the current best (Ericson 6.3.x, "descend larger" rule 6.3.2).
+// - a BVH of axis-aligned boxes built top-down by binned SAH over triangle centroids
+//   (Wald 2007; leaves <= 4 triangles, flattened node array, exact double boxes), and
+//   BVH-vs-BVH / point-vs-BVH depth-first traversal, nearer box pair first, pruning pairs
+//   whose box distance exceeds the current best (Ericson 6.3.1 "descend larger" rule,
+//   6.3.2 informed depth-first traversal).
 //
 // Units: every length is in the input's world units. Arrays: positions are xyz triples
 // (3 * vertexCount doubles), indices are triangle corner triples (3 * triangleCount);

@@ -179,6 +179,7 @@ private:
     double tolerance_ = 0;
     FreeSpace space_;
     AggregateFunction function_;
+    std::map<std::vector<uint32_t>, double> hullVolumeOfGroup_;
 
     bool prepare();
     void buildModels();
@@ -188,6 +189,12 @@ private:
     void analyseFreeSpace(const std::vector<int>& pointModel);
     void buildGraph();
     bool refineCoarseConnections();
+    void prerefineClosePairs();
+    struct Insertion {
+        uint32_t model, triangle;
+        double point[3];
+    };
+    size_t insertSurfacePoints(std::vector<Insertion>& insertions);
     void buildLevels();
 };
 
@@ -573,32 +580,65 @@ void Baker::buildGraph() {
     }
 }
 
-// DESIGN 2.4 step 4: where large input triangles leave no short triangulation edge between
-// two models the dendrogram joins (shortest edge much longer than the exact distance),
-// insert the closest points into both surfaces as Steiner vertices and triangulate again,
-// so that gap-spanning edges approach the true distance. One extra pass, only when needed.
-bool Baker::refineCoarseConnections() {
-    std::vector<GraphEdge> graph;
-    for (const ModelPair& p : space_.pairs) graph.push_back(GraphEdge{p.a, p.b, p.weight});
-    std::vector<Merge> merges = kruskalMerges(models_.size(), graph);
-    struct Insertion {
-        uint32_t model, triangle;
-        double point[3];
-    };
-    std::vector<Insertion> insertions;
-    for (const Merge& m : merges) {
-        int idx = space_.findPair(m.modelA, m.modelB);
-        if (idx < 0) continue;
-        const ModelPair& p = space_.pairs[idx];
-        if (p.closestTriangleA == ~0u || p.closestTriangleB == ~0u) continue;
-        if (!(p.shortestEdge > 1.5 * p.exactDistance + tolerance_)) continue;
-        Insertion a{p.a, p.closestTriangleA, {p.closestA[0], p.closestA[1], p.closestA[2]}};
-        Insertion b{p.b, p.closestTriangleB, {p.closestB[0], p.closestB[1], p.closestB[2]}};
-        insertions.push_back(a);
-        insertions.push_back(b);
+// Before the one triangulation: each model's nearest neighbours (by box distance) are
+// measured exactly; where the closest points lie far from the surface vertices (coarse
+// triangles), they are inserted as vertices, so the triangulation gets gap-spanning edges
+// close to the true distance without a second TetGen run (DESIGN 2.4 step 4).
+void Baker::prerefineClosePairs() {
+    timer_.begin("prerefine");
+    resolveStandInOverlaps();
+    const size_t n = models_.size();
+    if (n < 2) return;
+    for (Model& m : models_) {
+        computeBounds(m.positions, m.bounds);
+        m.bvh.build(m.positions.data(), m.positions.size() / 3, m.triangles.data(), m.triangles.size() / 3);
     }
-    if (insertions.empty()) return false;
-    timer_.begin("refine");
+    constexpr size_t kNeighbours = 6;
+    std::vector<std::pair<uint32_t, uint32_t>> candidates;
+    std::vector<std::pair<double, uint32_t>> near;
+    for (uint32_t i = 0; i < n; ++i) {
+        near.clear();
+        for (uint32_t j = 0; j < n; ++j) {
+            if (j == i) continue;
+            double d2 = 0;
+            for (int k = 0; k < 3; ++k) {
+                double gap = std::max({0.0, models_[j].bounds[k] - models_[i].bounds[3 + k], models_[i].bounds[k] - models_[j].bounds[3 + k]});
+                d2 += gap * gap;
+            }
+            near.emplace_back(d2, j);
+        }
+        const size_t keep = std::min(kNeighbours, near.size());
+        std::partial_sort(near.begin(), near.begin() + keep, near.end());
+        for (size_t k = 0; k < keep; ++k) candidates.emplace_back(std::min(i, near[k].second), std::max(i, near[k].second));
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    std::vector<Insertion> insertions;
+    auto nearestVertexDistance = [&](const Model& m, uint32_t tri, const double* p) {
+        double best = INFINITY;
+        for (int k = 0; k < 3; ++k) {
+            const double* v = &m.positions[3 * m.triangles[3 * tri + k]];
+            best = std::min(best, std::sqrt((v[0] - p[0]) * (v[0] - p[0]) + (v[1] - p[1]) * (v[1] - p[1]) + (v[2] - p[2]) * (v[2] - p[2])));
+        }
+        return best;
+    };
+    for (size_t c = 0; c < candidates.size(); ++c) {
+        const auto [i, j] = candidates[c];
+        detail::ClosestPair cp = detail::meshDistance(models_[i].bvh, models_[j].bvh);
+        if (cp.triangleA == ~0u || cp.triangleB == ~0u || !(cp.distance > tolerance_)) continue;
+        const double ra = nearestVertexDistance(models_[i], cp.triangleA, cp.pointA);
+        const double rb = nearestVertexDistance(models_[j], cp.triangleB, cp.pointB);
+        if (ra + rb <= 0.5 * cp.distance) continue;  // a short edge exists already
+        if (ra > 0.1 * cp.distance) insertions.push_back(Insertion{i, cp.triangleA, {cp.pointA[0], cp.pointA[1], cp.pointA[2]}});
+        if (rb > 0.1 * cp.distance) insertions.push_back(Insertion{j, cp.triangleB, {cp.pointB[0], cp.pointB[1], cp.pointB[2]}});
+        if (c % 64 == 0) timer_.report(double(c) / candidates.size());
+    }
+    insertSurfacePoints(insertions);
+}
+
+// Splits surface triangles 1 -> 3 at the given points (moved slightly inside the triangle
+// so no sliver or degenerate triangle appears). Returns how many points were inserted.
+size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
     std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
         return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
     });
@@ -669,6 +709,32 @@ bool Baker::refineCoarseConnections() {
         }
         i = j;
     }
+    return inserted;
+}
+
+// DESIGN 2.4 step 4: where large input triangles leave no short triangulation edge between
+// two models the dendrogram joins (shortest edge much longer than the exact distance),
+// insert the closest points into both surfaces as Steiner vertices and triangulate again,
+// so that gap-spanning edges approach the true distance. One extra pass, only when needed.
+bool Baker::refineCoarseConnections() {
+    std::vector<GraphEdge> graph;
+    for (const ModelPair& p : space_.pairs) graph.push_back(GraphEdge{p.a, p.b, p.weight});
+    std::vector<Merge> merges = kruskalMerges(models_.size(), graph);
+    std::vector<Insertion> insertions;
+    for (const Merge& m : merges) {
+        int idx = space_.findPair(m.modelA, m.modelB);
+        if (idx < 0) continue;
+        const ModelPair& p = space_.pairs[idx];
+        if (p.closestTriangleA == ~0u || p.closestTriangleB == ~0u) continue;
+        if (!(p.shortestEdge > 1.5 * p.exactDistance + tolerance_)) continue;
+        Insertion a{p.a, p.closestTriangleA, {p.closestA[0], p.closestA[1], p.closestA[2]}};
+        Insertion b{p.b, p.closestTriangleB, {p.closestB[0], p.closestB[1], p.closestB[2]}};
+        insertions.push_back(a);
+        insertions.push_back(b);
+    }
+    if (insertions.empty()) return false;
+    timer_.begin("refine");
+    const size_t inserted = insertSurfacePoints(insertions);
     diag(out_, Diagnostic::Severity::Note, "",
          "refined " + std::to_string(inserted) + " surface point(s) where the triangulation had no short connection "
          "between joined models; triangulating again");
@@ -752,7 +818,11 @@ void Baker::buildLevels() {
                 groupPoints[modelGroup[m]].insert(groupPoints[modelGroup[m]].end(), models_[m].hullPoints.begin(),
                                                   models_[m].hullPoints.end());
             for (size_t g = 0; g < groupCount; ++g) {
-                aggregates[g].volumeHull = detail::convexHullVolume(groupPoints[g]);
+                // A group unchanged since an earlier level keeps its hull volume.
+                auto cached = hullVolumeOfGroup_.find(aggregates[g].sourceObjects);
+                if (cached == hullVolumeOfGroup_.end())
+                    cached = hullVolumeOfGroup_.emplace(aggregates[g].sourceObjects, detail::convexHullVolume(groupPoints[g])).first;
+                aggregates[g].volumeHull = cached->second;
                 level.volumeHull += aggregates[g].volumeHull;
             }
         }
@@ -780,6 +850,7 @@ bool Baker::run() {
         return false;
     }
     buildModels();
+    if (settings_.distance == DistanceMode::Exact) prerefineClosePairs();
     if (!triangulate()) {
         timer_.end();
         return false;

@@ -13,6 +13,9 @@
 #include "sculpt_3d.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <numeric>
 #include <queue>
@@ -441,18 +444,30 @@ uint32_t FreeSpace::edgeStatsBelow(const ModelPair& p, double limit, double& mea
 }
 
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel) {
+    static const bool profile = std::getenv("AGGRELOD_PROFILE") != nullptr;
+    auto t0 = std::chrono::steady_clock::now();
+    auto lap = [&](const char* what) {
+        if (!profile) return;
+        auto t1 = std::chrono::steady_clock::now();
+        std::fprintf(stderr, "  sculpt %-10s %.3f s\n", what, std::chrono::duration<double>(t1 - t0).count());
+        t0 = t1;
+    };
     Sculptor sculptor(space, request, tetLabel);
     sculptor.initialLabels();
+    lap("labels");
     sculptor.isProtected.assign(space.mesh.tetCount(), 0);
     for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
+    lap("protect");
     sculptor.carve();
+    lap("carve");
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
-    for (int round = 0; round < 16; ++round) {
+    for (int round = 0; round < 6; ++round) {
         bool changed = sculptor.removeIslands();
         changed |= sculptor.repairNonManifoldEdges();
         changed |= sculptor.fillVoids();
+        lap("cleanup");
         if (!changed) break;
     }
 }

@@ -615,6 +615,26 @@ TEST(MeshDistance, RandomMeshesMatchBruteForce) {
     EXPECT_LT(intersecting, 180);
 }
 
+TEST(MeshDistance, LargerRandomMeshesMatchBruteForce) {
+    // Deeper trees (~100 leaves each), separated, touching-close and interpenetrating.
+    const double gaps[4] = {2.6, 2.2, 0.9, 0.5};
+    int separated = 0, intersecting = 0;
+    for (uint32_t seed = 0; seed < 4; ++seed) {
+        std::mt19937 rng(1000 + seed);
+        double offA[3] = {0, 0, 0}, offB[3] = {gaps[seed], 0.1, -0.05};
+        Mesh a = randomMesh(rng, 400, 1.0, offA), b = randomMesh(rng, 400, 1.0, offB);
+        ClosestPair r = meshDistance(bvhOf(a), bvhOf(b));
+        ClosestPair bf = bruteForce(a, b);
+        EXPECT_EQ(r.distance, bf.distance) << seed;
+        EXPECT_EQ(r.triangleA, bf.triangleA) << seed;
+        EXPECT_EQ(r.triangleB, bf.triangleB) << seed;
+        EXPECT_EQ(r.intersecting, bf.intersecting) << seed;
+        (r.intersecting ? intersecting : separated) += 1;
+    }
+    EXPECT_GE(separated, 1);
+    EXPECT_GE(intersecting, 1);
+}
+
 TEST(MeshDistance, BvhStructureAndDeterminism) {
     std::mt19937 rng(99);
     double off[3] = {0, 0, 0};
