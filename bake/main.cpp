@@ -112,6 +112,10 @@ int runBake(BakeOptions o) {
             return kUsage;
         }
     }
+    if (!std::isfinite(o.touchTolerance) || (o.touchTolerance < 0 && o.touchTolerance != -1)) {
+        printError("--touch-tolerance: must be a finite number >= 0");
+        return kUsage;
+    }
     std::sort(o.deltas.begin(), o.deltas.end());
     o.deltas.erase(std::unique(o.deltas.begin(), o.deltas.end()), o.deltas.end());
     if (!o.exclude.empty()) {

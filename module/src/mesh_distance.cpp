@@ -8,6 +8,10 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#if defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
+#include <emmintrin.h>
+#define AGGRELOD_MD_SSE 1
+#endif
 
 namespace aggrelod::detail {
 namespace {
@@ -36,6 +40,19 @@ inline double dist2(const Vec3& a, const Vec3& b) {
     return dot(d, d);
 }
 inline double clamp01(double v) { return v < 0 ? 0 : (v > 1 ? 1 : v); }
+
+// lo = min(lo, a), hi = max(hi, b) on 4 floats (build records; exact, order-independent).
+inline void growBox4(float* lo, float* hi, const float* a, const float* b) {
+#ifdef AGGRELOD_MD_SSE
+    _mm_storeu_ps(lo, _mm_min_ps(_mm_loadu_ps(lo), _mm_loadu_ps(a)));
+    _mm_storeu_ps(hi, _mm_max_ps(_mm_loadu_ps(hi), _mm_loadu_ps(b)));
+#else
+    for (int k = 0; k < 4; ++k) {
+        lo[k] = std::min(lo[k], a[k]);
+        hi[k] = std::max(hi[k], b[k]);
+    }
+#endif
+}
 
 // ---- primitives (squared distances, closest points) ------------------------------------
 
@@ -443,10 +460,7 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
         auto addToBin = [&](const Prim& p, int axis) {
             Bin& b = bins[axis][binOf(p.c[axis], w.clo[axis], scale[axis], nb)];
             ++b.count;
-            for (int k = 0; k < 4; ++k) {
-                b.lo[k] = std::min(b.lo[k], p.lo[k]);
-                b.hi[k] = std::max(b.hi[k], p.hi[k]);
-            }
+            growBox4(b.lo, b.hi, p.lo, p.hi);
         };
         for (uint32_t i = w.begin; i < w.end; ++i)
             for (int axis = 0; axis < 3; ++axis) addToBin(prims[i], axis);
@@ -460,10 +474,7 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
             uint32_t rc = 0;
             for (int i = nb - 1; i > 0; --i) {
                 rc += bs[i].count;
-                for (int k = 0; k < 4; ++k) {
-                    rlo[k] = std::min(rlo[k], bs[i].lo[k]);
-                    rhi[k] = std::max(rhi[k], bs[i].hi[k]);
-                }
+                growBox4(rlo, rhi, bs[i].lo, bs[i].hi);
                 rightCount[i] = rc;
                 rightArea[i] = rc ? area(rlo, rhi) : 0;
             }
@@ -472,10 +483,7 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
             uint32_t lc = 0;
             for (int i = 0; i < nb - 1; ++i) {
                 lc += bs[i].count;
-                for (int k = 0; k < 4; ++k) {
-                    llo[k] = std::min(llo[k], bs[i].lo[k]);
-                    lhi[k] = std::max(lhi[k], bs[i].hi[k]);
-                }
+                growBox4(llo, lhi, bs[i].lo, bs[i].hi);
                 if (lc == 0 || rightCount[i + 1] == 0) continue;
                 double cost = lc * area(llo, lhi) + rightCount[i + 1] * rightArea[i + 1];
                 if (cost < bestCost) {
@@ -489,12 +497,7 @@ void TriangleBvh::build(const double* positions, size_t vertexCount, const uint3
         // Partition (two-pointer, deterministic), gathering each side's centroid bounds.
         Work L{0, w.begin, 0, {FLT_MAX, FLT_MAX, FLT_MAX, 0}, {-FLT_MAX, -FLT_MAX, -FLT_MAX, 0}};
         Work R{0, 0, w.end, {FLT_MAX, FLT_MAX, FLT_MAX, 0}, {-FLT_MAX, -FLT_MAX, -FLT_MAX, 0}};
-        auto grow = [](Work& s, const Prim& p) {
-            for (int k = 0; k < 4; ++k) {
-                s.clo[k] = std::min(s.clo[k], p.c[k]);
-                s.chi[k] = std::max(s.chi[k], p.c[k]);
-            }
-        };
+        auto grow = [](Work& s, const Prim& p) { growBox4(s.clo, s.chi, p.c, p.c); };
         uint32_t mid = w.begin;
         if (bestAxis >= 0) {
             const int axis = bestAxis;
