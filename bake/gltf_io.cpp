@@ -258,6 +258,11 @@ bool readAccessor(const tinygltf::Model& model, int index, bool indices,
     const size_t elementSize = size_t(csize) * size_t(components);
 
     if (acc.bufferView < 0) {
+        // Nothing bounds the count by the file's size here: refuse absurd ones.
+        if (count > (size_t(1) << 28)) {
+            why = name + " has no bufferView and too many elements (" + std::to_string(count) + ")";
+            return false;
+        }
         if (!acc.sparse.isSparse) {
             // Spec: without a buffer view the accessor is all zeros. Geometry compressed by
             // an extension (Draco, meshopt) also looks like this; the caller reports that.
@@ -412,7 +417,12 @@ private:
         diags_.push_back(Diagnostic{severity, object, message});
     }
     bool excluded(int node) const {
-        return hasRegex_ && std::regex_search(displayName(model_, node), regex_);
+        if (!hasRegex_) return false;
+        // libstdc++'s regex matcher recurses per character: a crafted, very long name could
+        // overflow the stack, so only the first 1024 characters of a name are matched.
+        std::string name = displayName(model_, node);
+        if (name.size() > 1024) name.resize(1024);
+        return std::regex_search(name, regex_);
     }
     void addMeshOfNode(int node, const Mat4& world, ObjectBuilder& object);
     bool addPrimitive(int node, int meshIndex, int primIndex, const Mat4& world, bool flip,

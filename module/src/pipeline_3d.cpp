@@ -831,6 +831,7 @@ void Baker::buildLevels() {
         } else if (settings_.computeConstantBaseline) {
             detail::LevelShapeRequest constantRequest = request;
             constantRequest.function = &constant;
+            constantRequest.cleanUp = false;  // volume only: the clean-up changes it by slivers
             std::vector<int> constantLabel;
             detail::sculptLevel(space_, constantRequest, constantLabel);
             for (size_t t = 0; t < constantLabel.size(); ++t)

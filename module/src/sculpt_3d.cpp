@@ -237,7 +237,7 @@ struct Sculptor {
         bool changed = false;
         for (size_t t = 0; t < tetCount; ++t)
             if (label[t] >= 0 && !reached[t]) {
-                label[t] = -1;
+                setLabel(static_cast<int>(t), -1);
                 changed = true;
             }
         return changed;
@@ -278,7 +278,7 @@ struct Sculptor {
                 }
             }
             if (border >= 0) {
-                for (int t : members) label[t] = border;
+                for (int t : members) setLabel(t, border);
                 changed = true;
             }
         }
@@ -287,7 +287,7 @@ struct Sculptor {
 
     // Tets around edge (u, v), starting from tet t0 which contains it. When the ring
     // reaches the hull it is open and holds the tets of both sides.
-    void edgeRing(int t0, int u, int v, std::vector<int>& ring) const {
+    bool edgeRing(int t0, int u, int v, std::vector<int>& ring) const {
         auto local = [&](int t, int w) {
             for (int k = 0; k < 4; ++k)
                 if (mesh.tets[4 * t + k] == w) return k;
@@ -304,40 +304,64 @@ struct Sculptor {
             for (int guard = 0; guard < 1024; ++guard) {
                 int n = mesh.neighbors[4 * t + cross];
                 if (n < 0) break;       // open ring: walk the other way too
-                if (n == t0) return;    // closed ring complete
+                if (n == t0) return true;  // closed ring complete
                 int lu = local(n, u), lv = local(n, v), entered = -1;
                 for (int c = 0; c < 4; ++c)
                     if (mesh.neighbors[4 * n + c] == t && c != lu && c != lv) entered = c;
-                if (lu < 0 || lv < 0 || entered < 0) return;
+                if (lu < 0 || lv < 0 || entered < 0) return false;
                 ring.push_back(n);
                 t = n;
                 cross = 6 - lu - lv - entered;
             }
         }
+        return false;
     }
 
     // Edges where the group's solid meets itself only along the edge (more than two
     // surface faces): fill the gap tets when they are all unclaimed free space, else
     // remove the free unprotected solid tets around the edge.
-    bool repairNonManifoldEdges() {
+    // Tets whose label changed during clean-up (the next round only looks near them).
+    std::vector<int> changedTets;
+    void setLabel(int t, int value) {
+        label[t] = value;
+        changedTets.push_back(t);
+    }
+
+    bool repairNonManifoldEdges(bool fullScan) {
         const size_t tetCount = mesh.tetCount();
         struct EdgeUse {
             int u, v, group, tet;
         };
         std::vector<EdgeUse> uses;
-        for (size_t t = 0; t < tetCount; ++t) {
+        auto collectFaces = [&](int t) {
             const int g = label[t];
-            if (g < 0) continue;
+            if (g < 0) return;
             for (int j = 0; j < 4; ++j) {
                 int n = mesh.neighbors[4 * t + j];
                 if (n >= 0 && label[n] == g) continue;
                 for (int e = 0; e < 3; ++e) {
                     int u = mesh.tets[4 * t + kFaceCorners[j][e]];
                     int v = mesh.tets[4 * t + kFaceCorners[j][(e + 1) % 3]];
-                    uses.push_back({std::min(u, v), std::max(u, v), g, static_cast<int>(t)});
+                    uses.push_back({std::min(u, v), std::max(u, v), g, t});
                 }
             }
+        };
+        if (fullScan) {
+            for (size_t t = 0; t < tetCount; ++t) collectFaces(static_cast<int>(t));
+        } else {
+            // Only edges near tets changed in the previous round; their fans are checked
+            // whole below (ring runs), since the unchanged faces were not collected.
+            std::vector<int> near;
+            for (int t : changedTets) {
+                near.push_back(t);
+                for (int j = 0; j < 4; ++j)
+                    if (mesh.neighbors[4 * t + j] >= 0) near.push_back(mesh.neighbors[4 * t + j]);
+            }
+            std::sort(near.begin(), near.end());
+            near.erase(std::unique(near.begin(), near.end()), near.end());
+            for (int t : near) collectFaces(t);
         }
+        changedTets.clear();
         std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
             return std::tie(a.group, a.u, a.v, a.tet) < std::tie(b.group, b.u, b.v, b.tet);
         });
@@ -346,9 +370,10 @@ struct Sculptor {
         for (size_t i = 0; i < uses.size();) {
             size_t j = i;
             while (j < uses.size() && uses[j].group == uses[i].group && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
-            if (j - i > 2) {
+            bool candidate = fullScan ? j - i > 2 : true;
+            if (candidate) {
                 const int g = uses[i].group;
-                edgeRing(uses[i].tet, uses[i].u, uses[i].v, ring);
+                const bool closedRing = edgeRing(uses[i].tet, uses[i].u, uses[i].v, ring);
                 // Runs of consecutive tets in or out of the solid around the edge. A closed
                 // ring starts at a solid tet, so the last run may continue the first.
                 std::vector<std::pair<size_t, size_t>> runs;  // [begin, end) in ring
@@ -358,6 +383,15 @@ struct Sculptor {
                     while (e < ring.size() && (label[ring[e]] == g) == in) ++e;
                     runs.emplace_back(k, e);
                     k = e;
+                }
+                size_t solidRuns = 0;
+                for (auto r : runs)
+                    if (label[ring[r.first]] == g) ++solidRuns;
+                if (closedRing && runs.size() > 1 && label[ring[runs.front().first]] == g && label[ring[runs.back().first]] == g)
+                    --solidRuns;  // the last run continues the first
+                if (solidRuns < 2) {
+                    i = j;
+                    continue;
                 }
                 auto fillable = [&](std::pair<size_t, size_t> r) {
                     for (size_t k = r.first; k < r.second; ++k)
@@ -372,14 +406,14 @@ struct Sculptor {
                 bool acted = false;
                 for (auto r : runs)
                     if (label[ring[r.first]] != g && fillable(r)) {
-                        for (size_t k = r.first; k < r.second; ++k) label[ring[k]] = g;
+                        for (size_t k = r.first; k < r.second; ++k) setLabel(ring[k], g);
                         acted = changed = true;
                         break;  // one gap at a time; the next round re-examines the edge
                     }
                 if (!acted)
                     for (auto r : runs)
                         if (label[ring[r.first]] == g && openable(r)) {
-                            for (size_t k = r.first; k < r.second; ++k) label[ring[k]] = -1;
+                            for (size_t k = r.first; k < r.second; ++k) setLabel(ring[k], -1);
                             changed = true;
                             break;
                         }
@@ -463,9 +497,10 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
-    for (int round = 0; round < 6; ++round) {
+    if (!request.cleanUp) return;
+    for (int round = 0; round < 8; ++round) {
         bool changed = sculptor.removeIslands();
-        changed |= sculptor.repairNonManifoldEdges();
+        changed |= sculptor.repairNonManifoldEdges(round == 0);
         changed |= sculptor.fillVoids();
         lap("cleanup");
         if (!changed) break;

@@ -25,6 +25,7 @@ struct LevelShapeRequest {
     const AggregateFunction* function = nullptr;
     DistanceMode distance = DistanceMode::Exact;
     std::vector<ProtectedConnection> connections;       ///< joined pairs to keep connected
+    bool cleanUp = true;  ///< make the solids manifold (off for volume-only baselines)
 };
 
 /// Labels every tet with the group whose solid contains it (-1: not in any aggregate).
