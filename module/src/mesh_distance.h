@@ -26,7 +26,7 @@
 // Determinism: single-threaded, fixed traversal order; among pairs at equal distance the
 // lowest (triangleA, triangleB) pair (original indices) wins, so meshDistance without early
 // exit returns bit-for-bit what a brute-force loop over all pairs with
-// triangleTriangleDistance would return. Input coordinates must be finite.
+// triangleTriangleDistance would return.
 #pragma once
 
 #include <cstddef>
@@ -50,8 +50,9 @@ public:
         uint32_t count;  ///< leaf: number of triangles (1..4); inner: 0
     };
 
-    /// positions: 3 * vertexCount doubles; indices: 3 * triangleCount, each < vertexCount
-    /// (throws std::invalid_argument otherwise). Rebuilds from scratch.
+    /// positions: 3 * vertexCount doubles; indices: 3 * triangleCount, each < vertexCount;
+    /// referenced coordinates finite (throws std::invalid_argument otherwise). Rebuilds
+    /// from scratch; single-threaded, deterministic.
     void build(const double* positions, size_t vertexCount, const uint32_t* indices,
                size_t triangleCount);
     /// Bounding box of every triangle; lo = +inf, hi = -inf when empty.
@@ -84,7 +85,8 @@ struct ClosestPair {
 };
 
 /// Exact minimum distance between two triangle sets (vertex-face, edge-edge, and
-/// triangle-triangle intersection -> 0).
+/// triangle-triangle intersection -> 0). Surfaces only: a mesh nested inside another one
+/// without touching it gets the gap between the surfaces, not 0.
 /// Pairs farther than maxDistance are ignored; result.distance = inf (triangles ~0u) when no
 /// pair is within maxDistance. If stopBelow > 0, returns as soon as a pair at distance
 /// <= stopBelow is found (distance is then <= stopBelow but not necessarily minimal; still
