@@ -66,6 +66,7 @@ struct BakeOptions {
     std::string objectUnit = "node";    ///< node | subtree
     std::string statsPath;
     double touchTolerance = -1;
+    int threads = 0;
     bool quiet = false;
 };
 
@@ -101,6 +102,8 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
     cmd->add_option("--touch-tolerance", o.touchTolerance,
                     "Objects closer than this are one model (default: 1e-6 x scene diagonal)")
         ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--threads", o.threads, "Threads for the parallel stages (default 0: all cores); output is identical for any count")
+        ->check(CLI::Range(0, 1024));
     cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
     return cmd;
 }
@@ -152,6 +155,7 @@ int runBake(BakeOptions o) {
                                                  : AggregateFunctionKind::Adaptive;
     settings.distance = o.distance == "cdt" ? DistanceMode::Cdt : DistanceMode::Exact;
     settings.touchTolerance = o.touchTolerance;
+    settings.threadCount = o.threads;
     settings.progress = [&progress](const char* stage, double fraction) {
         progress.update(stage, fraction);
     };

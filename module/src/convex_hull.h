@@ -12,6 +12,10 @@ namespace aggrelod::detail {
 bool convexHull3(const std::vector<double>& points, std::vector<double>& hullPositions,
                  std::vector<uint32_t>& hullTriangles);
 
+/// Vertices of the convex hull of `points` (3 * n doubles), sorted by coordinates, into
+/// hullPositions (3 * m). Returns false (and leaves it empty) when degenerate.
+bool convexHullVertices(const std::vector<double>& points, std::vector<double>& hullPositions);
+
 /// Volume of the convex hull of `points` (3 * n doubles); 0 when degenerate.
 double convexHullVolume(const std::vector<double>& points);
 

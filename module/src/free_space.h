@@ -28,12 +28,18 @@ struct ModelPair {
     uint32_t firstLength = 0;       ///< this pair's edge lengths: FreeSpace::lengths[firstLength .. + edgeCount)
 };
 
+/// tetEdgePair values that are not pair indices.
+constexpr int kSameModelEdge = -1;  ///< both ends on one model (or on Steiner points only)
+constexpr int kUnpairedEdge = -2;   ///< two models with no pair statistics
+
 struct FreeSpace {
     TetMesh mesh;
     std::vector<int> vertexModel;   ///< per mesh vertex: owning model, -1 for Steiner points
     std::vector<int> tetModel;      ///< per tet: -1 free space, else the model it lies inside
     std::vector<double> tetVolume;  ///< per tet, units^3 (positive)
     std::vector<ModelPair> pairs;   ///< sorted by (a, b)
+    std::vector<double> tetEdgeLength; ///< 6 per tet (corner pairs 01 02 03 12 13 23), units
+    std::vector<int> tetEdgePair;      ///< 6 per tet: index into pairs, or kSameModelEdge / kUnpairedEdge
     size_t modelCount = 0;
     std::vector<double> lengths;        ///< per pair, ascending free-space edge lengths (see ModelPair)
     std::vector<double> lengthPrefix;   ///< running sum of lengths within each pair

@@ -5,6 +5,7 @@
 #include "free_space.h"
 #include "mesh_distance.h"
 #include "mesh_preparation.h"
+#include "parallel_for.h"
 #include "sculpt_3d.h"
 #include "tetgen_backend.h"
 
@@ -12,6 +13,7 @@
 #include <aggrelod/dendrogram.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -185,6 +187,7 @@ private:
     void buildModels();
     void makeStandIn(Model& m, const std::string& why);
     bool resolveStandInOverlaps();
+    bool standInsChanged_ = true;  ///< a stand-in was made since the last resolveStandInOverlaps()
     bool triangulate();
     void analyseFreeSpace(const std::vector<int>& pointModel);
     void buildGraph();
@@ -238,6 +241,7 @@ void Baker::makeStandIn(Model& m, const std::string& why) {
     std::vector<double> pts;
     for (uint32_t o : m.objects) pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
     m.standIn = true;
+    standInsChanged_ = true;
     m.positions.clear();
     m.triangles.clear();
     if (!detail::convexHull3(pts, m.positions, m.triangles)) {
@@ -301,15 +305,18 @@ void Baker::buildModels() {
 
 // A convex-hull stand-in may reach into another model: merge them (and re-hull) until no
 // stand-in touches or contains another model.
+// Also leaves every model's bounds and BVH up to date.
 bool Baker::resolveStandInOverlaps() {
     bool changed = false;
+    standInsChanged_ = false;
     for (int round = 0; round < 64; ++round) {
         models_.erase(std::remove_if(models_.begin(), models_.end(), [](const Model& m) { return m.objects.empty(); }),
                       models_.end());
-        for (Model& m : models_) {
+        detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t i) {
+            Model& m = models_[i];
             computeBounds(m.positions, m.bounds);
             m.bvh.build(m.positions.data(), m.positions.size() / 3, m.triangles.data(), m.triangles.size() / 3);
-        }
+        });
         auto pairs = overlappingPairs(models_.size(), [&](uint32_t k) { return models_[k].bounds; }, tolerance_);
         DisjointSets sets(models_.size());
         bool merged = false;
@@ -350,7 +357,7 @@ bool Baker::resolveStandInOverlaps() {
 bool Baker::triangulate() {
     timer_.begin("tetrahedralize");
     for (int attempt = 0; attempt < 6; ++attempt) {
-        resolveStandInOverlaps();
+        if (standInsChanged_) resolveStandInOverlaps();
         // Model order: by smallest object index (deterministic).
         std::sort(models_.begin(), models_.end(), [](const Model& a, const Model& b) { return a.objects[0] < b.objects[0]; });
         detail::PlcInput plc;
@@ -377,6 +384,7 @@ bool Baker::triangulate() {
             outcome = retry;
         }
         if (outcome.status == detail::TetgenStatus::Ok) {
+            timer_.begin("free space");
             space_.modelCount = models_.size();
             analyseFreeSpace(pointModel);
             return true;
@@ -529,18 +537,11 @@ void Baker::buildGraph() {
     space_.lengthSqPrefix.clear();
     for (size_t i = 0; i < accs.size();) {
         size_t j = i;
-        double sum = 0, sumSq = 0;
-        while (j < accs.size() && accs[j].a == accs[i].a && accs[j].b == accs[i].b) {
-            sum += accs[j].length;
-            sumSq += accs[j].length * accs[j].length;
-            ++j;
-        }
+        while (j < accs.size() && accs[j].a == accs[i].a && accs[j].b == accs[i].b) ++j;
         ModelPair p;
         p.a = accs[i].a;
         p.b = accs[i].b;
         p.edgeCount = static_cast<uint32_t>(j - i);
-        p.meanEdge = sum / p.edgeCount;
-        p.sigmaEdge = std::sqrt(std::max(0.0, sumSq / p.edgeCount - p.meanEdge * p.meanEdge));
         p.shortestEdge = accs[i].length;  // sorted by length within the pair
         p.shortestEdgeVertexA = accs[i].u;
         p.shortestEdgeVertexB = accs[i].v;
@@ -553,14 +554,18 @@ void Baker::buildGraph() {
             space_.lengthPrefix.push_back(run);
             space_.lengthSqPrefix.push_back(runSq);
         }
+        space_.edgeStatsBelow(p, INFINITY, p.meanEdge, p.sigmaEdge);
         space_.pairs.push_back(p);
         i = j;
     }
     // Exact distances between neighbouring models (BVH closest pair).
     timer_.begin("distances");
-    for (Model& m : models_)
-        m.bvh.build(m.positions.data(), m.positions.size() / 3, m.triangles.data(), m.triangles.size() / 3);
-    for (size_t i = 0; i < space_.pairs.size(); ++i) {
+    detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
+        models_[m].bvh.build(models_[m].positions.data(), models_[m].positions.size() / 3, models_[m].triangles.data(),
+                             models_[m].triangles.size() / 3);
+    });
+    const size_t pairCount = space_.pairs.size();
+    detail::parallelFor(pairCount, settings_.threadCount, [&](size_t i) {
         ModelPair& p = space_.pairs[i];
         const double* ua = &mesh.points[3 * p.shortestEdgeVertexA];
         const double* ub = &mesh.points[3 * p.shortestEdgeVertexB];
@@ -576,8 +581,9 @@ void Baker::buildGraph() {
             p.closestTriangleB = cp.triangleB;
         }
         p.weight = settings_.distance == DistanceMode::Exact ? p.exactDistance : p.shortestEdge;
-        if (i % 64 == 0) timer_.report(double(i) / space_.pairs.size());
-    }
+    }, [&](size_t done) {
+        if (done % 64 == 0) timer_.report(double(done) / pairCount);
+    });
 }
 
 // Before the one triangulation: each model's nearest neighbours (by box distance) are
@@ -589,10 +595,6 @@ void Baker::prerefineClosePairs() {
     resolveStandInOverlaps();
     const size_t n = models_.size();
     if (n < 2) return;
-    for (Model& m : models_) {
-        computeBounds(m.positions, m.bounds);
-        m.bvh.build(m.positions.data(), m.positions.size() / 3, m.triangles.data(), m.triangles.size() / 3);
-    }
     constexpr size_t kNeighbours = 6;
     std::vector<std::pair<uint32_t, uint32_t>> candidates;
     std::vector<std::pair<double, uint32_t>> near;
@@ -622,17 +624,25 @@ void Baker::prerefineClosePairs() {
         }
         return best;
     };
-    for (size_t c = 0; c < candidates.size(); ++c) {
+    // Measure every candidate on its own slot, then gather in candidate order.
+    std::vector<std::array<Insertion, 2>> found(candidates.size());
+    std::vector<std::array<bool, 2>> use(candidates.size(), {false, false});
+    detail::parallelFor(candidates.size(), settings_.threadCount, [&](size_t c) {
         const auto [i, j] = candidates[c];
         detail::ClosestPair cp = detail::meshDistance(models_[i].bvh, models_[j].bvh);
-        if (cp.triangleA == ~0u || cp.triangleB == ~0u || !(cp.distance > tolerance_)) continue;
+        if (cp.triangleA == ~0u || cp.triangleB == ~0u || !(cp.distance > tolerance_)) return;
         const double ra = nearestVertexDistance(models_[i], cp.triangleA, cp.pointA);
         const double rb = nearestVertexDistance(models_[j], cp.triangleB, cp.pointB);
-        if (ra + rb <= 0.5 * cp.distance) continue;  // a short edge exists already
-        if (ra > 0.1 * cp.distance) insertions.push_back(Insertion{i, cp.triangleA, {cp.pointA[0], cp.pointA[1], cp.pointA[2]}});
-        if (rb > 0.1 * cp.distance) insertions.push_back(Insertion{j, cp.triangleB, {cp.pointB[0], cp.pointB[1], cp.pointB[2]}});
-        if (c % 64 == 0) timer_.report(double(c) / candidates.size());
-    }
+        if (ra + rb <= 0.5 * cp.distance) return;  // a short edge exists already
+        found[c][0] = Insertion{i, cp.triangleA, {cp.pointA[0], cp.pointA[1], cp.pointA[2]}};
+        found[c][1] = Insertion{j, cp.triangleB, {cp.pointB[0], cp.pointB[1], cp.pointB[2]}};
+        use[c] = {ra > 0.1 * cp.distance, rb > 0.1 * cp.distance};
+    }, [&](size_t done) {
+        if (done % 64 == 0) timer_.report(double(done) / candidates.size());
+    });
+    for (size_t c = 0; c < candidates.size(); ++c)
+        for (int k = 0; k < 2; ++k)
+            if (use[c][k]) insertions.push_back(found[c][k]);
     insertSurfacePoints(insertions);
 }
 
@@ -743,6 +753,7 @@ bool Baker::refineCoarseConnections() {
 
 void Baker::buildLevels() {
     timer_.begin("hierarchy");
+    detail::precomputeTetEdges(space_);
     std::vector<GraphEdge> graph;
     for (const ModelPair& p : space_.pairs) graph.push_back(GraphEdge{p.a, p.b, p.weight});
     out_.merges = kruskalMerges(models_.size(), graph);
@@ -761,20 +772,29 @@ void Baker::buildLevels() {
 
     AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
     const bool isConstant = !settings_.customFunction && settings_.function == AggregateFunctionKind::Constant;
+    const bool measureConstant = !isConstant && settings_.computeConstantBaseline;
     timer_.begin("levels");
-    for (size_t li = 0; li < deltas.size(); ++li) {
-        Level level;
-        level.delta = deltas[li];
+
+    // What each level needs, prepared here so the sculpting below touches only its own data.
+    struct LevelWork {
+        std::vector<uint32_t> modelGroup;
         size_t groupCount = 0;
-        std::vector<uint32_t> modelGroup = groupsAtThreshold(models_.size(), out_.merges, level.delta, &groupCount);
+        detail::EdgeLimits limits, constantLimits;
         detail::LevelShapeRequest request;
-        request.modelGroup = &modelGroup;
-        request.groupCount = groupCount;
-        request.delta = level.delta;
-        request.function = &function_;
-        request.distance = settings_.distance;
+        std::vector<Aggregate> aggregates;
+        double volumeConstant = 0;
+    };
+    std::vector<LevelWork> work(deltas.size());
+    for (size_t li = 0; li < deltas.size(); ++li) {
+        LevelWork& w = work[li];
+        w.modelGroup = groupsAtThreshold(models_.size(), out_.merges, deltas[li], &w.groupCount);
+        w.limits = detail::computeEdgeLimits(space_, deltas[li], function_, settings_.distance);
+        if (measureConstant) w.constantLimits = detail::computeEdgeLimits(space_, deltas[li], constant, settings_.distance);
+        w.request.modelGroup = &w.modelGroup;
+        w.request.groupCount = w.groupCount;
+        w.request.limits = &w.limits;
         for (const Merge& m : out_.merges) {
-            if (!(m.height < level.delta)) break;
+            if (!(m.height < deltas[li])) break;
             int p = space_.findPair(m.modelA, m.modelB);
             if (p < 0) continue;
             const ModelPair& pair = space_.pairs[p];
@@ -789,14 +809,37 @@ void Baker::buildLevels() {
             }
             std::copy(pa, pa + 3, c.pointA);
             std::copy(pb, pb + 3, c.pointB);
-            request.connections.push_back(c);
+            w.request.connections.push_back(c);
         }
-        std::vector<int> label;
-        detail::sculptLevel(space_, request, label);
-        std::vector<Aggregate> aggregates;
-        detail::extractSurfaces(space_, label, groupCount, aggregates);
+    }
+
+    // Levels are independent given the one triangulation: sculpt them on several threads;
+    // each level writes only its own LevelWork.
+    detail::parallelFor(
+        work.size(), settings_.threadCount,
+        [&](size_t li) {
+            LevelWork& w = work[li];
+            std::vector<int> label;
+            detail::sculptLevel(space_, w.request, label);
+            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates);
+            if (measureConstant) {
+                detail::LevelShapeRequest constantRequest = w.request;
+                constantRequest.limits = &w.constantLimits;
+                constantRequest.cleanUp = false;  // volume only: the clean-up changes it by slivers
+                detail::sculptLevel(space_, constantRequest, label);
+                for (size_t t = 0; t < label.size(); ++t)
+                    if (label[t] >= 0) w.volumeConstant += space_.tetVolume[t];
+            }
+        },
+        [&](size_t done) { timer_.report(0.9 * double(done) / work.size()); });
+
+    for (size_t li = 0; li < deltas.size(); ++li) {
+        LevelWork& w = work[li];
+        Level level;
+        level.delta = deltas[li];
+        std::vector<Aggregate>& aggregates = w.aggregates;
         for (size_t m = 0; m < models_.size(); ++m) {
-            Aggregate& agg = aggregates[modelGroup[m]];
+            Aggregate& agg = aggregates[w.modelGroup[m]];
             agg.sourceObjects.insert(agg.sourceObjects.end(), models_[m].objects.begin(), models_[m].objects.end());
             agg.volumeOriginal += models_[m].volumeOriginal;
         }
@@ -813,11 +856,11 @@ void Baker::buildLevels() {
         level.measures = measuresOf(totalVolume, totalArea);
         level.volumeOriginal = out_.originals.volume;
         if (settings_.computeHullBaseline) {
-            std::vector<std::vector<double>> groupPoints(groupCount);
+            std::vector<std::vector<double>> groupPoints(w.groupCount);
             for (size_t m = 0; m < models_.size(); ++m)
-                groupPoints[modelGroup[m]].insert(groupPoints[modelGroup[m]].end(), models_[m].hullPoints.begin(),
-                                                  models_[m].hullPoints.end());
-            for (size_t g = 0; g < groupCount; ++g) {
+                groupPoints[w.modelGroup[m]].insert(groupPoints[w.modelGroup[m]].end(), models_[m].hullPoints.begin(),
+                                                    models_[m].hullPoints.end());
+            for (size_t g = 0; g < w.groupCount; ++g) {
                 // A group unchanged since an earlier level keeps its hull volume.
                 auto cached = hullVolumeOfGroup_.find(aggregates[g].sourceObjects);
                 if (cached == hullVolumeOfGroup_.end())
@@ -826,20 +869,10 @@ void Baker::buildLevels() {
                 level.volumeHull += aggregates[g].volumeHull;
             }
         }
-        if (isConstant) {
-            level.volumeConstant = totalVolume;
-        } else if (settings_.computeConstantBaseline) {
-            detail::LevelShapeRequest constantRequest = request;
-            constantRequest.function = &constant;
-            constantRequest.cleanUp = false;  // volume only: the clean-up changes it by slivers
-            std::vector<int> constantLabel;
-            detail::sculptLevel(space_, constantRequest, constantLabel);
-            for (size_t t = 0; t < constantLabel.size(); ++t)
-                if (constantLabel[t] >= 0) level.volumeConstant += space_.tetVolume[t];
-        }
+        level.volumeConstant = isConstant ? totalVolume : w.volumeConstant;
         level.aggregates = std::move(aggregates);
         out_.levels.push_back(std::move(level));
-        timer_.report(double(li + 1) / deltas.size());
+        timer_.report(0.9 + 0.1 * double(li + 1) / deltas.size());
     }
 }
 
@@ -858,12 +891,15 @@ bool Baker::run() {
     }
     out_.modelCount = models_.size();
     out_.objectModel.assign(objects_.size(), UINT32_MAX);
-    for (size_t m = 0; m < models_.size(); ++m) {
+    for (size_t m = 0; m < models_.size(); ++m)
         for (uint32_t o : models_[m].objects) out_.objectModel[o] = static_cast<uint32_t>(m);
-        std::vector<uint32_t> unusedTriangles;
-        std::vector<double> hullPositions;
-        if (detail::convexHull3(models_[m].positions, hullPositions, unusedTriangles)) models_[m].hullPoints = hullPositions;
-        else models_[m].hullPoints = models_[m].positions;
+    if (settings_.computeHullBaseline) {
+        // Each model's hull vertices: the group hulls of every level are hulls of these.
+        timer_.begin("model hulls");
+        detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
+            if (!detail::convexHullVertices(models_[m].positions, models_[m].hullPoints))
+                models_[m].hullPoints = models_[m].positions;
+        });
     }
     buildGraph();
     if (settings_.distance == DistanceMode::Exact && refineCoarseConnections()) {

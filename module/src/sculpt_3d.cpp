@@ -13,9 +13,7 @@
 #include "sculpt_3d.h"
 
 #include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
+#include <deque>
 #include <cmath>
 #include <numeric>
 #include <queue>
@@ -27,6 +25,11 @@ namespace {
 // Corners of the face opposite corner j, ordered so the normal points out of a
 // positively oriented tet.
 constexpr int kFaceCorners[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+// Tet edges (corner pairs) in FreeSpace::tetEdgeLength order, and for each face (opposite
+// corner j) the bit set of its three edges: those that do not touch corner j.
+constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+constexpr unsigned kEdgesOfFace[4] = {0b111000, 0b100110, 0b010101, 0b001011};
 
 double distance3(const double* a, const double* b) {
     const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
@@ -71,46 +74,28 @@ struct Sculptor {
 
     bool isKeptFree(int t, int group) const { return t >= 0 && space.tetModel[t] < 0 && label[t] == group; }
 
-    double edgeLimit(int u, int v) const {
-        int mu = space.vertexModel[u], mv = space.vertexModel[v];
-        if (mu < 0) mu = mv;
-        if (mv < 0) mv = mu;
-        AggregateFunctionInput in;
-        in.delta = request.delta;
-        if (mu < 0 || mu == mv) {
-            in.sameModel = true;
-            return (*request.function)(in);
-        }
-        int p = space.findPair(static_cast<uint32_t>(mu), static_cast<uint32_t>(mv));
-        if (p < 0) {
-            in.sameModel = false;
-            return (*request.function)(in);
-        }
-        const ModelPair& pair = space.pairs[p];
-        in.minDistance = request.distance == DistanceMode::Exact ? pair.exactDistance : pair.shortestEdge;
-        double mean = 0, sigma = 0;
-        space.edgeStatsBelow(pair, request.delta, mean, sigma);
-        in.sigma = sigma;
-        in.meanEdgeLength = mean;
-        in.sigmaAllEdges = pair.sigmaEdge;
-        return (*request.function)(in);
-    }
-
     // Longest exposed edge of tet t longer than its limit (0 if none).
     double carvePriority(int t) const {
         const int group = label[t];
-        double worst = 0;
+        // Bit e set: tet edge e lies on an exposed facet (edge e avoids corner j of facet j).
+        unsigned exposedEdges = 0;
         for (int j = 0; j < 4; ++j) {
             int n = mesh.neighbors[4 * t + j];
             if (n >= 0 && label[n] == group) continue;  // facet not exposed
-            for (int e = 0; e < 3; ++e) {
-                int u = mesh.tets[4 * t + kFaceCorners[j][e]];
-                int v = mesh.tets[4 * t + kFaceCorners[j][(e + 1) % 3]];
-                double len = distance3(point(u), point(v));
-                if (len > worst && len > edgeLimit(u, v)) worst = len;
-            }
+            exposedEdges |= kEdgesOfFace[j];
+        }
+        double worst = 0;
+        for (int e = 0; e < 6; ++e) {
+            if (!(exposedEdges & (1u << e))) continue;
+            const double len = space.tetEdgeLength[6 * static_cast<size_t>(t) + e];
+            if (len > worst && len > limitOfEdge(space.tetEdgePair[6 * static_cast<size_t>(t) + e])) worst = len;
         }
         return worst;
+    }
+
+    double limitOfEdge(int pairIndex) const {
+        if (pairIndex >= 0) return request.limits->pair[pairIndex];
+        return pairIndex == kSameModelEdge ? request.limits->sameModel : request.limits->unpaired;
     }
 
     // Step 4: face-connected chain of kept tets from model a's surface to model b's surface.
@@ -322,10 +307,17 @@ struct Sculptor {
     // remove the free unprotected solid tets around the edge.
     // Tets whose label changed during clean-up (the next round only looks near them).
     std::vector<int> changedTets;
+    // Per tet: 1 once removed, 2 once added by the clean-up. The edge repair never undoes
+    // what the clean-up did, so the rounds cannot cycle.
+    std::vector<unsigned char> cleanUpHistory;
     void setLabel(int t, int value) {
         label[t] = value;
         changedTets.push_back(t);
+        if (cleanUpHistory.empty()) cleanUpHistory.assign(mesh.tetCount(), 0);
+        cleanUpHistory[t] |= value < 0 ? 1 : 2;
     }
+    bool wasAdded(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 2); }
+    bool wasRemoved(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 1); }
 
     bool repairNonManifoldEdges(bool fullScan) {
         const size_t tetCount = mesh.tetCount();
@@ -365,60 +357,79 @@ struct Sculptor {
         std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
             return std::tie(a.group, a.u, a.v, a.tet) < std::tie(b.group, b.u, b.v, b.tet);
         });
-        bool changed = false;
-        std::vector<int> ring;
+        // Work list of edges to examine, in a deterministic order: first the candidates,
+        // then the edges of every tet a repair changed (a repair can make a neighbour edge
+        // non-manifold), until none is left. The cap only guards against a cycle.
+        std::deque<EdgeUse> work;
         for (size_t i = 0; i < uses.size();) {
             size_t j = i;
             while (j < uses.size() && uses[j].group == uses[i].group && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
-            bool candidate = fullScan ? j - i > 2 : true;
-            if (candidate) {
-                const int g = uses[i].group;
-                const bool closedRing = edgeRing(uses[i].tet, uses[i].u, uses[i].v, ring);
-                // Runs of consecutive tets in or out of the solid around the edge. A closed
-                // ring starts at a solid tet, so the last run may continue the first.
-                std::vector<std::pair<size_t, size_t>> runs;  // [begin, end) in ring
-                for (size_t k = 0; k < ring.size();) {
-                    size_t e = k;
-                    const bool in = label[ring[k]] == g;
-                    while (e < ring.size() && (label[ring[e]] == g) == in) ++e;
-                    runs.emplace_back(k, e);
-                    k = e;
+            if (!fullScan || j - i > 2) work.push_back(uses[i]);
+            i = j;
+        }
+        size_t budget = 64 * work.size() + 4096;
+        bool changed = false;
+        std::vector<int> ring;
+        std::vector<std::pair<size_t, size_t>> runs;  // [begin, end) in ring
+        std::vector<int> touched;
+        while (!work.empty() && budget-- > 0) {
+            const EdgeUse edge = work.front();
+            work.pop_front();
+            const int g = edge.group;
+            const bool closedRing = edgeRing(edge.tet, edge.u, edge.v, ring);
+            // Runs of consecutive tets in or out of the solid around the edge; on a closed
+            // ring the last run continues the first.
+            runs.clear();
+            for (size_t k = 0; k < ring.size();) {
+                size_t e = k;
+                const bool in = label[ring[k]] == g;
+                while (e < ring.size() && (label[ring[e]] == g) == in) ++e;
+                runs.emplace_back(k, e);
+                k = e;
+            }
+            size_t solidRuns = 0;
+            for (auto r : runs)
+                if (label[ring[r.first]] == g) ++solidRuns;
+            if (closedRing && runs.size() > 1 && label[ring[runs.front().first]] == g && label[ring[runs.back().first]] == g)
+                --solidRuns;
+            if (solidRuns < 2) continue;
+            auto fillable = [&](std::pair<size_t, size_t> r) {
+                for (size_t k = r.first; k < r.second; ++k)
+                    if (space.tetModel[ring[k]] >= 0 || label[ring[k]] >= 0 || wasRemoved(ring[k])) return false;
+                return true;
+            };
+            auto openable = [&](std::pair<size_t, size_t> r) {
+                for (size_t k = r.first; k < r.second; ++k)
+                    if (label[ring[k]] != g || space.tetModel[ring[k]] >= 0 || isProtected[ring[k]] || wasAdded(ring[k]))
+                        return false;
+                return true;
+            };
+            // Prefer opening a run of free fill (carving already judged such fill
+            // marginal, and the solid only shrinks); fill a gap only where no run of the
+            // solid can be opened (object interiors or protected connections).
+            touched.clear();
+            int newLabel = -1;
+            for (auto r : runs)
+                if (label[ring[r.first]] == g && openable(r)) {
+                    for (size_t k = r.first; k < r.second; ++k) touched.push_back(ring[k]);
+                    break;
                 }
-                size_t solidRuns = 0;
-                for (auto r : runs)
-                    if (label[ring[r.first]] == g) ++solidRuns;
-                if (closedRing && runs.size() > 1 && label[ring[runs.front().first]] == g && label[ring[runs.back().first]] == g)
-                    --solidRuns;  // the last run continues the first
-                if (solidRuns < 2) {
-                    i = j;
-                    continue;
-                }
-                auto fillable = [&](std::pair<size_t, size_t> r) {
-                    for (size_t k = r.first; k < r.second; ++k)
-                        if (label[ring[k]] == g || space.tetModel[ring[k]] >= 0 || label[ring[k]] >= 0) return false;
-                    return true;
-                };
-                auto openable = [&](std::pair<size_t, size_t> r) {
-                    for (size_t k = r.first; k < r.second; ++k)
-                        if (label[ring[k]] != g || space.tetModel[ring[k]] >= 0 || isProtected[ring[k]]) return false;
-                    return true;
-                };
-                bool acted = false;
+            if (touched.empty()) {
+                newLabel = g;
                 for (auto r : runs)
                     if (label[ring[r.first]] != g && fillable(r)) {
-                        for (size_t k = r.first; k < r.second; ++k) setLabel(ring[k], g);
-                        acted = changed = true;
-                        break;  // one gap at a time; the next round re-examines the edge
+                        for (size_t k = r.first; k < r.second; ++k) touched.push_back(ring[k]);
+                        break;
                     }
-                if (!acted)
-                    for (auto r : runs)
-                        if (label[ring[r.first]] == g && openable(r)) {
-                            for (size_t k = r.first; k < r.second; ++k) setLabel(ring[k], -1);
-                            changed = true;
-                            break;
-                        }
             }
-            i = j;
+            if (touched.empty()) continue;  // neither side can change: left as is
+            changed = true;
+            for (int t : touched) setLabel(t, newLabel);
+            for (int t : touched)
+                for (const auto& e : kTetEdges) {
+                    int u = mesh.tets[4 * t + e[0]], v = mesh.tets[4 * t + e[1]];
+                    work.push_back({std::min(u, v), std::max(u, v), g, t});
+                }
         }
         return changed;
     }
@@ -477,23 +488,55 @@ uint32_t FreeSpace::edgeStatsBelow(const ModelPair& p, double limit, double& mea
     return n;
 }
 
+void precomputeTetEdges(FreeSpace& space) {
+    const TetMesh& mesh = space.mesh;
+    const size_t tetCount = mesh.tetCount();
+    space.tetEdgeLength.resize(6 * tetCount);
+    space.tetEdgePair.resize(6 * tetCount);
+    for (size_t t = 0; t < tetCount; ++t)
+        for (int e = 0; e < 6; ++e) {
+            const int u = mesh.tets[4 * t + kTetEdges[e][0]], v = mesh.tets[4 * t + kTetEdges[e][1]];
+            space.tetEdgeLength[6 * t + e] = distance3(&mesh.points[3 * static_cast<size_t>(u)], &mesh.points[3 * static_cast<size_t>(v)]);
+            int mu = space.vertexModel[u], mv = space.vertexModel[v];
+            if (mu < 0) mu = mv;
+            if (mv < 0) mv = mu;
+            int pair = kSameModelEdge;
+            if (mu >= 0 && mu != mv) {
+                pair = space.findPair(static_cast<uint32_t>(mu), static_cast<uint32_t>(mv));
+                if (pair < 0) pair = kUnpairedEdge;
+            }
+            space.tetEdgePair[6 * t + e] = pair;
+        }
+}
+
+EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
+                             DistanceMode distance) {
+    EdgeLimits limits;
+    AggregateFunctionInput in;
+    in.delta = delta;
+    in.sameModel = true;
+    limits.sameModel = function(in);
+    in.sameModel = false;
+    limits.unpaired = function(in);
+    limits.pair.resize(space.pairs.size());
+    for (size_t p = 0; p < space.pairs.size(); ++p) {
+        const ModelPair& pair = space.pairs[p];
+        AggregateFunctionInput pin;
+        pin.delta = delta;
+        pin.minDistance = distance == DistanceMode::Exact ? pair.exactDistance : pair.shortestEdge;
+        space.edgeStatsBelow(pair, delta, pin.meanEdgeLength, pin.sigma);
+        pin.sigmaAllEdges = pair.sigmaEdge;
+        limits.pair[p] = function(pin);
+    }
+    return limits;
+}
+
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel) {
-    static const bool profile = std::getenv("AGGRELOD_PROFILE") != nullptr;
-    auto t0 = std::chrono::steady_clock::now();
-    auto lap = [&](const char* what) {
-        if (!profile) return;
-        auto t1 = std::chrono::steady_clock::now();
-        std::fprintf(stderr, "  sculpt %-10s %.3f s\n", what, std::chrono::duration<double>(t1 - t0).count());
-        t0 = t1;
-    };
     Sculptor sculptor(space, request, tetLabel);
     sculptor.initialLabels();
-    lap("labels");
     sculptor.isProtected.assign(space.mesh.tetCount(), 0);
     for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
-    lap("protect");
     sculptor.carve();
-    lap("carve");
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
@@ -502,7 +545,6 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
         bool changed = sculptor.removeIslands();
         changed |= sculptor.repairNonManifoldEdges(round == 0);
         changed |= sculptor.fillVoids();
-        lap("cleanup");
         if (!changed) break;
     }
 }

@@ -18,12 +18,26 @@ struct ProtectedConnection {
     double pointB[3] = {0, 0, 0};
 };
 
+/// F of every model pair at one level, evaluated once (the carving loop only looks it up,
+/// so levels can be sculpted on several threads without calling user code there).
+struct EdgeLimits {
+    double sameModel = 0;       ///< F for an edge with both ends on one model (or Steiner points)
+    double unpaired = 0;        ///< F for two models with no free-space edge statistics
+    std::vector<double> pair;   ///< per FreeSpace::pairs entry
+};
+
+/// Fills space.tetEdgeLength and space.tetEdgePair (after the pairs are built): the carving
+/// loop of every level then only looks up lengths and limits.
+void precomputeTetEdges(FreeSpace& space);
+
+/// Evaluates `function` for every pair at threshold delta (DESIGN 2.4 step 3).
+EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
+                             DistanceMode distance);
+
 struct LevelShapeRequest {
     const std::vector<uint32_t>* modelGroup = nullptr;  ///< per model: group index at this level
     size_t groupCount = 0;
-    double delta = 0;
-    const AggregateFunction* function = nullptr;
-    DistanceMode distance = DistanceMode::Exact;
+    const EdgeLimits* limits = nullptr;
     std::vector<ProtectedConnection> connections;       ///< joined pairs to keep connected
     bool cleanUp = true;  ///< make the solids manifold (off for volume-only baselines)
 };

@@ -9,6 +9,7 @@
 
 #include <tetgen.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -82,5 +83,19 @@ int main(int argc, char** argv) {
     std::printf("| **whole bake** | %.3f | 100 %% |\n", bakeSeconds);
     std::printf("| TetGen alone (pczQn, in-process, same input) | %.3f | |\n", tetgenSeconds);
     std::printf("\nratio whole bake / TetGen alone: %.2fx (goal <= 1.5x)\n", bakeSeconds / tetgenSeconds);
+    // Output quality on the same run: aggregates whose surface uses a directed edge twice
+    // (not edge-manifold) and aggregates with more than one shell.
+    size_t aggregates = 0, nonManifold = 0, multiShell = 0;
+    for (const Level& level : h.levels)
+        for (const Aggregate& a : level.aggregates) {
+            ++aggregates;
+            std::vector<std::pair<uint32_t, uint32_t>> edges;
+            for (size_t t = 0; t + 2 < a.indices.size(); t += 3)
+                for (int k = 0; k < 3; ++k) edges.emplace_back(a.indices[t + k], a.indices[t + (k + 1) % 3]);
+            std::sort(edges.begin(), edges.end());
+            if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) ++nonManifold;
+            if (a.componentCount > 1) ++multiShell;
+        }
+    std::printf("aggregates: %zu, not edge-manifold: %zu, more than one shell: %zu\n", aggregates, nonManifold, multiShell);
     return ok ? 0 : 1;
 }

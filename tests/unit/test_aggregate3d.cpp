@@ -204,3 +204,34 @@ TEST(Dendrogram, GroupCountNeverRisesAndLevelsAreDistinct) {
     EXPECT_EQ(h.levels.back().aggregates.size(), 1u);
     for (size_t i = 1; i < h.merges.size(); ++i) EXPECT_GE(h.merges[i].height, h.merges[i - 1].height);
 }
+
+TEST(Determinism, SameResultForAnyThreadCount) {
+    // An open box (a hull stand-in) among the spheres exercises the hull path too.
+    auto objects = samples::makeSpheres15(3);
+    InputObject open = samples::makeBox("openBox", {20, 0, 0}, {21, 1, 1});
+    open.indices.resize(open.indices.size() - 3);
+    objects.push_back(open);
+    std::vector<Hierarchy3D> runs;
+    for (int threads : {1, 2, 1}) {
+        Settings3D s;
+        s.threadCount = threads;
+        runs.emplace_back();
+        ASSERT_TRUE(buildHierarchy3D(objects, s, runs.back()));
+    }
+    for (size_t r = 1; r < runs.size(); ++r) {
+        ASSERT_EQ(runs[r].levels.size(), runs[0].levels.size());
+        for (size_t l = 0; l < runs[0].levels.size(); ++l) {
+            const Level& a = runs[0].levels[l];
+            const Level& b = runs[r].levels[l];
+            EXPECT_EQ(a.delta, b.delta);
+            EXPECT_EQ(a.volumeHull, b.volumeHull);
+            EXPECT_EQ(a.volumeConstant, b.volumeConstant);
+            ASSERT_EQ(a.aggregates.size(), b.aggregates.size());
+            for (size_t g = 0; g < a.aggregates.size(); ++g) {
+                EXPECT_EQ(a.aggregates[g].positions, b.aggregates[g].positions);
+                EXPECT_EQ(a.aggregates[g].indices, b.aggregates[g].indices);
+                EXPECT_EQ(a.aggregates[g].sourceObjects, b.aggregates[g].sourceObjects);
+            }
+        }
+    }
+}

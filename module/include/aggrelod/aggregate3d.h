@@ -57,6 +57,7 @@ struct AggregateFunctionInput {
     bool sameModel = false;      ///< m1 == m2
 };
 /// Pluggable aggregate function: returns the longest exposed edge length kept (world units).
+/// Called from the calling thread only, once per model pair and level.
 using AggregateFunction = std::function<double(const AggregateFunctionInput&)>;
 
 /// Built-in functions. Constant: paper Eq. 1. Adaptive: paper Eq. 2 (sigma documented in README).
@@ -74,7 +75,9 @@ struct Settings3D {
     double touchTolerance = -1;       ///< objects closer than this are one model; < 0: 1e-6 * scene diagonal
     bool computeHullBaseline = true;  ///< convex hull of each group as a baseline measure
     bool computeConstantBaseline = true; ///< also measure the constant function at the same groups
-    ProgressCallback progress;        ///< optional
+    ProgressCallback progress;        ///< optional; called from the calling thread only
+    int threadCount = 0;              ///< threads for sculpting levels; 0 = hardware concurrency.
+                                      ///< Results are identical for every thread count.
 };
 
 /// Figures of a set of closed meshes.
