@@ -3,7 +3,7 @@
 // tetrahedralization is the floor of this design, so the figure that matters is the ratio
 // bake / TetGen, measured in the same run (absolute seconds on shared machines are noisy).
 //
-// Usage: bench_bake [objects=1000] [triangles=150000] [levels=8] [seed=1]
+// Usage: bench_bake [objects=1000] [triangles=150000] [levels=8] [seed=1] [threads=0 (all)]
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/samples.h>
 
@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
     const int triangles = argc > 2 ? std::atoi(argv[2]) : 150000;
     const int levels = argc > 3 ? std::atoi(argv[3]) : 8;
     const uint32_t seed = argc > 4 ? static_cast<uint32_t>(std::atoi(argv[4])) : 1u;
+    const int threads = argc > 5 ? std::atoi(argv[5]) : 0;
     std::vector<InputObject> objects = samples::makeRandomScene(objectCount, triangles, seed);
     size_t tris = 0;
     for (const InputObject& o : objects) tris += o.indices.size() / 3;
@@ -70,13 +71,14 @@ int main(int argc, char** argv) {
 
     Settings3D settings;
     settings.automaticLevelCount = levels;
+    settings.threadCount = threads;
     Hierarchy3D h;
     auto start = std::chrono::steady_clock::now();
     const bool ok = buildHierarchy3D(objects, settings, h);
     const double bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-    std::printf("scene: %zu objects, %zu triangles, seed %u; bake %s, %zu levels, %zu tets (TetGen alone: %d tets)\n",
-                objects.size(), tris, seed, ok ? "ok" : "FAILED", h.levels.size(), h.tetrahedronCount, tets);
+    std::printf("scene: %zu objects, %zu triangles, seed %u, threads %d (0 = all); bake %s, %zu levels, %zu tets (TetGen alone: %d tets)\n",
+                objects.size(), tris, seed, threads, ok ? "ok" : "FAILED", h.levels.size(), h.tetrahedronCount, tets);
     std::printf("| stage | seconds | share of bake |\n|---|---:|---:|\n");
     for (const auto& [stage, seconds] : h.timings)
         std::printf("| %s | %.3f | %.1f %% |\n", stage.c_str(), seconds, 100.0 * seconds / bakeSeconds);
