@@ -123,21 +123,13 @@ bool convexHull3(const std::vector<double>& points, std::vector<double>& hullPos
     return true;
 }
 
-bool convexHullVertices(const std::vector<double>& points, std::vector<double>& hullPositions) {
-    hullPositions.clear();
-    Mesh mesh;
-    if (!hullMesh(points, mesh)) return false;
-    std::vector<std::array<double, 3>> verts;
-    for (auto v : mesh.vertices()) verts.push_back({mesh.point(v).x(), mesh.point(v).y(), mesh.point(v).z()});
-    std::sort(verts.begin(), verts.end());
-    for (const auto& p : verts) hullPositions.insert(hullPositions.end(), p.begin(), p.end());
-    return true;
-}
-
-double convexHullVolume(const std::vector<double>& points) {
+double convexHullVolume(const std::vector<double>& points, std::vector<double>* hullVertices) {
     std::vector<double> positions;
     std::vector<uint32_t> triangles;
-    if (!convexHull3(points, positions, triangles)) return 0.0;
+    if (!convexHull3(points, positions, triangles)) {
+        if (hullVertices) *hullVertices = points;
+        return 0.0;
+    }
     // Canonical triangles in sorted order, relative to the first (smallest) vertex.
     double volume = 0;
     const double* o = &positions[0];
@@ -148,6 +140,7 @@ double convexHullVolume(const std::vector<double>& points) {
         volume += (r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
                    r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0])) / 6.0;
     }
+    if (hullVertices) *hullVertices = std::move(positions);
     return volume;
 }
 

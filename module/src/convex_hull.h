@@ -12,11 +12,8 @@ namespace aggrelod::detail {
 bool convexHull3(const std::vector<double>& points, std::vector<double>& hullPositions,
                  std::vector<uint32_t>& hullTriangles);
 
-/// Vertices of the convex hull of `points` (3 * n doubles), sorted by coordinates, into
-/// hullPositions (3 * m). Returns false (and leaves it empty) when degenerate.
-bool convexHullVertices(const std::vector<double>& points, std::vector<double>& hullPositions);
-
-/// Volume of the convex hull of `points` (3 * n doubles); 0 when degenerate.
-double convexHullVolume(const std::vector<double>& points);
+/// Volume of the convex hull of `points` (3 * n doubles); 0 when degenerate. When
+/// `hullVertices` is given it receives the hull's vertices (3 * m, sorted).
+double convexHullVolume(const std::vector<double>& points, std::vector<double>* hullVertices = nullptr);
 
 }  // namespace aggrelod::detail

@@ -92,6 +92,7 @@ struct Model {
     double bounds[6];
     double volumeOriginal = 0;
     std::vector<double> hullPoints;   ///< convex hull vertices (for the hull baseline)
+    double hullVolume = 0;            ///< their hull's volume
 };
 
 std::string objectNames(const std::vector<InputObject>& objects, const std::vector<uint32_t>& ids, size_t limit = 6) {
@@ -181,7 +182,6 @@ private:
     double tolerance_ = 0;
     FreeSpace space_;
     AggregateFunction function_;
-    std::map<std::vector<uint32_t>, double> hullVolumeOfGroup_;
 
     bool prepare();
     void buildModels();
@@ -833,6 +833,19 @@ void Baker::buildLevels() {
         },
         [&](size_t done) { timer_.report(0.9 * double(done) / work.size()); });
 
+    // Hull baseline, level by level: starts from each model's own hull.
+    struct GroupHull {
+        std::vector<double> vertices;
+        double volume = 0;
+    };
+    std::vector<GroupHull> previousHulls(models_.size());
+    std::vector<uint32_t> previousHullOfModel(models_.size());
+    if (settings_.computeHullBaseline)
+        for (size_t m = 0; m < models_.size(); ++m) {
+            previousHullOfModel[m] = static_cast<uint32_t>(m);
+            previousHulls[m].vertices = models_[m].hullPoints;
+            previousHulls[m].volume = models_[m].hullVolume;
+        }
     for (size_t li = 0; li < deltas.size(); ++li) {
         LevelWork& w = work[li];
         Level level;
@@ -856,18 +869,28 @@ void Baker::buildLevels() {
         level.measures = measuresOf(totalVolume, totalArea);
         level.volumeOriginal = out_.originals.volume;
         if (settings_.computeHullBaseline) {
-            std::vector<std::vector<double>> groupPoints(w.groupCount);
-            for (size_t m = 0; m < models_.size(); ++m)
-                groupPoints[w.modelGroup[m]].insert(groupPoints[w.modelGroup[m]].end(), models_[m].hullPoints.begin(),
-                                                    models_[m].hullPoints.end());
+            // A group's hull is the hull of its sub-groups' hulls at the previous level
+            // (groups only coarsen): a group unchanged since then keeps its hull, others
+            // are built from the few vertices of their parts' hulls.
+            std::vector<GroupHull> hulls(w.groupCount);
+            std::vector<std::vector<uint32_t>> parts(w.groupCount);
+            for (size_t m = 0; m < models_.size(); ++m) parts[w.modelGroup[m]].push_back(previousHullOfModel[m]);
             for (size_t g = 0; g < w.groupCount; ++g) {
-                // A group unchanged since an earlier level keeps its hull volume.
-                auto cached = hullVolumeOfGroup_.find(aggregates[g].sourceObjects);
-                if (cached == hullVolumeOfGroup_.end())
-                    cached = hullVolumeOfGroup_.emplace(aggregates[g].sourceObjects, detail::convexHullVolume(groupPoints[g])).first;
-                aggregates[g].volumeHull = cached->second;
-                level.volumeHull += aggregates[g].volumeHull;
+                std::vector<uint32_t>& p = parts[g];
+                std::sort(p.begin(), p.end());
+                p.erase(std::unique(p.begin(), p.end()), p.end());
+                if (p.size() == 1) {
+                    hulls[g] = previousHulls[p[0]];
+                } else {
+                    std::vector<double> points;
+                    for (uint32_t part : p) points.insert(points.end(), previousHulls[part].vertices.begin(), previousHulls[part].vertices.end());
+                    hulls[g].volume = detail::convexHullVolume(points, &hulls[g].vertices);
+                }
+                aggregates[g].volumeHull = hulls[g].volume;
+                level.volumeHull += hulls[g].volume;
             }
+            for (size_t m = 0; m < models_.size(); ++m) previousHullOfModel[m] = w.modelGroup[m];
+            previousHulls = std::move(hulls);
         }
         level.volumeConstant = isConstant ? totalVolume : w.volumeConstant;
         level.aggregates = std::move(aggregates);
@@ -897,8 +920,7 @@ bool Baker::run() {
         // Each model's hull vertices: the group hulls of every level are hulls of these.
         timer_.begin("model hulls");
         detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
-            if (!detail::convexHullVertices(models_[m].positions, models_[m].hullPoints))
-                models_[m].hullPoints = models_[m].positions;
+            models_[m].hullVolume = detail::convexHullVolume(models_[m].positions, &models_[m].hullPoints);
         });
     }
     buildGraph();

@@ -127,18 +127,26 @@ struct Sculptor {
         }
         std::vector<int>& touched = scratchTouched;
         touched.clear();
-        const std::vector<int>& surfaceTets = modelSurfaceTets(static_cast<int>(c.modelA));
-        for (int t : surfaceTets) {
+        // Only the few surface tets nearest the closest point start the search: the chain
+        // has to leave a's surface there, and a large model has hundreds of surface tets.
+        constexpr size_t kSources = 8;
+        std::vector<Entry>& sources = scratchSources;
+        sources.clear();
+        for (int t : modelSurfaceTets(static_cast<int>(c.modelA))) {
             if (!isKeptFree(t, group)) continue;
             double cen[3];
             centroid(t, cen);
-            double g = distance3(cen, c.pointA);
-            if (g < best[t]) {
-                if (best[t] == INFINITY) touched.push_back(t);
-                best[t] = g;
-                from[t] = -1;
-                open.emplace(g + distance3(cen, c.pointB), g, t);
-            }
+            const double g = distance3(cen, c.pointA);
+            sources.emplace_back(g + distance3(cen, c.pointB), g, t);
+        }
+        const size_t keep = std::min(kSources, sources.size());
+        std::partial_sort(sources.begin(), sources.begin() + keep, sources.end());
+        for (size_t k = 0; k < keep; ++k) {
+            const auto [f, g, t] = sources[k];
+            if (best[t] == INFINITY) touched.push_back(t);
+            best[t] = g;
+            from[t] = -1;
+            open.emplace(f, g, t);
         }
         int reached = -1;
         size_t expansions = 0;
@@ -175,6 +183,7 @@ struct Sculptor {
     }
 
     std::vector<double> scratchBest;
+    std::vector<std::tuple<double, double, int>> scratchSources;
     std::vector<int> scratchFrom, scratchTouched;
     std::vector<std::vector<int>> surfaceTetsOfModel;
     bool surfaceTetsBuilt = false;
