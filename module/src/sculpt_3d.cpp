@@ -316,6 +316,7 @@ struct Sculptor {
     // remove the free unprotected solid tets around the edge.
     // Tets whose label changed during clean-up (the next round only looks near them).
     std::vector<int> changedTets;
+    bool openedByRepair = false;  ///< the last repair removed solid tets (islands may follow)
     // Per tet: 1 once removed, 2 once added by the clean-up. The edge repair never undoes
     // what the clean-up did, so the rounds cannot cycle.
     std::vector<unsigned char> cleanUpHistory;
@@ -433,6 +434,7 @@ struct Sculptor {
             }
             if (touched.empty()) continue;  // neither side can change: left as is
             changed = true;
+            if (newLabel < 0) openedByRepair = true;
             for (int t : touched) setLabel(t, newLabel);
             for (int t : touched)
                 for (const auto& e : kTetEdges) {
@@ -550,11 +552,15 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
     if (!request.cleanUp) return;
+    // Islands appear only where tets are removed; voids are filled in the same round; the
+    // edge repair follows its own changes. So another round is needed only when the repair
+    // opened something (new islands are possible then).
     for (int round = 0; round < 8; ++round) {
-        bool changed = sculptor.removeIslands();
-        changed |= sculptor.repairNonManifoldEdges(round == 0);
-        changed |= sculptor.fillVoids();
-        if (!changed) break;
+        sculptor.removeIslands();
+        sculptor.openedByRepair = false;
+        sculptor.repairNonManifoldEdges(round == 0);
+        sculptor.fillVoids();
+        if (!sculptor.openedByRepair) break;
     }
 }
 
