@@ -192,6 +192,10 @@ private:
     void analyseFreeSpace(const std::vector<int>& pointModel);
     void buildGraph();
     bool refineCoarseConnections();
+    void prepareModels();
+    bool modelsPrepared_ = false;  ///< BVHs and hulls match the models' current surfaces
+    /// Exact distances measured before triangulating, by (first object of a, first object of b).
+    std::map<std::pair<uint32_t, uint32_t>, detail::ClosestPair> distanceCache_;
     void prerefineClosePairs();
     struct Insertion {
         uint32_t model, triangle;
@@ -242,6 +246,8 @@ void Baker::makeStandIn(Model& m, const std::string& why) {
     for (uint32_t o : m.objects) pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
     m.standIn = true;
     standInsChanged_ = true;
+    modelsPrepared_ = false;
+    distanceCache_.clear();
     m.positions.clear();
     m.triangles.clear();
     if (!detail::convexHull3(pts, m.positions, m.triangles)) {
@@ -331,6 +337,8 @@ bool Baker::resolveStandInOverlaps() {
         }
         if (!merged) return changed;
         changed = true;
+        modelsPrepared_ = false;
+        distanceCache_.clear();
         std::vector<Model> next;
         std::map<uint32_t, size_t> at;
         for (uint32_t i = 0; i < models_.size(); ++i) {
@@ -560,10 +568,7 @@ void Baker::buildGraph() {
     }
     // Exact distances between neighbouring models (BVH closest pair).
     timer_.begin("distances");
-    detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
-        models_[m].bvh.build(models_[m].positions.data(), models_[m].positions.size() / 3, models_[m].triangles.data(),
-                             models_[m].triangles.size() / 3);
-    });
+    if (!modelsPrepared_) prepareModels();
     const size_t pairCount = space_.pairs.size();
     detail::parallelFor(pairCount, settings_.threadCount, [&](size_t i) {
         ModelPair& p = space_.pairs[i];
@@ -572,13 +577,20 @@ void Baker::buildGraph() {
         std::copy(ua, ua + 3, p.closestA);
         std::copy(ub, ub + 3, p.closestB);
         p.exactDistance = p.shortestEdge;
-        detail::ClosestPair cp = detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
-        if (cp.triangleA != ~0u && cp.distance <= p.shortestEdge) {
+        // Pairs measured before triangulating keep that result (same surfaces; their
+        // triangle numbers changed with the inserted points, so those are not kept).
+        auto cached = distanceCache_.find({models_[p.a].objects[0], models_[p.b].objects[0]});
+        const bool fromCache = cached != distanceCache_.end();
+        const detail::ClosestPair cp =
+            fromCache ? cached->second : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
+        if (std::isfinite(cp.distance) && cp.distance <= p.shortestEdge) {
             p.exactDistance = cp.distance;
             std::copy(cp.pointA, cp.pointA + 3, p.closestA);
             std::copy(cp.pointB, cp.pointB + 3, p.closestB);
-            p.closestTriangleA = cp.triangleA;
-            p.closestTriangleB = cp.triangleB;
+            if (!fromCache) {
+                p.closestTriangleA = cp.triangleA;
+                p.closestTriangleB = cp.triangleB;
+            }
         }
         p.weight = settings_.distance == DistanceMode::Exact ? p.exactDistance : p.shortestEdge;
     }, [&](size_t done) {
@@ -627,9 +639,11 @@ void Baker::prerefineClosePairs() {
     // Measure every candidate on its own slot, then gather in candidate order.
     std::vector<std::array<Insertion, 2>> found(candidates.size());
     std::vector<std::array<bool, 2>> use(candidates.size(), {false, false});
+    std::vector<detail::ClosestPair> measured(candidates.size());
     detail::parallelFor(candidates.size(), settings_.threadCount, [&](size_t c) {
         const auto [i, j] = candidates[c];
         detail::ClosestPair cp = detail::meshDistance(models_[i].bvh, models_[j].bvh);
+        measured[c] = cp;
         if (cp.triangleA == ~0u || cp.triangleB == ~0u || !(cp.distance > tolerance_)) return;
         const double ra = nearestVertexDistance(models_[i], cp.triangleA, cp.pointA);
         const double rb = nearestVertexDistance(models_[j], cp.triangleB, cp.pointB);
@@ -640,15 +654,19 @@ void Baker::prerefineClosePairs() {
     }, [&](size_t done) {
         if (done % 64 == 0) timer_.report(double(done) / candidates.size());
     });
-    for (size_t c = 0; c < candidates.size(); ++c)
+    for (size_t c = 0; c < candidates.size(); ++c) {
         for (int k = 0; k < 2; ++k)
             if (use[c][k]) insertions.push_back(found[c][k]);
+        const auto [i, j] = candidates[c];
+        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = measured[c];
+    }
     insertSurfacePoints(insertions);
 }
 
 // Splits surface triangles 1 -> 3 at the given points (moved slightly inside the triangle
 // so no sliver or degenerate triangle appears). Returns how many points were inserted.
 size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
+    modelsPrepared_ = false;  // surfaces change (not their shape: distances stay valid)
     std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
         return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
     });
@@ -720,6 +738,16 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
         i = j;
     }
     return inserted;
+}
+
+// Per model: BVH of its surface (for exact distances) and convex hull (for the baseline).
+void Baker::prepareModels() {
+    detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
+        Model& model = models_[m];
+        model.bvh.build(model.positions.data(), model.positions.size() / 3, model.triangles.data(), model.triangles.size() / 3);
+        if (settings_.computeHullBaseline) model.hullVolume = detail::convexHullVolume(model.positions, &model.hullPoints);
+    });
+    modelsPrepared_ = true;
 }
 
 // DESIGN 2.4 step 4: where large input triangles leave no short triangulation edge between
@@ -916,12 +944,9 @@ bool Baker::run() {
     out_.objectModel.assign(objects_.size(), UINT32_MAX);
     for (size_t m = 0; m < models_.size(); ++m)
         for (uint32_t o : models_[m].objects) out_.objectModel[o] = static_cast<uint32_t>(m);
-    if (settings_.computeHullBaseline) {
-        // Each model's hull vertices: the group hulls of every level are hulls of these.
+    if (!modelsPrepared_) {
         timer_.begin("model hulls");
-        detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
-            models_[m].hullVolume = detail::convexHullVolume(models_[m].positions, &models_[m].hullPoints);
-        });
+        prepareModels();
     }
     buildGraph();
     if (settings_.distance == DistanceMode::Exact && refineCoarseConnections()) {
