@@ -40,6 +40,7 @@ struct FreeSpace {
     std::vector<ModelPair> pairs;   ///< sorted by (a, b)
     std::vector<double> tetEdgeLength; ///< 6 per tet (corner pairs 01 02 03 12 13 23), units
     std::vector<int> tetEdgePair;      ///< 6 per tet: index into pairs, or kSameModelEdge / kUnpairedEdge
+    std::vector<std::vector<int>> surfaceTetsOfModel; ///< per model: free tets with a facet on its surface, ascending
     size_t modelCount = 0;
     std::vector<double> lengths;        ///< per pair, ascending free-space edge lengths (see ModelPair)
     std::vector<double> lengthPrefix;   ///< running sum of lengths within each pair

@@ -26,8 +26,8 @@ struct EdgeLimits {
     std::vector<double> pair;   ///< per FreeSpace::pairs entry
 };
 
-/// Fills space.tetEdgeLength and space.tetEdgePair (after the pairs are built): the carving
-/// loop of every level then only looks up lengths and limits.
+/// Fills space.tetEdgeLength, tetEdgePair and surfaceTetsOfModel (after the pairs are
+/// built): every level then only looks them up.
 void precomputeTetEdges(FreeSpace& space);
 
 /// Evaluates `function` for every pair at threshold delta (DESIGN 2.4 step 3).
