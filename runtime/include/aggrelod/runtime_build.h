@@ -1,0 +1,57 @@
+// aggrelod runtime: the whole contract between the bake and the runtime (as Recast's
+// dtNavMeshCreateParams). The bake fills one BuildParams with flat arrays; writeRuntimeFile
+// turns it into the versioned `.aglod` blob that the runtime reads in place (DESIGN section 4).
+// Standard library only.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace aggrelod::runtime {
+
+/// No parent / no index.
+constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
+
+/// One node of the hierarchy. Leaves are the original objects (geometricError 0, level
+/// kLeafLevel); inner nodes are aggregates (proxies). Ranges index the arrays of BuildParams.
+struct BuildNode {
+    uint32_t parent = kNoIndex;      ///< index into BuildParams::nodes; kNoIndex for roots
+    uint32_t firstChild = 0;         ///< range [firstChild, firstChild+childCount) in childIndices
+    uint32_t childCount = 0;
+    uint32_t firstSource = 0;        ///< range in sourceObjects: original objects this node stands for
+    uint32_t sourceCount = 0;
+    uint32_t firstVertex = 0;        ///< range in positions (counted in vertices, 3 floats each)
+    uint32_t vertexCount = 0;
+    uint32_t firstIndex = 0;         ///< range in indices (counted in indices, 3 per triangle);
+    uint32_t indexCount = 0;         ///<   indices are relative to firstVertex
+    uint32_t level = 0;              ///< 0 = finest aggregate level, rising with delta; kLeafLevel for originals
+    float delta = 0.0f;              ///< threshold of the level, world units (0 for leaves)
+    float geometricError = 0.0f;     ///< world units; >= every child's (0 for leaves)
+    float boundsMin[3] = {0, 0, 0};  ///< axis-aligned box, world units, contains the children's
+    float boundsMax[3] = {0, 0, 0};
+    float sphereCenter[3] = {0, 0, 0};  ///< bounding sphere, contains the children's
+    float sphereRadius = 0.0f;
+};
+
+constexpr uint32_t kLeafLevel = 0xFFFFu;
+
+/// Everything the runtime file holds. Arrays are owned by the caller.
+struct BuildParams {
+    std::vector<BuildNode> nodes;        ///< parents may come before or after children
+    std::vector<uint32_t> childIndices;  ///< node indices
+    std::vector<uint32_t> sourceObjects; ///< original object indices in [0, objectNames.size())
+    std::vector<float> positions;        ///< xyz per vertex, world units
+    std::vector<uint32_t> indices;       ///< 3 per triangle, relative to the node's firstVertex
+    std::vector<std::string> objectNames;///< name of each original object (UTF-8)
+    uint64_t settingsHash = 0;           ///< hash of the bake settings (for cache invalidation)
+    std::string toolVersion;             ///< e.g. "0.1.0"
+};
+
+/// Serialises params into a `.aglod` blob (little-endian, 16-byte aligned sections,
+/// offsets not pointers). Returns false and fills error when params are inconsistent
+/// (a range outside its array, a child whose parent differs, ...). Deterministic:
+/// the same params give byte-identical bytes.
+bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error);
+
+}  // namespace aggrelod::runtime
