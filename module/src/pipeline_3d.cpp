@@ -21,6 +21,7 @@
 #include <numeric>
 #include <set>
 #include <string>
+#include <thread>
 #include <tuple>
 
 namespace aggrelod {
@@ -192,7 +193,7 @@ private:
     void analyseFreeSpace(const std::vector<int>& pointModel);
     void buildGraph();
     bool refineCoarseConnections();
-    void prepareModels();
+    void prepareModels(int threadCount);
     bool modelsPrepared_ = false;  ///< BVHs and hulls match the models' current surfaces
     /// Exact distances measured before triangulating, by (first object of a, first object of b).
     std::map<std::pair<uint32_t, uint32_t>, detail::ClosestPair> distanceCache_;
@@ -378,7 +379,14 @@ bool Baker::triangulate() {
             plc.triangleMarkers.insert(plc.triangleMarkers.end(), models_[m].triangles.size() / 3, static_cast<int>(m) + 1);
         }
         space_ = FreeSpace{};
+        // TetGen runs in a child process on one core; meanwhile this process builds the
+        // models' BVHs and hulls (needed right after) on one thread. Each model's result
+        // does not depend on the thread doing it, so output stays deterministic.
+        std::thread preparing;
+        const bool overlap = !modelsPrepared_ && settings_.threadCount != 1;
+        if (overlap) preparing = std::thread([this] { prepareModels(1); });
         detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
+        if (preparing.joinable()) preparing.join();
         for (const char* fallback : {"Y", "M"}) {
             if (outcome.status != detail::TetgenStatus::Crashed && outcome.status != detail::TetgenStatus::InternalError) break;
             std::vector<int> markers;
@@ -568,7 +576,7 @@ void Baker::buildGraph() {
     }
     // Exact distances between neighbouring models (BVH closest pair).
     timer_.begin("distances");
-    if (!modelsPrepared_) prepareModels();
+    if (!modelsPrepared_) prepareModels(settings_.threadCount);
     const size_t pairCount = space_.pairs.size();
     detail::parallelFor(pairCount, settings_.threadCount, [&](size_t i) {
         ModelPair& p = space_.pairs[i];
@@ -741,8 +749,8 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
 }
 
 // Per model: BVH of its surface (for exact distances) and convex hull (for the baseline).
-void Baker::prepareModels() {
-    detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t m) {
+void Baker::prepareModels(int threadCount) {
+    detail::parallelFor(models_.size(), threadCount, [&](size_t m) {
         Model& model = models_[m];
         model.bvh.build(model.positions.data(), model.positions.size() / 3, model.triangles.data(), model.triangles.size() / 3);
         if (settings_.computeHullBaseline) model.hullVolume = detail::convexHullVolume(model.positions, &model.hullPoints);
@@ -847,17 +855,13 @@ void Baker::buildLevels() {
         work.size(), settings_.threadCount,
         [&](size_t li) {
             LevelWork& w = work[li];
-            std::vector<int> label;
-            detail::sculptLevel(space_, w.request, label);
+            std::vector<int> label, constantLabel;
+            if (measureConstant) w.request.baselineLimits = &w.constantLimits;
+            detail::sculptLevel(space_, w.request, label, &constantLabel);
             detail::extractSurfaces(space_, label, w.groupCount, w.aggregates);
-            if (measureConstant) {
-                detail::LevelShapeRequest constantRequest = w.request;
-                constantRequest.limits = &w.constantLimits;
-                constantRequest.cleanUp = false;  // volume only: the clean-up changes it by slivers
-                detail::sculptLevel(space_, constantRequest, label);
-                for (size_t t = 0; t < label.size(); ++t)
-                    if (label[t] >= 0) w.volumeConstant += space_.tetVolume[t];
-            }
+            if (measureConstant)
+                for (size_t t = 0; t < constantLabel.size(); ++t)
+                    if (constantLabel[t] >= 0) w.volumeConstant += space_.tetVolume[t];
         },
         [&](size_t done) { timer_.report(0.9 * double(done) / work.size()); });
 
@@ -946,7 +950,7 @@ bool Baker::run() {
         for (uint32_t o : models_[m].objects) out_.objectModel[o] = static_cast<uint32_t>(m);
     if (!modelsPrepared_) {
         timer_.begin("model hulls");
-        prepareModels();
+        prepareModels(settings_.threadCount);
     }
     buildGraph();
     if (settings_.distance == DistanceMode::Exact && refineCoarseConnections()) {

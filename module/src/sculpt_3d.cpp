@@ -43,8 +43,10 @@ struct Sculptor {
     const TetMesh& mesh;
     std::vector<char> isProtected;
 
+    const EdgeLimits* limits;
+
     Sculptor(const FreeSpace& s, const LevelShapeRequest& r, std::vector<int>& l)
-        : space(s), request(r), label(l), mesh(s.mesh) {}
+        : space(s), request(r), label(l), mesh(s.mesh), limits(r.limits) {}
 
     const double* point(int v) const { return &mesh.points[3 * static_cast<size_t>(v)]; }
 
@@ -94,8 +96,8 @@ struct Sculptor {
     }
 
     double limitOfEdge(int pairIndex) const {
-        if (pairIndex >= 0) return request.limits->pair[pairIndex];
-        return pairIndex == kSameModelEdge ? request.limits->sameModel : request.limits->unpaired;
+        if (pairIndex >= 0) return limits->pair[pairIndex];
+        return pairIndex == kSameModelEdge ? limits->sameModel : limits->unpaired;
     }
 
     // Step 4: face-connected chain of kept tets from model a's surface to model b's surface.
@@ -189,72 +191,100 @@ struct Sculptor {
 
     // Kept free tets that cannot reach an object of their group through faces of the
     // group's solid are removed (they would touch it only along an edge or at a vertex).
+    // Floods start from kept free tets only and stop at the first object tet (or tet
+    // already known to be anchored) of the group, so object interiors are never walked.
+    std::vector<unsigned char> floodState;  // per tet, scratch: 0 unknown, 1 anchored / outer
+    std::vector<int> floodMembers;
     bool removeIslands() {
         const size_t tetCount = mesh.tetCount();
-        std::vector<char> reached(tetCount, 0);
-        std::vector<int> stack;
-        for (size_t t = 0; t < tetCount; ++t)
-            if (space.tetModel[t] >= 0 && label[t] >= 0) {
-                reached[t] = 1;
-                stack.push_back(static_cast<int>(t));
-            }
-        while (!stack.empty()) {
-            int t = stack.back();
-            stack.pop_back();
-            for (int j = 0; j < 4; ++j) {
-                int n = mesh.neighbors[4 * t + j];
-                if (n >= 0 && !reached[n] && label[n] == label[t]) {
-                    reached[n] = 1;
-                    stack.push_back(n);
+        floodState.assign(tetCount, 0);
+        std::vector<int>& members = floodMembers;
+        bool changed = false;
+        for (size_t s = 0; s < tetCount; ++s) {
+            if (space.tetModel[s] >= 0 || label[s] < 0 || floodState[s]) continue;
+            const int g = label[s];
+            members.clear();
+            members.push_back(static_cast<int>(s));
+            floodState[s] = 2;  // in the current flood
+            bool anchored = false;
+            for (size_t head = 0; head < members.size() && !anchored; ++head) {
+                const int t = members[head];
+                for (int j = 0; j < 4; ++j) {
+                    const int n = mesh.neighbors[4 * t + j];
+                    if (n < 0 || label[n] != g) continue;
+                    if (space.tetModel[n] >= 0 || floodState[n] == 1) {
+                        anchored = true;
+                        break;
+                    }
+                    if (floodState[n] == 0) {
+                        floodState[n] = 2;
+                        members.push_back(n);
+                    }
                 }
             }
-        }
-        bool changed = false;
-        for (size_t t = 0; t < tetCount; ++t)
-            if (label[t] >= 0 && !reached[t]) {
-                setLabel(static_cast<int>(t), -1);
+            for (int t : members) floodState[t] = 1;
+            if (!anchored) {
+                for (int t : members) setLabel(t, -1);
                 changed = true;
             }
+        }
         return changed;
     }
 
-    // Closed cavities: connected free space no exposed to the outside (hull) and bordered
+    // Closed cavities: connected free space not exposed to the outside (hull) and bordered
     // by one group only is filled, so every aggregate is one shell without inner voids.
+    // A cavity borders its group, so floods start only from free tets next to a solid, and
+    // stop as soon as they meet the hull, a second group or space already known to be
+    // outside: most of the free space is never walked.
     bool fillVoids() {
         const size_t tetCount = mesh.tetCount();
-        std::vector<int> component(tetCount, -1);
-        std::vector<int> stack, members;
+        floodState.assign(tetCount, 0);
+        std::vector<int>& members = floodMembers;
         bool changed = false;
-        for (size_t s = 0; s < tetCount; ++s) {
-            if (label[s] >= 0 || component[s] >= 0) continue;
+        auto floodFrom = [&](int s) {
+            if (label[s] >= 0 || floodState[s]) return;
             members.clear();
-            stack.push_back(static_cast<int>(s));
-            component[s] = static_cast<int>(s);
+            members.push_back(s);
+            floodState[s] = 2;
             int border = -1;  // the single bordering group, -2 when several or the hull
-            while (!stack.empty()) {
-                int t = stack.back();
-                stack.pop_back();
-                members.push_back(t);
+            for (size_t head = 0; head < members.size() && border != -2; ++head) {
+                const int t = members[head];
                 for (int j = 0; j < 4; ++j) {
-                    int n = mesh.neighbors[4 * t + j];
+                    const int n = mesh.neighbors[4 * t + j];
                     if (n < 0) {
                         border = -2;
-                        continue;
+                        break;
                     }
                     if (label[n] < 0) {
-                        if (component[n] < 0) {
-                            component[n] = static_cast<int>(s);
-                            stack.push_back(n);
+                        if (floodState[n] == 1) {
+                            border = -2;  // joins space already known to be outside
+                            break;
+                        }
+                        if (floodState[n] == 0) {
+                            floodState[n] = 2;
+                            members.push_back(n);
                         }
                         continue;
                     }
                     if (border == -1) border = label[n];
-                    else if (border != label[n]) border = -2;
+                    else if (border != label[n]) {
+                        border = -2;
+                        break;
+                    }
                 }
             }
             if (border >= 0) {
                 for (int t : members) setLabel(t, border);
                 changed = true;
+            } else {
+                for (int t : members) floodState[t] = 1;
+            }
+        };
+        for (size_t t = 0; t < tetCount; ++t) {
+            if (label[t] < 0) continue;
+            for (int j = 0; j < 4; ++j) {
+                const int n = mesh.neighbors[4 * t + j];
+                if (n >= 0) floodFrom(n);
             }
         }
         return changed;
@@ -530,11 +560,20 @@ EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const Aggrega
     return limits;
 }
 
-void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel) {
+void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
+                 std::vector<int>* baselineLabel) {
     Sculptor sculptor(space, request, tetLabel);
     sculptor.initialLabels();
     sculptor.isProtected.assign(space.mesh.tetCount(), 0);
     for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
+    if (request.baselineLimits && baselineLabel) {
+        // Same groups, same protected connections: only the carving limits differ.
+        *baselineLabel = tetLabel;
+        Sculptor baseline(space, request, *baselineLabel);
+        baseline.limits = request.baselineLimits;
+        baseline.isProtected = sculptor.isProtected;
+        baseline.carve();
+    }
     sculptor.carve();
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an

@@ -40,11 +40,16 @@ struct LevelShapeRequest {
     const EdgeLimits* limits = nullptr;
     std::vector<ProtectedConnection> connections;       ///< joined pairs to keep connected
     bool cleanUp = true;  ///< make the solids manifold (off for volume-only baselines)
+    /// Optional second set of limits (the constant baseline): carved from the same initial
+    /// labels and protected connections, without clean-up (volume only).
+    const EdgeLimits* baselineLimits = nullptr;
 };
 
 /// Labels every tet with the group whose solid contains it (-1: not in any aggregate).
-/// Object interiors take their model's group; free tets are kept or carved.
-void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel);
+/// Object interiors take their model's group; free tets are kept or carved. When
+/// request.baselineLimits is set, *baselineLabel gets the labels carved with those limits.
+void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
+                 std::vector<int>* baselineLabel = nullptr);
 
 /// Builds the closed, edge-manifold, outward surface of every group from the tet labels.
 /// aggregates[g] gets positions, indices and componentCount.

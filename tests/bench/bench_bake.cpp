@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
     const int levels = argc > 3 ? std::atoi(argv[3]) : 8;
     const uint32_t seed = argc > 4 ? static_cast<uint32_t>(std::atoi(argv[4])) : 1u;
     const int threads = argc > 5 ? std::atoi(argv[5]) : 0;
+    const bool constantBaseline = argc > 6 ? std::atoi(argv[6]) != 0 : true;
     std::vector<InputObject> objects = samples::makeRandomScene(objectCount, triangles, seed);
     size_t tris = 0;
     for (const InputObject& o : objects) tris += o.indices.size() / 3;
@@ -72,6 +73,7 @@ int main(int argc, char** argv) {
     Settings3D settings;
     settings.automaticLevelCount = levels;
     settings.threadCount = threads;
+    settings.computeConstantBaseline = constantBaseline;
     Hierarchy3D h;
     auto start = std::chrono::steady_clock::now();
     const bool ok = buildHierarchy3D(objects, settings, h);
