@@ -41,6 +41,10 @@ struct FreeSpace {
     std::vector<double> tetEdgeLength; ///< 6 per tet (corner pairs 01 02 03 12 13 23), units
     std::vector<int> tetEdgePair;      ///< 6 per tet: index into pairs, or kSameModelEdge / kUnpairedEdge
     std::vector<std::vector<int>> surfaceTetsOfModel; ///< per model: free tets with a facet on its surface, ascending
+    /// Per tet: for an object tet, bit j is set when the neighbour across face j lies outside
+    /// its model (free space or the hull); 0 for free tets. Only those faces of an object
+    /// tet can ever be on an aggregate's surface, so scans skip object interiors.
+    std::vector<uint8_t> objectFaceMask;
     size_t modelCount = 0;
     std::vector<double> lengths;        ///< per pair, ascending free-space edge lengths (see ModelPair)
     std::vector<double> lengthPrefix;   ///< running sum of lengths within each pair

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +24,12 @@
 #include <string>
 #include <thread>
 #include <tuple>
+
+#ifdef __linux__
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 
 namespace aggrelod {
 namespace {
@@ -196,7 +203,15 @@ private:
     void prepareModels(int threadCount);
     bool modelsPrepared_ = false;  ///< BVHs and hulls match the models' current surfaces
     /// Exact distances measured before triangulating, by (first object of a, first object of b).
-    std::map<std::pair<uint32_t, uint32_t>, detail::ClosestPair> distanceCache_;
+    /// trianglesCurrent: the triangle numbers refer to the current surfaces (no point was
+    /// inserted since the measurement). Whether a pair is cached never changes the result:
+    /// meshDistance gives the same closest pair with or without its distance bound.
+    struct CachedDistance {
+        detail::ClosestPair pair;
+        bool trianglesCurrent = false;
+    };
+    std::map<std::pair<uint32_t, uint32_t>, CachedDistance> distanceCache_;
+    void measureLikelyNeighbours(const std::atomic<bool>& stop);
     void prerefineClosePairs();
     struct Insertion {
         uint32_t model, triangle;
@@ -382,10 +397,22 @@ bool Baker::triangulate() {
         // TetGen runs in a child process on one core; meanwhile this process builds the
         // models' BVHs and hulls (needed right after) on one thread. Each model's result
         // does not depend on the thread doing it, so output stays deterministic.
+        // Then it measures exact distances of likely neighbour pairs for the graph stage
+        // until TetGen is done (the cache only saves time; it never changes a result).
         std::thread preparing;
+        std::atomic<bool> tetgenDone{false};
         const bool overlap = !modelsPrepared_ && settings_.threadCount != 1;
-        if (overlap) preparing = std::thread([this] { prepareModels(1); });
+        if (overlap)
+            preparing = std::thread([this, &tetgenDone] {
+#ifdef __linux__
+                // Lowest priority for this thread only: on a busy machine TetGen goes first.
+                setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+#endif
+                prepareModels(1);
+                if (settings_.distance == DistanceMode::Exact) measureLikelyNeighbours(tetgenDone);
+            });
         detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
+        tetgenDone = true;
         if (preparing.joinable()) preparing.join();
         for (const char* fallback : {"Y", "M"}) {
             if (outcome.status != detail::TetgenStatus::Crashed && outcome.status != detail::TetgenStatus::InternalError) break;
@@ -590,12 +617,12 @@ void Baker::buildGraph() {
         auto cached = distanceCache_.find({models_[p.a].objects[0], models_[p.b].objects[0]});
         const bool fromCache = cached != distanceCache_.end();
         const detail::ClosestPair cp =
-            fromCache ? cached->second : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
+            fromCache ? cached->second.pair : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
         if (std::isfinite(cp.distance) && cp.distance <= p.shortestEdge) {
             p.exactDistance = cp.distance;
             std::copy(cp.pointA, cp.pointA + 3, p.closestA);
             std::copy(cp.pointB, cp.pointB + 3, p.closestB);
-            if (!fromCache) {
+            if (!fromCache || cached->second.trianglesCurrent) {
                 p.closestTriangleA = cp.triangleA;
                 p.closestTriangleB = cp.triangleB;
             }
@@ -666,7 +693,7 @@ void Baker::prerefineClosePairs() {
         for (int k = 0; k < 2; ++k)
             if (use[c][k]) insertions.push_back(found[c][k]);
         const auto [i, j] = candidates[c];
-        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = measured[c];
+        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = CachedDistance{measured[c], false};
     }
     insertSurfacePoints(insertions);
 }
@@ -675,6 +702,7 @@ void Baker::prerefineClosePairs() {
 // so no sliver or degenerate triangle appears). Returns how many points were inserted.
 size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
     modelsPrepared_ = false;  // surfaces change (not their shape: distances stay valid)
+    for (auto& entry : distanceCache_) entry.second.trianglesCurrent = false;
     std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
         return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
     });
@@ -748,6 +776,40 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
     return inserted;
 }
 
+// Exact distances of each model's nearest models by box distance (more than the
+// near-pair refinement step measured), into distanceCache_, until `stop` is set.
+void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
+    constexpr size_t kNeighbours = 32;
+    const size_t n = models_.size();
+    std::vector<std::pair<uint32_t, uint32_t>> candidates;
+    std::vector<std::pair<double, uint32_t>> near;
+    for (uint32_t i = 0; i < n && !stop; ++i) {
+        near.clear();
+        for (uint32_t j = 0; j < n; ++j) {
+            if (j == i) continue;
+            double d2 = 0;
+            for (int k = 0; k < 3; ++k) {
+                double gap = std::max({0.0, models_[j].bounds[k] - models_[i].bounds[3 + k], models_[i].bounds[k] - models_[j].bounds[3 + k]});
+                d2 += gap * gap;
+            }
+            near.emplace_back(d2, j);
+        }
+        const size_t keep = std::min(kNeighbours, near.size());
+        std::partial_sort(near.begin(), near.begin() + keep, near.end());
+        for (size_t k = 0; k < keep; ++k) candidates.emplace_back(std::min(i, near[k].second), std::max(i, near[k].second));
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    for (const auto& [i, j] : candidates) {
+        if (stop) return;
+        const std::pair<uint32_t, uint32_t> key{models_[i].objects[0], models_[j].objects[0]};
+        // Pairs already measured keep their entry: whether the triangles are current must
+        // not depend on this (optional) step, or output would depend on the thread count.
+        if (distanceCache_.count(key)) continue;
+        distanceCache_[key] = CachedDistance{detail::meshDistance(models_[i].bvh, models_[j].bvh), true};
+    }
+}
+
 // Per model: BVH of its surface (for exact distances) and convex hull (for the baseline).
 void Baker::prepareModels(int threadCount) {
     detail::parallelFor(models_.size(), threadCount, [&](size_t m) {
@@ -789,7 +851,7 @@ bool Baker::refineCoarseConnections() {
 
 void Baker::buildLevels() {
     timer_.begin("hierarchy");
-    detail::precomputeTetEdges(space_);
+    detail::precomputeTetEdges(space_, settings_.threadCount);
     std::vector<GraphEdge> graph;
     for (const ModelPair& p : space_.pairs) graph.push_back(GraphEdge{p.a, p.b, p.weight});
     out_.merges = kruskalMerges(models_.size(), graph);
@@ -907,7 +969,7 @@ void Baker::buildLevels() {
             std::vector<GroupHull> hulls(w.groupCount);
             std::vector<std::vector<uint32_t>> parts(w.groupCount);
             for (size_t m = 0; m < models_.size(); ++m) parts[w.modelGroup[m]].push_back(previousHullOfModel[m]);
-            for (size_t g = 0; g < w.groupCount; ++g) {
+            detail::parallelFor(w.groupCount, settings_.threadCount, [&](size_t g) {
                 std::vector<uint32_t>& p = parts[g];
                 std::sort(p.begin(), p.end());
                 p.erase(std::unique(p.begin(), p.end()), p.end());
@@ -918,6 +980,8 @@ void Baker::buildLevels() {
                     for (uint32_t part : p) points.insert(points.end(), previousHulls[part].vertices.begin(), previousHulls[part].vertices.end());
                     hulls[g].volume = detail::convexHullVolume(points, &hulls[g].vertices);
                 }
+            });
+            for (size_t g = 0; g < w.groupCount; ++g) {
                 aggregates[g].volumeHull = hulls[g].volume;
                 level.volumeHull += hulls[g].volume;
             }

@@ -12,6 +12,8 @@
 // adjacency, Euclidean costs), so joined models always come out as one solid.
 #include "sculpt_3d.h"
 
+#include "parallel_for.h"
+
 #include <algorithm>
 #include <deque>
 #include <cmath>
@@ -73,6 +75,10 @@ struct Sculptor {
             label[t] = mixed ? -1 : group;
         }
     }
+
+    // Faces of t that can lie on a surface: all four for a free tet, the model-surface
+    // faces for an object tet.
+    unsigned candidateFaces(size_t t) const { return space.tetModel[t] >= 0 ? space.objectFaceMask[t] : 0xFu; }
 
     bool isKeptFree(int t, int group) const { return t >= 0 && space.tetModel[t] < 0 && label[t] == group; }
 
@@ -282,7 +288,9 @@ struct Sculptor {
         };
         for (size_t t = 0; t < tetCount; ++t) {
             if (label[t] < 0) continue;
+            const unsigned faces = candidateFaces(t);
             for (int j = 0; j < 4; ++j) {
+                if (!(faces & (1u << j))) continue;
                 const int n = mesh.neighbors[4 * t + j];
                 if (n >= 0) floodFrom(n);
             }
@@ -349,7 +357,9 @@ struct Sculptor {
         auto collectFaces = [&](int t) {
             const int g = label[t];
             if (g < 0) return;
+            const unsigned faces = candidateFaces(static_cast<size_t>(t));
             for (int j = 0; j < 4; ++j) {
+                if (!(faces & (1u << j))) continue;
                 int n = mesh.neighbors[4 * t + j];
                 if (n >= 0 && label[n] == g) continue;
                 for (int e = 0; e < 3; ++e) {
@@ -506,7 +516,7 @@ uint32_t FreeSpace::edgeStatsBelow(const ModelPair& p, double limit, double& mea
     return n;
 }
 
-void precomputeTetEdges(FreeSpace& space) {
+void precomputeTetEdges(FreeSpace& space, int threadCount) {
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
     space.surfaceTetsOfModel.assign(space.modelCount, {});
@@ -520,9 +530,21 @@ void precomputeTetEdges(FreeSpace& space) {
             }
         }
     }
+    space.objectFaceMask.assign(tetCount, 0);
+    for (size_t t = 0; t < tetCount; ++t) {
+        if (space.tetModel[t] < 0) continue;
+        for (int j = 0; j < 4; ++j) {
+            const int n = mesh.neighbors[4 * t + j];
+            if (n < 0 || space.tetModel[n] != space.tetModel[t]) space.objectFaceMask[t] |= static_cast<uint8_t>(1u << j);
+        }
+    }
     space.tetEdgeLength.resize(6 * tetCount);
     space.tetEdgePair.resize(6 * tetCount);
-    for (size_t t = 0; t < tetCount; ++t)
+    // Blocks of tets on several threads; each tet writes only its own six slots.
+    constexpr size_t kBlock = 16384;
+    parallelFor((tetCount + kBlock - 1) / kBlock, threadCount, [&](size_t block) {
+    const size_t end = std::min(tetCount, (block + 1) * kBlock);
+    for (size_t t = block * kBlock; t < end; ++t)
         for (int e = 0; e < 6; ++e) {
             const int u = mesh.tets[4 * t + kTetEdges[e][0]], v = mesh.tets[4 * t + kTetEdges[e][1]];
             space.tetEdgeLength[6 * t + e] = distance3(&mesh.points[3 * static_cast<size_t>(u)], &mesh.points[3 * static_cast<size_t>(v)]);
@@ -536,6 +558,7 @@ void precomputeTetEdges(FreeSpace& space) {
             }
             space.tetEdgePair[6 * t + e] = pair;
         }
+    });
 }
 
 EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
@@ -619,12 +642,16 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
     for (size_t t = 0; t < tetCount; ++t) {
         const int g = label[t];
         if (g < 0) continue;
+        // Object interiors are skipped: only their model-surface faces can be on a surface.
+        const unsigned candidates = space.tetModel[t] >= 0 ? space.objectFaceMask[t] : 0xFu;
         for (int j = 0; j < 4; ++j) {
+            if (!(candidates & (1u << j))) continue;
             int n = mesh.neighbors[4 * t + j];
             if (n < 0 || label[n] != g) faces[g].emplace_back(static_cast<int>(t), j);
         }
     }
     std::vector<int> faceIndexOf(4 * tetCount, -1);
+    std::vector<int> twinEdge;
     for (size_t g = 0; g < groupCount; ++g) {
         const auto& list = faces[g];
         Aggregate& agg = aggregates[g];
@@ -645,9 +672,13 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         Corners shells;
         shells.parent.resize(list.size());
         std::iota(shells.parent.begin(), shells.parent.end(), 0u);
+        // Twin of each face edge, found by one rotation and recorded for both sides (the
+        // rotation from the twin back through the same solid run ends at this face).
+        twinEdge.assign(3 * list.size(), -1);
         for (size_t f = 0; f < list.size(); ++f) {
             const auto [t0, j0] = list[f];
             for (int e = 0; e < 3; ++e) {
+                if (twinEdge[3 * f + e] >= 0) continue;
                 const int u = vertexAt(t0, kFaceCorners[j0][e]);
                 const int v = vertexAt(t0, kFaceCorners[j0][(e + 1) % 3]);
                 // Rotate around edge uv through the group's solid tets until leaving it.
@@ -681,8 +712,12 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 for (int e1 = 0; e1 < 3; ++e1) {
                     int c = vertexAt(t1, kFaceCorners[j1][e1]);
                     if (c == u) corners.unite(static_cast<uint32_t>(3 * f + e), static_cast<uint32_t>(3 * twinFace + e1));
-                    if (c == v) corners.unite(static_cast<uint32_t>(3 * f + (e + 1) % 3), static_cast<uint32_t>(3 * twinFace + e1));
+                    if (c == v) {
+                        corners.unite(static_cast<uint32_t>(3 * f + (e + 1) % 3), static_cast<uint32_t>(3 * twinFace + e1));
+                        twinEdge[3 * static_cast<size_t>(twinFace) + e1] = static_cast<int>(3 * f + e);  // twin's edge v -> u
+                    }
                 }
+                twinEdge[3 * f + e] = 3 * twinFace;
                 shells.unite(static_cast<uint32_t>(f), static_cast<uint32_t>(twinFace));
             }
         }

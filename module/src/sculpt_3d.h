@@ -27,8 +27,8 @@ struct EdgeLimits {
 };
 
 /// Fills space.tetEdgeLength, tetEdgePair and surfaceTetsOfModel (after the pairs are
-/// built): every level then only looks them up.
-void precomputeTetEdges(FreeSpace& space);
+/// built): every level then only looks them up. threadCount: as Settings3D::threadCount.
+void precomputeTetEdges(FreeSpace& space, int threadCount);
 
 /// Evaluates `function` for every pair at threshold delta (DESIGN 2.4 step 3).
 EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,

@@ -9,6 +9,9 @@
 
 #include <tetgen.h>
 
+#include <sys/resource.h>
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,7 +21,19 @@
 using namespace aggrelod;
 
 namespace {
-double tetgenAloneSeconds(const std::vector<InputObject>& objects, int& tetCount) {
+double cpuSeconds(clockid_t clock) {
+    timespec ts{};
+    clock_gettime(clock, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+double childrenCpuSeconds() {
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+double tetgenAloneSeconds(const std::vector<InputObject>& objects, int& tetCount, double& cpu) {
     tetgenio in, out;
     size_t points = 0, faces = 0;
     for (const InputObject& o : objects) {
@@ -50,7 +65,9 @@ double tetgenAloneSeconds(const std::vector<InputObject>& objects, int& tetCount
     }
     char switches[] = "pczQn";
     auto start = std::chrono::steady_clock::now();
+    const double cpuStart = cpuSeconds(CLOCK_THREAD_CPUTIME_ID);
     tetrahedralize(switches, &in, &out);
+    cpu = cpuSeconds(CLOCK_THREAD_CPUTIME_ID) - cpuStart;
     tetCount = out.numberoftetrahedra;
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -68,7 +85,8 @@ int main(int argc, char** argv) {
     for (const InputObject& o : objects) tris += o.indices.size() / 3;
 
     int tets = 0;
-    const double tetgenSeconds = tetgenAloneSeconds(objects, tets);
+    double tetgenCpu = 0;
+    const double tetgenSeconds = tetgenAloneSeconds(objects, tets, tetgenCpu);
 
     Settings3D settings;
     settings.automaticLevelCount = levels;
@@ -76,7 +94,10 @@ int main(int argc, char** argv) {
     settings.computeConstantBaseline = constantBaseline;
     Hierarchy3D h;
     auto start = std::chrono::steady_clock::now();
+    const double childCpuStart = childrenCpuSeconds(), processCpuStart = cpuSeconds(CLOCK_PROCESS_CPUTIME_ID);
     const bool ok = buildHierarchy3D(objects, settings, h);
+    const double childCpu = childrenCpuSeconds() - childCpuStart;
+    const double processCpu = cpuSeconds(CLOCK_PROCESS_CPUTIME_ID) - processCpuStart;
     const double bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     std::printf("scene: %zu objects, %zu triangles, seed %u, threads %d (0 = all); bake %s, %zu levels, %zu tets (TetGen alone: %d tets)\n",
@@ -87,6 +108,9 @@ int main(int argc, char** argv) {
     std::printf("| **whole bake** | %.3f | 100 %% |\n", bakeSeconds);
     std::printf("| TetGen alone (pczQn, in-process, same input) | %.3f | |\n", tetgenSeconds);
     std::printf("\nratio whole bake / TetGen alone: %.2fx (goal <= 1.5x)\n", bakeSeconds / tetgenSeconds);
+    // CPU seconds are less sensitive than wall time to other load on a shared machine.
+    std::printf("CPU seconds: TetGen alone %.3f; bake: TetGen child %.3f, this process %.3f (all threads)\n",
+                tetgenCpu, childCpu, processCpu);
     // Output quality on the same run: aggregates whose surface uses a directed edge twice
     // (not edge-manifold) and aggregates with more than one shell.
     size_t aggregates = 0, nonManifold = 0, multiShell = 0;
