@@ -550,8 +550,26 @@ void Baker::buildGraph() {
             edges.emplace_back(std::min(u, v), std::max(u, v));
         }
     }
-    std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    // Sorted and unique, as std::sort + std::unique would give, but bucketed by the first
+    // vertex first (counting sort): each edge appears in several tets, and the list is long.
+    {
+        const size_t pointCount = mesh.pointCount();
+        std::vector<uint32_t> start(pointCount + 1, 0);
+        for (const auto& e : edges) ++start[e.first + 1];
+        for (size_t p = 0; p < pointCount; ++p) start[p + 1] += start[p];
+        std::vector<int> second(edges.size());
+        std::vector<uint32_t> at(start.begin(), start.end() - 1);
+        for (const auto& e : edges) second[at[e.first]++] = e.second;
+        edges.clear();
+        for (size_t u = 0; u < pointCount; ++u) {
+            int* b = second.data() + start[u];
+            int* e = second.data() + start[u + 1];
+            if (b == e) continue;
+            std::sort(b, e);
+            for (int* v = b; v != e; ++v)
+                if (v == b || *v != v[-1]) edges.emplace_back(static_cast<int>(u), *v);
+        }
+    }
     // Accumulate per model pair (u on a, v on b, a < b).
     struct Acc {
         uint32_t a, b;
@@ -881,6 +899,8 @@ void Baker::buildLevels() {
         detail::LevelShapeRequest request;
         std::vector<Aggregate> aggregates;
         double volumeConstant = 0;
+        double totalVolume = 0, totalArea = 0;  ///< sums over the level's aggregates
+        size_t triangleCount = 0;
     };
     std::vector<LevelWork> work(deltas.size());
     for (size_t li = 0; li < deltas.size(); ++li) {
@@ -921,12 +941,28 @@ void Baker::buildLevels() {
             if (measureConstant) w.request.baselineLimits = &w.constantLimits;
             detail::sculptLevel(space_, w.request, label, &constantLabel);
             detail::extractSurfaces(space_, label, w.groupCount, w.aggregates);
+            // Per-aggregate sources and measures, on the same thread (levels are independent).
+            for (size_t m = 0; m < models_.size(); ++m) {
+                Aggregate& agg = w.aggregates[w.modelGroup[m]];
+                agg.sourceObjects.insert(agg.sourceObjects.end(), models_[m].objects.begin(), models_[m].objects.end());
+                agg.volumeOriginal += models_[m].volumeOriginal;
+            }
+            for (Aggregate& agg : w.aggregates) {
+                std::sort(agg.sourceObjects.begin(), agg.sourceObjects.end());
+                double v = 0, a = 0;
+                detail::meshVolumeArea(agg.positions, agg.indices, v, a);
+                agg.measures = measuresOf(v, a);
+                w.totalVolume += v;
+                w.totalArea += a;
+                w.triangleCount += agg.indices.size() / 3;
+            }
             if (measureConstant)
                 for (size_t t = 0; t < constantLabel.size(); ++t)
                     if (constantLabel[t] >= 0) w.volumeConstant += space_.tetVolume[t];
         },
-        [&](size_t done) { timer_.report(0.9 * double(done) / work.size()); });
+        [&](size_t done) { timer_.report(double(done) / work.size()); });
 
+    timer_.begin("level measures");
     // Hull baseline, level by level: starts from each model's own hull.
     struct GroupHull {
         std::vector<double> vertices;
@@ -945,21 +981,8 @@ void Baker::buildLevels() {
         Level level;
         level.delta = deltas[li];
         std::vector<Aggregate>& aggregates = w.aggregates;
-        for (size_t m = 0; m < models_.size(); ++m) {
-            Aggregate& agg = aggregates[w.modelGroup[m]];
-            agg.sourceObjects.insert(agg.sourceObjects.end(), models_[m].objects.begin(), models_[m].objects.end());
-            agg.volumeOriginal += models_[m].volumeOriginal;
-        }
-        double totalVolume = 0, totalArea = 0;
-        for (Aggregate& agg : aggregates) {
-            std::sort(agg.sourceObjects.begin(), agg.sourceObjects.end());
-            double v = 0, a = 0;
-            detail::meshVolumeArea(agg.positions, agg.indices, v, a);
-            agg.measures = measuresOf(v, a);
-            totalVolume += v;
-            totalArea += a;
-            level.triangleCount += agg.indices.size() / 3;
-        }
+        const double totalVolume = w.totalVolume, totalArea = w.totalArea;
+        level.triangleCount = w.triangleCount;
         level.measures = measuresOf(totalVolume, totalArea);
         level.volumeOriginal = out_.originals.volume;
         if (settings_.computeHullBaseline) {
@@ -991,7 +1014,7 @@ void Baker::buildLevels() {
         level.volumeConstant = isConstant ? totalVolume : w.volumeConstant;
         level.aggregates = std::move(aggregates);
         out_.levels.push_back(std::move(level));
-        timer_.report(0.9 + 0.1 * double(li + 1) / deltas.size());
+        timer_.report(double(li + 1) / deltas.size());
     }
 }
 

@@ -201,16 +201,18 @@ struct Sculptor {
     // already known to be anchored) of the group, so object interiors are never walked.
     std::vector<unsigned char> floodState;  // per tet, scratch: 0 unknown, 1 anchored / outer
     std::vector<int> floodMembers;
-    bool removeIslands() {
+    // fullScan: every kept free tet starts a flood. Otherwise only the kept free neighbours
+    // of tets removed since the last pass do: an island can only be cut off by a removal.
+    bool removeIslands(bool fullScan) {
         const size_t tetCount = mesh.tetCount();
         floodState.assign(tetCount, 0);
         std::vector<int>& members = floodMembers;
         bool changed = false;
-        for (size_t s = 0; s < tetCount; ++s) {
-            if (space.tetModel[s] >= 0 || label[s] < 0 || floodState[s]) continue;
+        auto floodFrom = [&](int s) {
+            if (space.tetModel[s] >= 0 || label[s] < 0 || floodState[s]) return;
             const int g = label[s];
             members.clear();
-            members.push_back(static_cast<int>(s));
+            members.push_back(s);
             floodState[s] = 2;  // in the current flood
             bool anchored = false;
             for (size_t head = 0; head < members.size() && !anchored; ++head) {
@@ -233,6 +235,17 @@ struct Sculptor {
                 for (int t : members) setLabel(t, -1);
                 changed = true;
             }
+        };
+        std::vector<int> removed;
+        removed.swap(removedSinceIslands);
+        if (fullScan) {
+            for (size_t t = 0; t < tetCount; ++t) floodFrom(static_cast<int>(t));
+        } else {
+            for (int r : removed)
+                for (int j = 0; j < 4; ++j) {
+                    const int n = mesh.neighbors[4 * r + j];
+                    if (n >= 0) floodFrom(n);
+                }
         }
         return changed;
     }
@@ -242,7 +255,9 @@ struct Sculptor {
     // A cavity borders its group, so floods start only from free tets next to a solid, and
     // stop as soon as they meet the hull, a second group or space already known to be
     // outside: most of the free space is never walked.
-    bool fillVoids() {
+    // fullScan as for removeIslands; otherwise floods start only at tets changed since the
+    // last pass and their neighbours (a new cavity needs a removal or a fill next to it).
+    bool fillVoids(bool fullScan) {
         const size_t tetCount = mesh.tetCount();
         floodState.assign(tetCount, 0);
         std::vector<int>& members = floodMembers;
@@ -286,13 +301,25 @@ struct Sculptor {
                 for (int t : members) floodState[t] = 1;
             }
         };
-        for (size_t t = 0; t < tetCount; ++t) {
-            if (label[t] < 0) continue;
-            const unsigned faces = candidateFaces(t);
-            for (int j = 0; j < 4; ++j) {
-                if (!(faces & (1u << j))) continue;
-                const int n = mesh.neighbors[4 * t + j];
-                if (n >= 0) floodFrom(n);
+        std::vector<int> changedTets;
+        changedTets.swap(changedSinceVoids);
+        if (fullScan) {
+            for (size_t t = 0; t < tetCount; ++t) {
+                if (label[t] < 0) continue;
+                const unsigned faces = candidateFaces(t);
+                for (int j = 0; j < 4; ++j) {
+                    if (!(faces & (1u << j))) continue;
+                    const int n = mesh.neighbors[4 * t + j];
+                    if (n >= 0) floodFrom(n);
+                }
+            }
+        } else {
+            for (int t : changedTets) {
+                floodFrom(t);
+                for (int j = 0; j < 4; ++j) {
+                    const int n = mesh.neighbors[4 * t + j];
+                    if (n >= 0) floodFrom(n);
+                }
             }
         }
         return changed;
@@ -339,9 +366,12 @@ struct Sculptor {
     // Per tet: 1 once removed, 2 once added by the clean-up. The edge repair never undoes
     // what the clean-up did, so the rounds cannot cycle.
     std::vector<unsigned char> cleanUpHistory;
+    std::vector<int> removedSinceIslands, changedSinceVoids;
     void setLabel(int t, int value) {
         label[t] = value;
         changedTets.push_back(t);
+        changedSinceVoids.push_back(t);
+        if (value < 0) removedSinceIslands.push_back(t);
         if (cleanUpHistory.empty()) cleanUpHistory.assign(mesh.tetCount(), 0);
         cleanUpHistory[t] |= value < 0 ? 1 : 2;
     }
@@ -606,10 +636,10 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
     // edge repair follows its own changes. So another round is needed only when the repair
     // opened something (new islands are possible then).
     for (int round = 0; round < 8; ++round) {
-        sculptor.removeIslands();
+        sculptor.removeIslands(round == 0);
         sculptor.openedByRepair = false;
         sculptor.repairNonManifoldEdges(round == 0);
-        sculptor.fillVoids();
+        sculptor.fillVoids(round == 0);
         if (!sculptor.openedByRepair) break;
     }
 }
@@ -636,9 +666,10 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
     aggregates.resize(groupCount);
-    // Surface faces per group: (tet, face) with the tet in the group's solid and the
-    // neighbour outside it.
-    std::vector<std::vector<std::pair<int, int>>> faces(groupCount);
+    // Surface faces: (tet, face) with the tet in a group's solid and the neighbour outside
+    // it, gathered by group in one array (counting sort, tet order kept within a group).
+    std::vector<std::pair<int, int>> allFaces;
+    std::vector<uint32_t> faceGroup;
     for (size_t t = 0; t < tetCount; ++t) {
         const int g = label[t];
         if (g < 0) continue;
@@ -647,35 +678,47 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         for (int j = 0; j < 4; ++j) {
             if (!(candidates & (1u << j))) continue;
             int n = mesh.neighbors[4 * t + j];
-            if (n < 0 || label[n] != g) faces[g].emplace_back(static_cast<int>(t), j);
+            if (n < 0 || label[n] != g) {
+                allFaces.emplace_back(static_cast<int>(t), j);
+                faceGroup.push_back(static_cast<uint32_t>(g));
+            }
         }
+    }
+    std::vector<size_t> groupStart(groupCount + 1, 0);
+    for (uint32_t g : faceGroup) ++groupStart[g + 1];
+    for (size_t g = 0; g < groupCount; ++g) groupStart[g + 1] += groupStart[g];
+    std::vector<std::pair<int, int>> byGroup(allFaces.size());
+    {
+        std::vector<size_t> at(groupStart.begin(), groupStart.end() - 1);
+        for (size_t f = 0; f < allFaces.size(); ++f) byGroup[at[faceGroup[f]]++] = allFaces[f];
     }
     std::vector<int> faceIndexOf(4 * tetCount, -1);
     std::vector<int> twinEdge;
+    std::vector<uint32_t> outIndex;
+    Corners corners, shells;
     for (size_t g = 0; g < groupCount; ++g) {
-        const auto& list = faces[g];
+        const std::pair<int, int>* list = byGroup.data() + groupStart[g];
+        const size_t listSize = groupStart[g + 1] - groupStart[g];
         Aggregate& agg = aggregates[g];
         agg.positions.clear();
         agg.indices.clear();
         agg.componentCount = 0;
-        if (list.empty()) continue;
-        for (size_t f = 0; f < list.size(); ++f) faceIndexOf[4 * list[f].first + list[f].second] = static_cast<int>(f);
+        if (listSize == 0) continue;
+        for (size_t f = 0; f < listSize; ++f) faceIndexOf[4 * list[f].first + list[f].second] = static_cast<int>(f);
         auto vertexAt = [&](int t, int corner) { return mesh.tets[4 * t + corner]; };
         auto localCorner = [&](int t, int v) {
             for (int k = 0; k < 4; ++k)
                 if (mesh.tets[4 * t + k] == v) return k;
             return -1;
         };
-        Corners corners;
-        corners.parent.resize(3 * list.size());
+        corners.parent.resize(3 * listSize);
         std::iota(corners.parent.begin(), corners.parent.end(), 0u);
-        Corners shells;
-        shells.parent.resize(list.size());
+        shells.parent.resize(listSize);
         std::iota(shells.parent.begin(), shells.parent.end(), 0u);
         // Twin of each face edge, found by one rotation and recorded for both sides (the
         // rotation from the twin back through the same solid run ends at this face).
-        twinEdge.assign(3 * list.size(), -1);
-        for (size_t f = 0; f < list.size(); ++f) {
+        twinEdge.assign(3 * listSize, -1);
+        for (size_t f = 0; f < listSize; ++f) {
             const auto [t0, j0] = list[f];
             for (int e = 0; e < 3; ++e) {
                 if (twinEdge[3 * f + e] >= 0) continue;
@@ -722,10 +765,10 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
             }
         }
         // One output vertex per corner class, numbered by first use.
-        std::vector<uint32_t> outIndex(3 * list.size(), UINT32_MAX);
+        outIndex.assign(3 * listSize, UINT32_MAX);
         uint32_t next = 0;
-        agg.indices.resize(3 * list.size());
-        for (size_t f = 0; f < list.size(); ++f) {
+        agg.indices.resize(3 * listSize);
+        for (size_t f = 0; f < listSize; ++f) {
             const auto [t, j] = list[f];
             for (int e = 0; e < 3; ++e) {
                 uint32_t root = corners.find(static_cast<uint32_t>(3 * f + e));
@@ -738,10 +781,10 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
             }
         }
         int components = 0;
-        for (size_t f = 0; f < list.size(); ++f)
+        for (size_t f = 0; f < listSize; ++f)
             if (shells.find(static_cast<uint32_t>(f)) == f) ++components;
         agg.componentCount = components;
-        for (const auto& [t, j] : list) faceIndexOf[4 * t + j] = -1;
+        for (size_t f = 0; f < listSize; ++f) faceIndexOf[4 * list[f].first + list[f].second] = -1;
     }
 }
 
