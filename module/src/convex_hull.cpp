@@ -45,9 +45,21 @@ bool hullMesh(const std::vector<double>& points, Mesh& mesh) {
 // into polygons and fan each one from its smallest vertex, so the output is canonical.
 void canonicalTriangulation(const std::vector<double>& positions, std::vector<std::array<uint32_t, 3>>& tris) {
     auto point = [&](uint32_t v) { return Point(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]); };
-    std::map<std::pair<uint32_t, uint32_t>, size_t> faceOfEdge;
+    // Directed edge -> face, as a sorted array (hulls are small; this runs once per group).
+    struct EdgeFace {
+        uint32_t u, v;
+        size_t face;
+        bool operator<(const EdgeFace& o) const { return std::tie(u, v) < std::tie(o.u, o.v); }
+    };
+    std::vector<EdgeFace> faceOfEdge;
+    faceOfEdge.reserve(3 * tris.size());
     for (size_t f = 0; f < tris.size(); ++f)
-        for (int k = 0; k < 3; ++k) faceOfEdge[{tris[f][k], tris[f][(k + 1) % 3]}] = f;
+        for (int k = 0; k < 3; ++k) faceOfEdge.push_back({tris[f][k], tris[f][(k + 1) % 3], f});
+    std::sort(faceOfEdge.begin(), faceOfEdge.end());
+    auto faceAcross = [&](uint32_t u, uint32_t v) -> long {
+        auto it = std::lower_bound(faceOfEdge.begin(), faceOfEdge.end(), EdgeFace{u, v, 0});
+        return it != faceOfEdge.end() && it->u == u && it->v == v ? static_cast<long>(it->face) : -1;
+    };
     std::vector<size_t> parent(tris.size());
     for (size_t f = 0; f < tris.size(); ++f) parent[f] = f;
     auto find = [&](size_t x) {
@@ -56,36 +68,45 @@ void canonicalTriangulation(const std::vector<double>& positions, std::vector<st
     };
     for (size_t f = 0; f < tris.size(); ++f)
         for (int k = 0; k < 3; ++k) {
-            auto it = faceOfEdge.find({tris[f][(k + 1) % 3], tris[f][k]});
-            if (it == faceOfEdge.end()) continue;
-            const auto& g = tris[it->second];
+            const long other = faceAcross(tris[f][(k + 1) % 3], tris[f][k]);
+            if (other < 0) continue;
+            const auto& g = tris[static_cast<size_t>(other)];
             uint32_t apex = g[0] + g[1] + g[2] - tris[f][k] - tris[f][(k + 1) % 3];
             if (CGAL::coplanar(point(tris[f][0]), point(tris[f][1]), point(tris[f][2]), point(apex))) {
-                size_t a = find(f), b = find(it->second);
+                size_t a = find(f), b = find(static_cast<size_t>(other));
                 if (a != b) parent[std::max(a, b)] = std::min(a, b);
             }
         }
-    std::map<size_t, std::map<uint32_t, uint32_t>> boundary;  // facet -> next vertex along its boundary
+    // Boundary edges of each merged facet (root, u -> v), sorted by (root, u).
+    std::vector<std::array<uint64_t, 3>> boundary;
     for (size_t f = 0; f < tris.size(); ++f) {
         const size_t root = find(f);
         for (int k = 0; k < 3; ++k) {
             uint32_t u = tris[f][k], v = tris[f][(k + 1) % 3];
-            auto it = faceOfEdge.find({v, u});
-            if (it != faceOfEdge.end() && find(it->second) == root) continue;  // inner edge
-            boundary[root][u] = v;
+            const long other = faceAcross(v, u);
+            if (other >= 0 && find(static_cast<size_t>(other)) == root) continue;  // inner edge
+            boundary.push_back({root, u, v});
         }
     }
+    std::sort(boundary.begin(), boundary.end());
     std::vector<std::array<uint32_t, 3>> out;
-    for (const auto& [root, next] : boundary) {
-        const uint32_t start = next.begin()->first;  // smallest vertex of the polygon
-        std::vector<uint32_t> loop{start};
-        for (uint32_t v = next.at(start); v != start && loop.size() <= next.size(); v = next.at(v)) loop.push_back(v);
+    std::vector<uint32_t> loop;
+    for (size_t i = 0; i < boundary.size();) {
+        size_t j = i;
+        while (j < boundary.size() && boundary[j][0] == boundary[i][0]) ++j;
+        auto next = [&](uint64_t u) -> uint64_t {
+            auto it = std::lower_bound(boundary.begin() + i, boundary.begin() + j, std::array<uint64_t, 3>{boundary[i][0], u, 0});
+            return it != boundary.begin() + j && (*it)[1] == u ? (*it)[2] : u;
+        };
+        const uint64_t start = boundary[i][1];  // smallest vertex of the polygon
+        loop.assign(1, static_cast<uint32_t>(start));
+        for (uint64_t v = next(start); v != start && loop.size() <= j - i; v = next(v)) loop.push_back(static_cast<uint32_t>(v));
         for (size_t k = 1; k + 1 < loop.size(); ++k) out.push_back({loop[0], loop[k], loop[k + 1]});
+        i = j;
     }
     std::sort(out.begin(), out.end());
     tris = std::move(out);
 }
-
 bool convexHull3(const std::vector<double>& points, std::vector<double>& hullPositions,
                  std::vector<uint32_t>& hullTriangles) {
     hullPositions.clear();
@@ -98,9 +119,9 @@ bool convexHull3(const std::vector<double>& points, std::vector<double>& hullPos
     std::sort(verts.begin(), verts.end(), [](const auto& a, const auto& b) {
         return std::make_tuple(a.first.x(), a.first.y(), a.first.z()) < std::make_tuple(b.first.x(), b.first.y(), b.first.z());
     });
-    std::map<Mesh::Vertex_index, uint32_t> remap;
+    std::vector<uint32_t> remap(mesh.number_of_vertices() + mesh.number_of_removed_vertices(), 0);  // by vertex index
     for (size_t i = 0; i < verts.size(); ++i) {
-        remap[verts[i].second] = static_cast<uint32_t>(i);
+        remap[static_cast<size_t>(verts[i].second)] = static_cast<uint32_t>(i);
         hullPositions.push_back(verts[i].first.x());
         hullPositions.push_back(verts[i].first.y());
         hullPositions.push_back(verts[i].first.z());
@@ -110,7 +131,7 @@ bool convexHull3(const std::vector<double>& points, std::vector<double>& hullPos
         std::array<uint32_t, 3> t{};
         int k = 0;
         for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
-            if (k < 3) t[k] = remap[v];
+            if (k < 3) t[k] = remap[static_cast<size_t>(v)];
             ++k;
         }
         if (k != 3) continue;
