@@ -21,18 +21,14 @@ namespace aggrelod::runtime {
 
 Selector::Selector(const RuntimeFile& file) : file_(&file) {
     const uint32_t n = file.nodeCount();
-    bounds_.resize(n);
-    childless_.resize(n);
+    sourceObjects_ = file.allSourceObjects().data;
+    hot_.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
         const NodeRecord& r = file.node(i);
-        bounds_[i] = {{r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2]},
-                      r.sphereRadius, r.geometricError, r.parent};
-        childless_[i] = r.childCount == 0;
+        hot_[i] = {{r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2]}, r.sphereRadius, r.geometricError,
+                   r.parent, r.firstSource, r.childCount == 0 ? r.sourceCount : 0u};
     }
-    refined_.assign(n, 0);
-    decidedStamp_.assign(n, 0);
-    decision_.assign(n, 0);
-    emittedStamp_.assign(n, 0);
+    state_.assign(n, State{0, 0, 0, 0});
     targetStamp_.assign(n, 0);
     target_.assign(n, kNoIndex);
     cut_.resize(n);
@@ -45,7 +41,7 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
 }
 
 void Selector::reset() {
-    std::fill(refined_.begin(), refined_.end(), 0);
+    for (State& st : state_) st.refined = 0;
     nextSize_ = proxyCount_ = originalCount_ = 0;
     for (uint32_t root : file_->roots()) emit(root);
     std::swap(cut_, nextCut_);
@@ -62,7 +58,7 @@ Selector::Frame Selector::makeFrame(const float p[3], float k, float tau, float 
 }
 
 float Selector::screenSpaceErrorOf(uint32_t node, const Camera& camera) const {
-    const Bound& b = bounds_[node];
+    const Hot& b = hot_[node];
     double d2 = 0;
     for (int k = 0; k < 3; ++k) {
         const double d = double(camera.position[k]) - b.center[k];
@@ -74,7 +70,7 @@ float Selector::screenSpaceErrorOf(uint32_t node, const Camera& camera) const {
 
 // sse > tau  <=>  error * k / tau > d  <=>  |p - c| < error * reach + radius (no sqrt, no divide).
 inline bool Selector::exceeds(uint32_t node, float reach) const {
-    const Bound& b = bounds_[node];
+    const Hot& b = hot_[node];
     if (!(b.error > 0.0f)) return false;
     const float dx = frameP_[0] - b.center[0], dy = frameP_[1] - b.center[1], dz = frameP_[2] - b.center[2];
     const float r = b.error * reach + b.radius;
@@ -82,19 +78,21 @@ inline bool Selector::exceeds(uint32_t node, float reach) const {
 }
 
 inline bool Selector::refine(uint32_t node, const Frame& f) {
-    if (decidedStamp_[node] == frame_) return decision_[node] != 0;
+    State& st = state_[node];
+    if (st.decidedStamp == frame_) return st.decision != 0;
     ++stats_.errorTests;
-    const bool yes = !childless_[node] &&
-                     (exceeds(node, f.reachRefine) || (refined_[node] && exceeds(node, f.reachCoarsen)));
-    decidedStamp_[node] = frame_;
-    decision_[node] = yes;
+    const bool yes = hot_[node].leafSources == 0 &&
+                     (exceeds(node, f.reachRefine) || (st.refined && exceeds(node, f.reachCoarsen)));
+    st.decidedStamp = frame_;
+    st.decision = yes;
     return yes;
 }
 
 inline void Selector::emit(uint32_t node) {
     nextCut_[nextSize_++] = node;
-    if (childless_[node]) {
-        for (uint32_t o : file_->sources(node)) originals_[originalCount_++] = o;
+    const Hot& h = hot_[node];
+    if (h.leafSources != 0) {
+        for (uint32_t k = 0; k < h.leafSources; ++k) originals_[originalCount_++] = sourceObjects_[h.firstSource + k];
     } else {
         proxies_[proxyCount_++] = node;
     }
@@ -106,7 +104,7 @@ void Selector::descend(uint32_t start, const Frame& f) {
     while (top > 0) {
         const uint32_t x = stack_[--top];
         if (refine(x, f)) {
-            refined_[x] = 1;
+            state_[x].refined = 1;
             ++stats_.refined;
             const Span<uint32_t> kids = file_->children(x);
             for (size_t i = kids.size; i-- > 0;) stack_[top++] = kids[i];
@@ -118,8 +116,7 @@ void Selector::descend(uint32_t start, const Frame& f) {
 
 void Selector::beginFrame(const Frame& f) {
     if (++frame_ == 0) {  // stamp wrap-around after 2^32 frames
-        std::fill(decidedStamp_.begin(), decidedStamp_.end(), 0);
-        std::fill(emittedStamp_.begin(), emittedStamp_.end(), 0);
+        for (State& st : state_) st.decidedStamp = st.emittedStamp = 0;
         std::fill(targetStamp_.begin(), targetStamp_.end(), 0);
         frame_ = 1;
     }
@@ -137,27 +134,27 @@ void Selector::runIncremental(const Frame& f) {
     beginFrame(f);
     for (uint32_t i = 0; i < cutSize_; ++i) {
         const uint32_t n = cut_[i];
-        const uint32_t parent = bounds_[n].parent;
+        const uint32_t parent = hot_[n].parent;
         if (parent != kNoIndex && !refine(parent, f)) {
             uint32_t top;
             if (targetStamp_[parent] == frame_) {
                 top = target_[parent];  // a sibling already climbed from here
             } else {
                 top = parent;
-                for (uint32_t g = bounds_[top].parent; g != kNoIndex && !refine(g, f); g = bounds_[g].parent) top = g;
+                for (uint32_t g = hot_[top].parent; g != kNoIndex && !refine(g, f); g = hot_[g].parent) top = g;
                 targetStamp_[parent] = frame_;
                 target_[parent] = top;
-                for (uint32_t x = parent;; x = bounds_[x].parent) {
-                    refined_[x] = 0;
+                for (uint32_t x = parent;; x = hot_[x].parent) {
+                    state_[x].refined = 0;
                     if (x == top) break;
                 }
             }
-            if (emittedStamp_[top] != frame_) {
-                emittedStamp_[top] = frame_;
+            if (state_[top].emittedStamp != frame_) {
+                state_[top].emittedStamp = frame_;
                 ++stats_.coarsened;
                 emit(top);
             }
-        } else if (refine(n, f)) {
+        } else if (hot_[n].leafSources == 0 && refine(n, f)) {
             descend(n, f);
         } else {
             emit(n);
@@ -183,9 +180,9 @@ void Selector::runFull(const Frame& f) {
     }
     // Refined flags now describe the new cut: clear the old ancestors, mark the new ones.
     for (uint32_t i = 0; i < cutSize_; ++i)
-        for (uint32_t x = bounds_[cut_[i]].parent; x != kNoIndex && refined_[x]; x = bounds_[x].parent)
-            refined_[x] = 0;
-    for (uint32_t i = 0; i < refinedCount; ++i) refined_[newlyRefined_[i]] = 1;
+        for (uint32_t x = hot_[cut_[i]].parent; x != kNoIndex && state_[x].refined; x = hot_[x].parent)
+            state_[x].refined = 0;
+    for (uint32_t i = 0; i < refinedCount; ++i) state_[newlyRefined_[i]].refined = 1;
     stats_.refined = refinedCount;
     endFrame();
 }

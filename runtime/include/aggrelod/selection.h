@@ -76,11 +76,19 @@ public:
     float screenSpaceErrorOf(uint32_t node, const Camera& camera) const;
 
 private:
-    struct Bound {  // compact copy of what the rule reads, 24 bytes per node
+    struct Hot {  // what the rule and the output read, 32 bytes per node
         float center[3];
         float radius;
         float error;
         uint32_t parent;
+        uint32_t firstSource;
+        uint32_t leafSources;  // sourceCount for a leaf, 0 for an inner node
+    };
+    struct State {  // per-node frame state, 12 bytes
+        uint32_t decidedStamp;  // frame in which refine() was cached
+        uint32_t emittedStamp;  // frame in which the node was emitted by a coarsening
+        uint8_t decision;
+        uint8_t refined;        // refined in the previous (then current) frame
     };
     struct Frame {  // per-call parameters of the rule
         float p[3];
@@ -98,12 +106,9 @@ private:
     static Frame makeFrame(const float p[3], float k, float tau, float coarsenRatio);
 
     const RuntimeFile* file_;
-    std::vector<Bound> bounds_;
-    std::vector<uint8_t> childless_;
-    std::vector<uint8_t> refined_;       // refined in the previous (then current) frame
-    std::vector<uint32_t> decidedStamp_; // frame in which refine() was cached
-    std::vector<uint8_t> decision_;
-    std::vector<uint32_t> emittedStamp_;
+    const uint32_t* sourceObjects_ = nullptr;
+    std::vector<Hot> hot_;
+    std::vector<State> state_;
     std::vector<uint32_t> targetStamp_, target_;  // per-frame memo of coarsening climbs
     float frameP_[3] = {0, 0, 0};
     std::vector<uint32_t> cut_, nextCut_, stack_, newlyRefined_, proxies_, originals_;
