@@ -31,9 +31,9 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
 /// Levels present in the file, increasing (aggregate levels; the originals are kLeafLevel).
 std::vector<uint32_t> levelsOf(const RuntimeFile& file);
 
-/// An Embree scene over a cut. Node meshes are turned into Embree geometries the first time a
-/// cut uses them and kept; changing the cut enables/disables them and rebuilds the BVH.
-/// Queries are const and may run from several threads at once; changing the cut may not.
+/// An Embree scene over a cut: the cut's node meshes merged into one Embree geometry (rebuilt,
+/// with the BVH, when the cut changes). Queries are const and may run from several threads at
+/// once; changing the cut may not.
 class CollisionWorld {
 public:
     /// buildThreads: threads Embree may use to build (0 = all cores).
