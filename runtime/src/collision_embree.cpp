@@ -94,8 +94,7 @@ struct CollisionWorld::Impl {
     }
 
     // One Embree geometry holding every triangle of the cut: Embree rebuilds the scene BVH on
-    // each commit anyway, and one geometry traces 2-3x faster than one per node (measured on
-    // 75,000 boxes).
+    // each commit anyway, so per-node geometries bought nothing but bookkeeping.
     void setCut(std::vector<uint32_t> nodes) {
         if (!scene) return;
         std::sort(nodes.begin(), nodes.end());
