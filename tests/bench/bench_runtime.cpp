@@ -160,7 +160,7 @@ static void benchSelection(uint32_t objects, int frames) {
 #ifdef AGGRELOD_HAVE_COLLISION
 static void benchRaysOn(const RuntimeFile& file, int rayCount);
 static void benchRays(uint32_t objects, int rayCount) {
-    std::printf("\n## Ray throughput (Embree 3, %u objects, %d rays from outside towards the scene)\n", objects,
+    std::printf("\n## Ray throughput (Embree 3, %u objects, %d rays from outside towards the objects)\n", objects,
                 rayCount);
     Loaded h;
     if (!load(aggrelod::testing::makeSyntheticHierarchy(objects, 2, 4), h)) return;
@@ -186,14 +186,22 @@ static void benchRaysOn(const RuntimeFile& file, int rayCount) {
     float radius = 0;  // half the box diagonal: rays start 2 radii from their target
     for (int k = 0; k < 3; ++k) radius += 0.25f * (hi[k] - lo[k]) * (hi[k] - lo[k]);
     radius = std::sqrt(radius);
+    // Each ray aims at a random point of a random original object's box, from a random
+    // direction (mostly from above the horizon), starting 2 scene radii away: most rays hit,
+    // so the figures measure traversal, not the cheap misses.
+    std::vector<uint32_t> targets;
+    for (uint32_t n = 0; n < file.nodeCount(); ++n)
+        if (file.isLeaf(n) && !file.triangles(n).empty()) targets.push_back(n);
+    if (targets.empty()) return;
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0, 1);
     std::vector<float> rays(6 * size_t(rayCount));
     for (int i = 0; i < rayCount; ++i) {
+        const NodeRecord& leaf = file.node(targets[rng() % targets.size()]);
         float target[3], dir[3] = {u(rng) - 0.5f, u(rng) * 0.6f - 0.1f, u(rng) - 0.5f};
         const float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
         for (int k = 0; k < 3; ++k) {
-            target[k] = lo[k] + u(rng) * (hi[k] - lo[k]);
+            target[k] = leaf.boundsMin[k] + u(rng) * (leaf.boundsMax[k] - leaf.boundsMin[k]);
             rays[6 * i + k] = target[k] + dir[k] / len * (2 * radius);
             rays[6 * i + 3 + k] = -dir[k] / len;
         }
@@ -213,19 +221,22 @@ static void benchRaysOn(const RuntimeFile& file, int rayCount) {
         double rate[3] = {0, 0, 0};
         std::atomic<uint64_t> hits{0};
         for (unsigned threads : {1u, 2u}) {
-            hits = 0;
-            const auto t0 = Clock::now();
-            std::vector<std::thread> pool;
-            for (unsigned t = 0; t < threads; ++t)
-                pool.emplace_back([&, t] {
-                    uint64_t local = 0;
-                    CollisionHit hit;
-                    for (int i = int(t); i < rayCount; i += int(threads))
-                        local += world.raycast(&rays[6 * i], &rays[6 * i + 3], 1e30f, hit);
-                    hits += local;
-                });
-            for (auto& th : pool) th.join();
-            rate[threads] = rayCount / seconds(t0, Clock::now()) / 1e6;
+            // Best of 3: the machine is shared, and pre-emption only ever slows a run down.
+            for (int rep = 0; rep < 3; ++rep) {
+                hits = 0;
+                const auto t0 = Clock::now();
+                std::vector<std::thread> pool;
+                for (unsigned t = 0; t < threads; ++t)
+                    pool.emplace_back([&, t] {
+                        uint64_t local = 0;
+                        CollisionHit hit;
+                        for (int i = int(t); i < rayCount; i += int(threads))
+                            local += world.raycast(&rays[6 * i], &rays[6 * i + 3], 1e30f, hit);
+                        hits += local;
+                    });
+                for (auto& th : pool) th.join();
+                rate[threads] = std::max(rate[threads], rayCount / seconds(t0, Clock::now()) / 1e6);
+            }
         }
         if (level == kLeafLevel) originals1 = rate[1];
         char name[16];
@@ -300,7 +311,7 @@ int main(int argc, char** argv) {
                     file.nodeCount(), file.objectCount(), file.byteSize(), double(file.byteSize()) / file.nodeCount(),
                     1e3 * seconds(t0, Clock::now()));
 #ifdef AGGRELOD_HAVE_COLLISION
-        std::printf("\n## Ray throughput (Embree 3, %d rays from outside towards the scene)\n", rays);
+        std::printf("\n## Ray throughput (Embree 3, %d rays from outside towards the objects)\n", rays);
         benchRaysOn(file, rays);
 #endif
         return 0;
