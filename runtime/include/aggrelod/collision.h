@@ -53,6 +53,9 @@ public:
     void useLevel(uint32_t level);
     /// Uses a cut that is finer near `point`: a node is used when its geometric error is at
     /// most maxErrorPerDistance * its distance to `point` (world units / world units).
+    /// The cut itself is incremental (a Selector), but a changed cut rebuilds the merged mesh
+    /// and the BVH (O(triangles of the cut)): call it when the agent has moved appreciably,
+    /// not for every query.
     void useDistanceCut(const float point[3], float maxErrorPerDistance);
     /// Nodes of the current cut, increasing.
     const std::vector<uint32_t>& currentCut() const;
