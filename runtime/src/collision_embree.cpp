@@ -1,0 +1,242 @@
+// Collision queries with Embree 3 (DESIGN section 3): the only file that includes Embree.
+// Pitfalls handled here (NOTES-deps): ray mask 0xFFFFFFFF (a zeroed ray never hits),
+// tnear/tfar/flags/geomID set explicitly, an error callback on the device, vertex buffers
+// allocated by Embree (rtcSetNewGeometryBuffer pads them for its 16-byte SIMD loads),
+// occlusion reported by rtcOccluded1 setting tfar to -inf.
+#include <aggrelod/collision.h>
+#include <aggrelod/selection.h>
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <mutex>
+
+namespace aggrelod::runtime {
+
+void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out) {
+    out.clear();
+    // Leaves are finer than level 0: rank(leaf) = -1, rank(inner) = its level.
+    auto rank = [&](uint32_t node) -> int64_t {
+        return file.isLeaf(node) ? -1 : int64_t(file.node(node).level);
+    };
+    const int64_t wanted = level == kLeafLevel ? -1 : int64_t(level);
+    std::vector<uint32_t> stack(file.roots().begin(), file.roots().end());
+    while (!stack.empty()) {
+        const uint32_t x = stack.back();
+        stack.pop_back();
+        if (rank(x) <= wanted || file.isLeaf(x)) {
+            out.push_back(x);
+        } else {
+            for (uint32_t c : file.children(x)) stack.push_back(c);
+        }
+    }
+    std::sort(out.begin(), out.end());
+}
+
+std::vector<uint32_t> levelsOf(const RuntimeFile& file) {
+    std::vector<uint32_t> levels;
+    for (uint32_t i = 0; i < file.nodeCount(); ++i)
+        if (!file.isLeaf(i)) levels.push_back(file.node(i).level);
+    std::sort(levels.begin(), levels.end());
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    return levels;
+}
+
+struct CollisionWorld::Impl {
+    const RuntimeFile& file;
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    RTCGeometry geometry = nullptr;       // all triangles of the cut, merged
+    std::vector<uint32_t> cut;            // nodes, increasing
+    // A hit is mapped back with two lookups (each likely a cache miss on big scenes):
+    struct TriangleRef {
+        uint32_t slot;   // position of the node in `cut`
+        uint32_t local;  // triangle within the node's mesh
+    };
+    struct SlotInfo {
+        const uint32_t* objects;
+        uint32_t objectCount;
+        uint32_t node;
+    };
+    std::vector<TriangleRef> triangleRefs;  // per merged triangle
+    std::vector<SlotInfo> slots;            // per cut node
+    std::unique_ptr<Selector> distanceSelector;
+    mutable std::mutex errorMutex;
+    std::string lastError;
+    bool failed = false;
+    bool committed = false;  // queries before the first cut find nothing
+
+    static void onError(void* user, RTCError code, const char* text) {
+        auto* self = static_cast<Impl*>(user);
+        std::lock_guard<std::mutex> lock(self->errorMutex);
+        self->lastError = "Embree error " + std::to_string(int(code)) + ": " + (text ? text : "");
+        self->failed = true;
+    }
+
+    Impl(const RuntimeFile& f, unsigned threads) : file(f) {
+        const std::string config = threads ? "threads=" + std::to_string(threads) : std::string();
+        device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+        if (!device) {
+            failed = true;
+            lastError = "Embree device creation failed (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")";
+            return;
+        }
+        rtcSetDeviceErrorFunction(device, &Impl::onError, this);
+        scene = rtcNewScene(device);
+    }
+    ~Impl() {
+        if (geometry) rtcReleaseGeometry(geometry);
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+
+    // One Embree geometry holding every triangle of the cut: Embree rebuilds the scene BVH on
+    // each commit anyway, so per-node geometries bought nothing but bookkeeping.
+    void setCut(std::vector<uint32_t> nodes) {
+        if (!scene) return;
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        while (!nodes.empty() && nodes.back() >= file.nodeCount()) nodes.pop_back();
+        if (geometry) {
+            rtcDetachGeometry(scene, 0);
+            rtcReleaseGeometry(geometry);
+            geometry = nullptr;
+        }
+        cut = std::move(nodes);
+        triangleRefs.clear();
+        slots.clear();
+        size_t vertexTotal = 0;
+        for (uint32_t slot = 0; slot < cut.size(); ++slot) {
+            const uint32_t n = cut[slot];
+            const Span<uint32_t> objects = file.sources(n);
+            slots.push_back({objects.data, uint32_t(objects.size), n});
+            vertexTotal += file.vertices(n).size / 3;
+            const uint32_t triangles = uint32_t(file.triangles(n).size / 3);
+            for (uint32_t t = 0; t < triangles; ++t) triangleRefs.push_back({slot, t});
+        }
+        const size_t triangleTotal = triangleRefs.size();
+        if (triangleTotal > 0) {
+            geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            auto* vb = geometry ? static_cast<float*>(rtcSetNewGeometryBuffer(
+                                      geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertexTotal))
+                                : nullptr;
+            auto* ib = geometry ? static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+                                      geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangleTotal))
+                                : nullptr;
+            if (!vb || !ib) {
+                if (geometry) rtcReleaseGeometry(geometry);
+                geometry = nullptr;
+            } else {
+                size_t v = 0, t = 0;
+                for (uint32_t n : cut) {
+                    const Span<float> verts = file.vertices(n);
+                    const Span<uint32_t> tris = file.triangles(n);
+                    std::memcpy(vb + 3 * v, verts.data, verts.size * sizeof(float));
+                    for (size_t k = 0; k < tris.size; ++k) ib[t + k] = tris[k] + uint32_t(v);
+                    v += verts.size / 3;
+                    t += tris.size;
+                }
+                rtcCommitGeometry(geometry);
+                rtcAttachGeometryByID(scene, geometry, 0);
+            }
+        }
+        rtcCommitScene(scene);
+        committed = true;
+    }
+
+    bool intersect(const float o[3], const float d[3], float maxDistance, CollisionHit& hit) const {
+        if (!scene || failed || !committed) return false;
+        const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(len > 0) || !(maxDistance >= 0)) return false;
+        RTCRayHit rh;
+        rh.ray.org_x = o[0]; rh.ray.org_y = o[1]; rh.ray.org_z = o[2];
+        rh.ray.dir_x = d[0] / len; rh.ray.dir_y = d[1] / len; rh.ray.dir_z = d[2] / len;
+        rh.ray.tnear = 0.0f;
+        rh.ray.tfar = maxDistance;
+        rh.ray.time = 0.0f;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.ray.id = 0;
+        rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        rtcIntersect1(scene, &context, &rh);
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+        const TriangleRef ref = triangleRefs[rh.hit.primID];
+        const SlotInfo& info = slots[ref.slot];
+        hit.distance = rh.ray.tfar;
+        hit.node = info.node;
+        hit.triangle = ref.local;
+        hit.objects = {info.objects, info.objectCount};
+        // Embree's unnormalised geometric normal points to the side from which the triangle's
+        // vertices run counter-clockwise (checked by RuntimeCollision.*): outward for our meshes.
+        const float n[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+        const float nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; ++k) hit.normal[k] = nl > 0 ? n[k] / nl : 0.0f;
+        return true;
+    }
+
+    bool occluded(const float o[3], const float d[3], float maxDistance) const {
+        if (!scene || failed || !committed) return false;
+        const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(len > 0) || !(maxDistance >= 0)) return false;
+        RTCRay ray;
+        ray.org_x = o[0]; ray.org_y = o[1]; ray.org_z = o[2];
+        ray.dir_x = d[0] / len; ray.dir_y = d[1] / len; ray.dir_z = d[2] / len;
+        ray.tnear = 0.0f;
+        ray.tfar = maxDistance;
+        ray.time = 0.0f;
+        ray.mask = 0xFFFFFFFFu;
+        ray.id = 0;
+        ray.flags = 0;
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        rtcOccluded1(scene, &context, &ray);
+        return ray.tfar == -std::numeric_limits<float>::infinity();
+    }
+};
+
+CollisionWorld::CollisionWorld(const RuntimeFile& file, unsigned buildThreads)
+    : impl_(std::make_unique<Impl>(file, buildThreads)) {}
+CollisionWorld::~CollisionWorld() = default;
+
+bool CollisionWorld::ok() const { return !impl_->failed; }
+std::string CollisionWorld::error() const {
+    std::lock_guard<std::mutex> lock(impl_->errorMutex);
+    return impl_->lastError;
+}
+
+void CollisionWorld::useCut(const uint32_t* nodes, size_t count) {
+    impl_->setCut(std::vector<uint32_t>(nodes, nodes + count));
+}
+void CollisionWorld::useLevel(uint32_t level) {
+    std::vector<uint32_t> nodes;
+    cutAtLevel(impl_->file, level, nodes);
+    impl_->setCut(std::move(nodes));
+}
+void CollisionWorld::useDistanceCut(const float point[3], float maxErrorPerDistance) {
+    if (!impl_->distanceSelector) impl_->distanceSelector = std::make_unique<Selector>(impl_->file);
+    impl_->distanceSelector->selectByDistance(point, maxErrorPerDistance);
+    const Span<uint32_t> cut = impl_->distanceSelector->cut();
+    impl_->setCut(std::vector<uint32_t>(cut.begin(), cut.end()));
+}
+const std::vector<uint32_t>& CollisionWorld::currentCut() const { return impl_->cut; }
+
+bool CollisionWorld::raycast(const float origin[3], const float direction[3], float maxDistance,
+                             CollisionHit& hit) const {
+    return impl_->intersect(origin, direction, maxDistance, hit);
+}
+bool CollisionWorld::segment(const float a[3], const float b[3], CollisionHit& hit) const {
+    const float d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    return impl_->intersect(a, d, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), hit);
+}
+bool CollisionWorld::occluded(const float origin[3], const float direction[3], float maxDistance) const {
+    return impl_->occluded(origin, direction, maxDistance);
+}
+
+}  // namespace aggrelod::runtime
