@@ -133,7 +133,9 @@ TEST(TwoCubes, JoinAboveGapIntoOneClosedSolid) {
         }
         // At delta = 2 every gap edge (at most sqrt(1 + 1 + 0.25) = 1.5) is under F for the
         // constant function: the whole gap is filled, volume = cubes + gap = 2 + 0.5.
-        if (fn == AggregateFunctionKind::Constant) EXPECT_NEAR(h.levels[1].aggregates[0].measures.volume, 2.5, 1e-12);
+        if (fn == AggregateFunctionKind::Constant) {
+            EXPECT_NEAR(h.levels[1].aggregates[0].measures.volume, 2.5, 1e-12);
+        }
     }
 }
 
