@@ -1143,7 +1143,11 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 }
 
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                    const std::string& path, std::string& error) {
+                    const std::string& path, std::string& error, const HierarchyNodes* nodes) {
+    if (nodes && (nodes->nodeOfAggregate.size() != hierarchy.levels.size() || nodes->objectCount != objects.size())) {
+        error = path + ": the hierarchy nodes do not belong to this hierarchy";
+        return false;
+    }
     try {
         GlbBuilder glb;
         tinygltf::Model& model = glb.model();
@@ -1200,6 +1204,29 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 extras["components"] = tinygltf::Value(agg.componentCount);
                 extras["volume"] = tinygltf::Value(agg.measures.volume);
                 extras["volume_original"] = tinygltf::Value(agg.volumeOriginal);
+                if (nodes) {
+                    if (g >= nodes->nodeOfAggregate[k].size()) {
+                        error = path + ": " + name + " has no hierarchy node";
+                        return false;
+                    }
+                    const uint32_t nodeIndex = nodes->nodeOfAggregate[k][g];
+                    const HierarchyNode& hn = nodes->nodes[nodeIndex];
+                    tinygltf::Value::Array children;
+                    for (uint32_t c : hn.children) children.push_back(intValue(c));
+                    extras["node"] = intValue(nodeIndex);
+                    extras["parent"] = hn.parent == kNoNode ? tinygltf::Value(-1) : intValue(hn.parent);
+                    extras["children"] = tinygltf::Value(std::move(children));
+                    extras["first_level"] = tinygltf::Value(hn.firstLevel);
+                    extras["last_level"] = tinygltf::Value(hn.lastLevel);
+                    extras["geometric_error"] = tinygltf::Value(hn.geometricError);
+                    tinygltf::Value::Object proxyError;
+                    proxyError["proxy_to_originals"] = tinygltf::Value(hn.error.proxyToOriginals);
+                    proxyError["originals_to_proxy"] = tinygltf::Value(hn.error.originalsToProxy);
+                    proxyError["sample_spacing"] = tinygltf::Value(hn.error.sampleSpacing);
+                    proxyError["bound"] = tinygltf::Value(hn.error.bound());
+                    extras["proxy_error"] = tinygltf::Value(std::move(proxyError));
+                    extras["proxy_triangles"] = intValue(hn.indices.size() / 3);
+                }
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
             }

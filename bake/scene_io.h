@@ -3,6 +3,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/hierarchy_nodes.h>
 
 #include <string>
 #include <vector>
@@ -35,9 +36,15 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
                      std::string& error);
 
 /// Writes OUTDIR/levels.glb: one node per aggregate per level, grouped under one parent
-/// node per level; extras {level, delta, sources: [input object names]}.
+/// node per level; extras {level, delta, sources: [input object names]}. With `nodes`
+/// (the hierarchy nodes of the same bake), each aggregate's extras also carry its node of
+/// the runtime hierarchy: node, parent, children (node indices; index < object count = that
+/// original object), first_level, last_level, geometric_error (stored, monotone),
+/// proxy_error {proxy_to_originals, originals_to_proxy, sample_spacing, bound},
+/// proxy_triangles. World units throughout.
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                    const std::string& path, std::string& error);
+                    const std::string& path, std::string& error,
+                    const HierarchyNodes* nodes = nullptr);
 
 /// Writes the stats JSON (see README "Stats file"). Timings are written last, in their
 /// own object, so determinism checks can drop them.

@@ -210,6 +210,8 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         for (uint32_t o : n.sources) originals.push_back(&objects[o]);
         double spacing = settings.sampleSpacingFraction * n.delta;
         n.error = measureProxyError(n.positions, n.indices, originals, spacing, settings.maxSamplesPerDirection);
+    }, [&](size_t done) {
+        if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
     });
 
     // Errors and bounds, children first (children have smaller indices than their parent).

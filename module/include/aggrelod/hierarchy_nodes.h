@@ -32,6 +32,7 @@ struct ProxySettings {
     /// ... widened so that one direction of one proxy takes at most about this many samples.
     size_t maxSamplesPerDirection = 20000;
     int threadCount = 0;  ///< 0 = hardware concurrency; results identical for every count
+    ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
 };
 
 /// One-sided sampled distances between a proxy and the original objects it stands for.
