@@ -51,7 +51,17 @@ struct BuildParams {
 /// Serialises params into a `.aglod` blob (little-endian, 16-byte aligned sections,
 /// offsets not pointers). Returns false and fills error when params are inconsistent
 /// (a range outside its array, a child whose parent differs, ...). Deterministic:
-/// the same params give byte-identical bytes.
+/// the same params give byte-identical bytes. Implemented in runtime/src/runtime_writer.cpp;
+/// the result is checked by the reader's validator (RuntimeFile::openMemory), which requires:
+/// - every range inside its array, every triangle index < the node's vertexCount,
+///   indexCount a multiple of 3, positions.size() a multiple of 3, finite floats,
+///   geometricError/sphereRadius/delta >= 0, boundsMin <= boundsMax;
+/// - parent/children consistent (each non-root listed exactly once, by its parent), no cycle,
+///   at least one node;
+/// - each leaf (childCount 0) stands for >= 1 object, every object in exactly one leaf, an
+///   inner node lists exactly the objects of its leaves (any order, no duplicates);
+/// - child error <= parent error (exact), child sphere and box inside the parent's (slack
+///   1e-5 relative to the parent's coordinates).
 bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error);
 
 }  // namespace aggrelod::runtime

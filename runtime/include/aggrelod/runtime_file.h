@@ -1,0 +1,127 @@
+// aggrelod runtime: the `.aglod` runtime file, read in place (DESIGN section 4).
+// A RuntimeFile views a memory-mapped file or a caller buffer; it never copies the arrays.
+// Every count, stride, index range and the tree shape are validated once at open; a bad
+// file is refused with a FileStatus and a message, never a crash. Standard library only.
+#pragma once
+
+#include <aggrelod/runtime_build.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace aggrelod::runtime {
+
+/// Format version written by writeRuntimeFile. A reader accepts only its own major version.
+constexpr uint16_t kFormatMajor = 1;
+constexpr uint16_t kFormatMinor = 0;
+
+/// Why a file was refused (FileStatus::Ok when it was accepted).
+enum class FileStatus : uint32_t {
+    Ok = 0,
+    IoError,           ///< cannot open / map the file
+    WrongMagic,        ///< not an .aglod file
+    WrongVersion,      ///< major version differs from kFormatMajor
+    Truncated,         ///< fewer bytes than the header says (or than a header)
+    ChecksumMismatch,  ///< content changed after writing
+    BadSection,        ///< section table inconsistent (missing, overlapping, misaligned, bad stride)
+    IndexOutOfRange,   ///< a range or index points outside its array
+    BadTree,           ///< parents/children inconsistent, cycle, coverage, error or bounds not monotone
+    BadValue,          ///< NaN / infinite / negative where not allowed
+    Misaligned,        ///< caller buffer not 16-byte aligned
+    UnsupportedHost,   ///< big-endian host (the format is little-endian, read in place)
+};
+
+/// Short English name of a status, e.g. "checksum mismatch".
+const char* toString(FileStatus status);
+
+/// One node as stored in the file (88 bytes, little-endian, same fields as BuildNode).
+struct NodeRecord {
+    uint32_t parent;
+    uint32_t firstChild, childCount;    ///< range in children()
+    uint32_t firstSource, sourceCount;  ///< range in sourceObjects()
+    uint32_t firstVertex, vertexCount;  ///< range in positions(), counted in vertices
+    uint32_t firstIndex, indexCount;    ///< range in indices(); relative to firstVertex
+    uint32_t level;                     ///< kLeafLevel for originals
+    float delta;                        ///< world units
+    float geometricError;               ///< world units, >= every child's
+    float boundsMin[3], boundsMax[3];   ///< world units, contains the children's
+    float sphereCenter[3];
+    float sphereRadius;
+};
+static_assert(sizeof(NodeRecord) == 88, "NodeRecord is the on-disk layout");
+
+/// A read-only array view (pointer + count) into the file.
+template <class T>
+struct Span {
+    const T* data = nullptr;
+    size_t size = 0;
+    const T* begin() const { return data; }
+    const T* end() const { return data + size; }
+    const T& operator[](size_t i) const { return data[i]; }
+    bool empty() const { return size == 0; }
+};
+
+class MappedFile;  // POSIX mmap, runtime/src/mapped_file.cpp
+
+/// A validated `.aglod` file. Move-only; owns its mapping when opened from a path.
+class RuntimeFile {
+public:
+    RuntimeFile();
+    ~RuntimeFile();
+    RuntimeFile(RuntimeFile&&) noexcept;
+    RuntimeFile& operator=(RuntimeFile&&) noexcept;
+    RuntimeFile(const RuntimeFile&) = delete;
+    RuntimeFile& operator=(const RuntimeFile&) = delete;
+
+    /// Maps `path` read-only and validates it. On failure `out` is left empty and
+    /// `message` says what is wrong (e.g. "node 12: child 40 has parent 3").
+    static FileStatus openFile(const std::string& path, RuntimeFile& out, std::string& message);
+
+    /// Validates `size` bytes at `data` (16-byte aligned) and views them in place: the
+    /// caller keeps the buffer alive and unchanged while `out` is used.
+    static FileStatus openMemory(const void* data, size_t size, RuntimeFile& out,
+                                 std::string& message);
+
+    bool isOpen() const { return base_ != nullptr; }
+    uint16_t versionMajor() const { return versionMajor_; }
+    uint16_t versionMinor() const { return versionMinor_; }
+    uint64_t settingsHash() const { return settingsHash_; }
+    std::string_view toolVersion() const { return toolVersion_; }
+    size_t byteSize() const { return byteSize_; }
+
+    uint32_t nodeCount() const { return static_cast<uint32_t>(nodes_.size); }
+    uint32_t objectCount() const { return static_cast<uint32_t>(nameRanges_.size / 2); }
+    const NodeRecord& node(uint32_t i) const { return nodes_.data[i]; }
+    Span<NodeRecord> nodes() const { return nodes_; }
+    /// Nodes without parent, increasing.
+    Span<uint32_t> roots() const { return roots_; }
+    /// Children / original objects / vertices (xyz floats) / triangle indices of a node.
+    Span<uint32_t> children(uint32_t node) const;
+    Span<uint32_t> sources(uint32_t node) const;
+    Span<float> vertices(uint32_t node) const;  ///< 3 floats per vertex, world units
+    Span<uint32_t> triangles(uint32_t node) const;  ///< 3 per triangle, relative to node's vertices
+    bool isLeaf(uint32_t node) const { return nodes_.data[node].childCount == 0; }
+    /// Name of original object `object` (< objectCount()), UTF-8.
+    std::string_view objectName(uint32_t object) const;
+    /// Largest number of nodes on a root-to-leaf path.
+    uint32_t depth() const { return depth_; }
+
+private:
+    friend struct FileValidator;
+    const uint8_t* base_ = nullptr;
+    size_t byteSize_ = 0;
+    std::unique_ptr<MappedFile> mapping_;
+    uint16_t versionMajor_ = 0, versionMinor_ = 0;
+    uint64_t settingsHash_ = 0;
+    std::string toolVersion_;
+    uint32_t depth_ = 0;
+    Span<NodeRecord> nodes_;
+    Span<uint32_t> roots_, childIndices_, sourceObjects_, indices_, nameRanges_;
+    Span<float> positions_;
+    Span<char> nameBlob_;
+};
+
+}  // namespace aggrelod::runtime

@@ -1,0 +1,241 @@
+// The `.aglod` runtime file (DESIGN section 4): round trip of the writer and the in-place
+// reader, refusal of inconsistent hierarchies by the writer, and refusal of corrupt bytes by
+// the reader (every single-byte change of the header and section table, truncations, forged
+// tables with a recomputed checksum). Built and run under AddressSanitizer
+// (aggrelod_runtime_asan_tests), so an out-of-bounds read during validation fails the suite.
+#include <aggrelod/runtime_build.h>
+#include <aggrelod/runtime_file.h>
+
+#include "../../runtime/src/aglod_layout.h"
+#include "synthetic_hierarchy.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <set>
+
+using namespace aggrelod::runtime;
+using aggrelod::testing::makeSyntheticHierarchy;
+
+namespace {
+
+std::vector<uint8_t> writeOrDie(const BuildParams& p) {
+    std::vector<uint8_t> bytes;
+    std::string error;
+    EXPECT_TRUE(writeRuntimeFile(p, bytes, error)) << error;
+    return bytes;
+}
+
+// A heap copy of exactly `size` bytes, so that ASan flags any read past the end.
+struct ExactBuffer {
+    std::unique_ptr<uint8_t[]> data;
+    size_t size;
+    ExactBuffer(const uint8_t* src, size_t n) : data(new uint8_t[n ? n : 1]), size(n) {
+        if (n) std::memcpy(data.get(), src, n);
+    }
+};
+
+FileStatus openCopy(const std::vector<uint8_t>& bytes, size_t size, std::string& message) {
+    ExactBuffer copy(bytes.data(), size);
+    RuntimeFile file;
+    return RuntimeFile::openMemory(copy.data.get(), copy.size, file, message);
+}
+
+void resign(std::vector<uint8_t>& bytes) {
+    using namespace aggrelod::runtime::layout;
+    const uint64_t sum = fileChecksum(bytes.data(), bytes.size(), kChecksumOffset);
+    std::memcpy(bytes.data() + kChecksumOffset, &sum, 8);
+}
+
+}  // namespace
+
+TEST(RuntimeFormat, RoundTripKeepsEveryField) {
+    const BuildParams p = makeSyntheticHierarchy(300, 7, 3, 2);
+    const std::vector<uint8_t> bytes = writeOrDie(p);
+    ASSERT_EQ(bytes.size() % 32, 0u);
+    RuntimeFile file;
+    std::string message;
+    ASSERT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), file, message), FileStatus::Ok) << message;
+    EXPECT_EQ(file.versionMajor(), kFormatMajor);
+    EXPECT_EQ(file.settingsHash(), p.settingsHash);
+    EXPECT_EQ(file.toolVersion(), p.toolVersion);
+    ASSERT_EQ(file.nodeCount(), p.nodes.size());
+    ASSERT_EQ(file.objectCount(), p.objectNames.size());
+    std::vector<uint32_t> roots;
+    for (uint32_t i = 0; i < p.nodes.size(); ++i) {
+        const BuildNode& b = p.nodes[i];
+        const NodeRecord& r = file.node(i);
+        EXPECT_EQ(r.parent, b.parent);
+        EXPECT_EQ(r.level, b.level);
+        EXPECT_EQ(r.geometricError, b.geometricError);
+        EXPECT_EQ(r.delta, b.delta);
+        EXPECT_EQ(r.sphereRadius, b.sphereRadius);
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(r.boundsMin[k], b.boundsMin[k]);
+            EXPECT_EQ(r.boundsMax[k], b.boundsMax[k]);
+            EXPECT_EQ(r.sphereCenter[k], b.sphereCenter[k]);
+        }
+        ASSERT_EQ(file.children(i).size, b.childCount);
+        for (uint32_t c = 0; c < b.childCount; ++c) EXPECT_EQ(file.children(i)[c], p.childIndices[b.firstChild + c]);
+        ASSERT_EQ(file.sources(i).size, b.sourceCount);
+        for (uint32_t s = 0; s < b.sourceCount; ++s) EXPECT_EQ(file.sources(i)[s], p.sourceObjects[b.firstSource + s]);
+        ASSERT_EQ(file.vertices(i).size, 3u * b.vertexCount);
+        for (uint32_t v = 0; v < 3 * b.vertexCount; ++v) EXPECT_EQ(file.vertices(i)[v], p.positions[3 * b.firstVertex + v]);
+        ASSERT_EQ(file.triangles(i).size, b.indexCount);
+        for (uint32_t t = 0; t < b.indexCount; ++t) EXPECT_EQ(file.triangles(i)[t], p.indices[b.firstIndex + t]);
+        if (b.parent == kNoIndex) roots.push_back(i);
+    }
+    ASSERT_EQ(file.roots().size, roots.size());
+    for (size_t i = 0; i < roots.size(); ++i) EXPECT_EQ(file.roots()[i], roots[i]);
+    for (uint32_t o = 0; o < file.objectCount(); ++o) EXPECT_EQ(file.objectName(o), p.objectNames[o]);
+    EXPECT_GE(file.depth(), 5u);  // 150 objects per root, branching 3
+}
+
+TEST(RuntimeFormat, WriterIsDeterministicAndFileOpensFromDisk) {
+    const BuildParams p = makeSyntheticHierarchy(200, 3);
+    const std::vector<uint8_t> a = writeOrDie(p), b = writeOrDie(p);
+    EXPECT_EQ(a, b);
+    const std::string path = std::string(AGGRELOD_TEST_TMP) + "/roundtrip.aglod";
+    {
+        std::ofstream out(path, std::ios::binary);
+        out.write(reinterpret_cast<const char*>(a.data()), static_cast<std::streamsize>(a.size()));
+    }
+    RuntimeFile file;
+    std::string message;
+    ASSERT_EQ(RuntimeFile::openFile(path, file, message), FileStatus::Ok) << message;
+    EXPECT_EQ(file.nodeCount(), p.nodes.size());
+    EXPECT_EQ(file.byteSize(), a.size());
+    RuntimeFile moved = std::move(file);  // the mapping moves with the file
+    EXPECT_EQ(moved.objectName(5), "box5");
+    EXPECT_EQ(RuntimeFile::openFile(path + ".missing", file, message), FileStatus::IoError);
+    EXPECT_NE(message.find("roundtrip.aglod.missing"), std::string::npos) << message;
+    { std::ofstream empty(path + ".empty"); }
+    EXPECT_EQ(RuntimeFile::openFile(path + ".empty", file, message), FileStatus::Truncated);
+    std::remove(path.c_str());
+    std::remove((path + ".empty").c_str());
+}
+
+TEST(RuntimeFormat, SectionsAreAlignedAndLittleEndianHeader) {
+    const std::vector<uint8_t> bytes = writeOrDie(makeSyntheticHierarchy(50, 1));
+    EXPECT_EQ(std::memcmp(bytes.data(), "AGGRELOD", 8), 0);
+    uint64_t total = 0;
+    std::memcpy(&total, bytes.data() + 16, 8);
+    EXPECT_EQ(total, bytes.size());
+    for (uint32_t s = 0; s < aggrelod::runtime::layout::kSectionCount; ++s) {
+        uint64_t offset = 0;
+        std::memcpy(&offset, bytes.data() + 64 + 32 * s + 8, 8);
+        EXPECT_EQ(offset % 16, 0u) << "section " << s + 1;
+    }
+}
+
+TEST(RuntimeFormat, WriterRefusesInconsistentHierarchies) {
+    const BuildParams good = makeSyntheticHierarchy(40, 2);
+    struct Case {
+        const char* what;
+        void (*breakIt)(BuildParams&);
+        const char* expected;
+    };
+    const Case cases[] = {
+        {"child with another parent", [](BuildParams& p) { p.nodes[p.childIndices[0]].parent = p.childIndices[1]; }, "bad tree"},
+        {"source out of range", [](BuildParams& p) { p.sourceObjects[0] = 9999; }, "index out of range"},
+        {"error not monotone", [](BuildParams& p) { p.nodes[0].geometricError = 1e6f; }, "bad tree"},
+        {"child outside parent", [](BuildParams& p) { p.nodes[0].boundsMax[0] += 1e4f; p.nodes[0].sphereCenter[0] += 1e4f; }, "bad tree"},
+        {"triangle index too big", [](BuildParams& p) { p.indices[0] = 100; }, "index out of range"},
+        {"NaN radius", [](BuildParams& p) { p.nodes[1].sphereRadius = std::nanf(""); }, "bad value"},
+        {"object in no leaf", [](BuildParams& p) { p.objectNames.push_back("orphan"); }, "bad tree"},
+        {"cycle", [](BuildParams& p) {
+             // Make the root a child of its first child: no parentless node is left.
+             const uint32_t root = static_cast<uint32_t>(p.nodes.size() - 1);
+             p.nodes[root].parent = p.childIndices[p.nodes[root].firstChild];
+         }, "bad tree"},
+        {"child range past the array", [](BuildParams& p) { p.nodes.back().firstChild = 1u << 30; }, "index out of range"},
+    };
+    for (const Case& c : cases) {
+        BuildParams p = good;
+        c.breakIt(p);
+        std::vector<uint8_t> bytes;
+        std::string error;
+        EXPECT_FALSE(writeRuntimeFile(p, bytes, error)) << c.what;
+        EXPECT_NE(error.find(c.expected), std::string::npos) << c.what << ": " << error;
+        EXPECT_TRUE(bytes.empty()) << c.what;
+    }
+}
+
+TEST(RuntimeFormat, EverySingleByteChangeOfHeaderAndTableIsRefused) {
+    const std::vector<uint8_t> good = writeOrDie(makeSyntheticHierarchy(60, 4));
+    const size_t tableEnd = 64 + 32 * aggrelod::runtime::layout::kSectionCount;
+    std::set<FileStatus> seen;
+    for (size_t at = 0; at < tableEnd; ++at) {
+        for (int delta : {1, 0x80, 0xFF}) {
+            std::vector<uint8_t> bad = good;
+            bad[at] = static_cast<uint8_t>(bad[at] + delta);
+            std::string message;
+            const FileStatus status = openCopy(bad, bad.size(), message);
+            ASSERT_NE(status, FileStatus::Ok) << "byte " << at << " +" << delta;
+            EXPECT_FALSE(message.empty());
+            seen.insert(status);
+        }
+    }
+    EXPECT_TRUE(seen.count(FileStatus::WrongMagic));
+    EXPECT_TRUE(seen.count(FileStatus::WrongVersion));
+    EXPECT_TRUE(seen.count(FileStatus::Truncated));
+    EXPECT_TRUE(seen.count(FileStatus::ChecksumMismatch));
+}
+
+TEST(RuntimeFormat, TruncationAtHundredOffsetsIsRefused) {
+    const std::vector<uint8_t> good = writeOrDie(makeSyntheticHierarchy(120, 5));
+    for (int i = 0; i < 100; ++i) {
+        const size_t size = good.size() * static_cast<size_t>(i) / 100;  // 0 .. 99 % of the file
+        std::string message;
+        const FileStatus status = openCopy(good, size, message);
+        EXPECT_EQ(status, FileStatus::Truncated) << size << " bytes: " << message;
+    }
+    std::string message;
+    EXPECT_EQ(openCopy(good, good.size() - 1, message), FileStatus::Truncated);
+}
+
+TEST(RuntimeFormat, ForgedContentWithValidChecksumIsRefused) {
+    // An attacker (or a writer bug) can recompute the checksum: the structural checks must
+    // still hold. Single-byte changes of the table with a valid checksum, then of the nodes.
+    const std::vector<uint8_t> good = writeOrDie(makeSyntheticHierarchy(60, 6));
+    const size_t tableEnd = 64 + 32 * aggrelod::runtime::layout::kSectionCount;
+    int refused = 0, accepted = 0;
+    for (size_t at = 12; at < tableEnd; ++at) {
+        if (at >= 24 && at < 64) continue;  // checksum, settings hash, tool version: free fields
+        std::vector<uint8_t> bad = good;
+        bad[at] ^= 0x40;
+        resign(bad);
+        std::string message;
+        const FileStatus status = openCopy(bad, bad.size(), message);
+        status == FileStatus::Ok ? ++accepted : ++refused;
+    }
+    EXPECT_EQ(accepted, 0);
+    uint64_t nodesOffset = 0;
+    std::memcpy(&nodesOffset, good.data() + 64 + 8, 8);
+    // Parent, child range, source range, vertex range and index range of every node.
+    for (uint32_t node = 0; node < 60; ++node) {
+        for (size_t field = 0; field < 9; ++field) {
+            std::vector<uint8_t> bad = good;
+            bad[nodesOffset + 88 * node + 4 * field + 3] ^= 0x10;  // +2^28 on a u32 field
+            resign(bad);
+            std::string message;
+            const FileStatus status = openCopy(bad, bad.size(), message);
+            EXPECT_TRUE(status == FileStatus::IndexOutOfRange || status == FileStatus::BadTree ||
+                        status == FileStatus::BadValue)
+                << "node " << node << " field " << field << ": " << toString(status) << " " << message;
+        }
+    }
+}
+
+TEST(RuntimeFormat, MisalignedBufferIsRefused) {
+    const std::vector<uint8_t> good = writeOrDie(makeSyntheticHierarchy(20, 8));
+    std::vector<uint8_t> shifted(good.size() + 16);
+    std::memcpy(shifted.data() + 4, good.data(), good.size());
+    RuntimeFile file;
+    std::string message;
+    EXPECT_EQ(RuntimeFile::openMemory(shifted.data() + 4, good.size(), file, message), FileStatus::Misaligned);
+    EXPECT_FALSE(file.isOpen());
+}
