@@ -9,6 +9,7 @@
 #include <aggrelod/hierarchy_nodes.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -74,8 +75,24 @@ void computeBounds(HierarchyNode& node, const std::vector<double>& exactPosition
     node.sphereRadius = floatUp(r * (1 + 1e-6));
 }
 
-bool sameMesh(const Aggregate& a, const Aggregate& b) {
-    return a.sourceObjects == b.sourceObjects && a.indices == b.indices && a.positions == b.positions;
+/// Vertex coordinates as sorted xyz triples.
+std::vector<std::array<double, 3>> sortedVertices(const Aggregate& a) {
+    std::vector<std::array<double, 3>> v(a.positions.size() / 3);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = {a.positions[3 * i], a.positions[3 * i + 1], a.positions[3 * i + 2]};
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+bool nearlyEqual(double x, double y) { return std::fabs(x - y) <= 1e-9 * std::max(std::fabs(x), std::fabs(y)); }
+
+/// The same solid: same objects, same vertices, same volume and area. This tells apart real
+/// changes of the fill and ignores a flat face (e.g. a planar quad of an object, filled by a
+/// zero-volume sliver) split along its other diagonal at another level.
+bool sameSolid(const Aggregate& a, const Aggregate& b) {
+    if (a.sourceObjects != b.sourceObjects || a.positions.size() != b.positions.size()) return false;
+    if (a.indices == b.indices && a.positions == b.positions) return true;
+    return nearlyEqual(a.measures.volume, b.measures.volume) && nearlyEqual(a.measures.area, b.measures.area) &&
+           sortedVertices(a) == sortedVertices(b);
 }
 
 }  // namespace
@@ -158,8 +175,8 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         n.indices = objects[o].indices;
         n.exactTriangleCount = n.indices.size() / 3;
     }
-    // Aggregates, level by level; an aggregate equal to the one holding the same objects one
-    // level finer is the same node (its level range grows).
+    // Aggregates, level by level; an aggregate that is the same solid as the one holding the
+    // same objects one level finer is the same node (its level range grows).
     out.nodeOfAggregate.resize(levelCount);
     for (size_t k = 0; k < levelCount; ++k) {
         const Level& level = hierarchy.levels[k];
@@ -168,7 +185,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
             const Aggregate& agg = level.aggregates[g];
             if (k > 0) {
                 const uint32_t previous = groupOf[k - 1][agg.sourceObjects.front()];
-                if (sameMesh(hierarchy.levels[k - 1].aggregates[previous], agg)) {
+                if (sameSolid(hierarchy.levels[k - 1].aggregates[previous], agg)) {
                     const uint32_t node = out.nodeOfAggregate[k - 1][previous];
                     nodes[node].lastLevel = static_cast<int>(k);
                     out.nodeOfAggregate[k][g] = node;

@@ -4,7 +4,8 @@
 // Leaves are the original objects (geometric error 0). Inner nodes are the aggregates of
 // the levels of a Hierarchy3D; the parent of an aggregate is the aggregate that contains
 // its objects at the next coarser level. An aggregate that does not change from one level
-// to the next (same objects, same mesh) is one node spanning those levels. Every
+// to the next (same objects, same solid: same vertices, volume and area, whatever the
+// triangulation of flat faces) is one node spanning those levels. Every
 // aggregate gets a proxy simplified with meshoptimizer (target error a fraction of the
 // level's delta) and its measured geometric error against the original objects.
 //
