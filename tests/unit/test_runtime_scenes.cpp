@@ -133,7 +133,7 @@ std::unique_ptr<BakedScene> bakeScene(const std::string& label, const fs::path& 
     s->label = label;
     s->dir = dir;
     std::vector<std::string> argv = {AGGRELOD_CLI, "bake", input.string(), "-o", (s->dir / "out").string(), "--quiet",
-                                     "--levels", "4"};
+                                     "--levels", "4", "--threads", "2"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     const RunResult r = runProgram(argv, s->dir);
     if (!(r.exited && r.exitCode == 0)) {
@@ -207,4 +207,216 @@ BakedScene& scene(SceneId id) {
         slot = bakeScene("truck_town", town, dir, {"--exclude", ground}, options);
     }
     return *slot;
+}
+
+const char* const kSceneNames[] = {"spheres15", "chess", "truck_town"};
+
+/// Skips the test when the scene is absent (truck_town lives in ../shared/data), fails it
+/// when the bake or the read-back failed.
+#define REQUIRE_SCENE(s)                                                               \
+    do {                                                                               \
+        if ((s).problem.rfind("absent", 0) == 0) GTEST_SKIP() << (s).problem;          \
+        ASSERT_TRUE((s).ok) << (s).label << ": " << (s).problem;                       \
+    } while (0)
+
+/// The levels [first, last] a file node stands for: from its own level to one below its
+/// parent's (to the coarsest level for a root).
+std::pair<uint32_t, uint32_t> levelRange(const runtime::RuntimeFile& f, uint32_t node, uint32_t levelCount) {
+    const runtime::NodeRecord& n = f.node(node);
+    const uint32_t last = n.parent == runtime::kNoIndex ? levelCount - 1 : f.node(n.parent).level - 1;
+    return {n.level, last};
+}
+
+/// Unit vector, uniformly distributed.
+void randomDirection(std::mt19937_64& rng, double d[3]) {
+    std::normal_distribution<double> normal(0, 1);
+    double len = 0;
+    do {
+        for (int k = 0; k < 3; ++k) d[k] = normal(rng);
+        len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    } while (len < 1e-9);
+    for (int k = 0; k < 3; ++k) d[k] /= len;
+}
+
+/// Distance from the scene centre beyond every node's bounding sphere (rays start outside).
+double outsideRadius(const BakedScene& s) {
+    double r = s.radius;
+    for (uint32_t root : s.file.roots()) {
+        const runtime::NodeRecord& n = s.file.node(root);
+        double c = 0;
+        for (int k = 0; k < 3; ++k) c += (n.sphereCenter[k] - s.center[k]) * (n.sphereCenter[k] - s.center[k]);
+        r = std::max(r, std::sqrt(c) + n.sphereRadius);
+    }
+    return 1.5 * r;
+}
+
+// ------------------------------------------------------------------------------------------
+// Conservative: exact aggregates are hit no later than the originals; proxies within error.
+
+struct ConservativeFigures {
+    size_t rays = 0, exactViolations = 0, proxyViolations = 0, depthOverError = 0;
+    size_t grazing = 0;  ///< later along the ray by > eps, but the hit point within eps of the aggregate
+    double maxExactExcess = 0, maxProxyDepth = 0, maxProxyAlongRay = 0, maxDepthOverError = 0;
+};
+
+void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& total) {
+    const runtime::RuntimeFile& f = s.file;
+    const uint32_t levelCount = uint32_t(s.levels.size());
+    ASSERT_GT(levelCount, 0u);
+    RayScene originals;
+    for (const InputObject& o : s.originals) originals.add(o);
+    originals.commit();
+    // Leaf node of each object (leaves may come in any order in the file).
+    std::vector<uint32_t> leafOf(s.originals.size(), runtime::kNoIndex);
+    for (uint32_t i = 0; i < f.nodeCount(); ++i)
+        if (f.node(i).level == runtime::kLeafLevel) leafOf[f.sources(i)[0]] = i;
+    const double diameter = 2 * s.radius;
+    // Tolerance: the exact aggregates keep the objects' own facets (or, for an open object
+    // stood in by its convex hull, the hull's facets through its vertices), re-triangulated
+    // and written as float; Embree intersects in float. A violation is an original hit point
+    // farther than eps outside the aggregate (measured perpendicular to its surface: along a
+    // grazing ray a plane offset h becomes h / sin(angle)). Measured offsets stay below
+    // 1.1e-3 m on truck_town (6e-6 of its 181 m size; float spacing at 90 m is 7.6e-6 m);
+    // eps = 1e-5 of the scene size covers them and is far below any object's size.
+    const double eps = 1e-5 * diameter;
+    const double far = outsideRadius(s);
+    std::mt19937_64 rng(12345);
+    for (uint32_t level = 0; level < levelCount; ++level) {
+        RayScene exact;
+        std::vector<detail::TriangleBvh> exactBvh(s.levels[level].size());
+        for (size_t a = 0; a < s.levels[level].size(); ++a) {
+            const InputObject& mesh = s.levels[level][a];
+            exact.add(mesh);
+            exactBvh[a].build(mesh.positions.data(), mesh.positions.size() / 3, mesh.indices.data(), mesh.indices.size() / 3);
+        }
+        exact.commit();
+        RayScene proxies;
+        std::vector<uint32_t> proxyNode;  // mesh id -> file node
+        std::vector<uint32_t> nodeAtLevel(s.originals.size(), runtime::kNoIndex);
+        std::map<uint32_t, detail::TriangleBvh> bvhOfNode;
+        for (uint32_t i = 0; i < f.nodeCount(); ++i) {
+            if (f.node(i).level == runtime::kLeafLevel) continue;
+            const auto [first, last] = levelRange(f, i, levelCount);
+            if (level < first || level > last) continue;
+            const auto v = f.vertices(i);
+            const auto t = f.triangles(i);
+            proxies.add(v.data, v.size / 3, t.data, t.size / 3);
+            proxyNode.push_back(i);
+            for (uint32_t o : f.sources(i)) nodeAtLevel[o] = i;
+            std::vector<double> p(v.begin(), v.end());
+            bvhOfNode[i].build(p.data(), p.size() / 3, t.data, t.size / 3);
+        }
+        proxies.commit();
+        for (size_t o = 0; o < s.originals.size(); ++o)
+            ASSERT_NE(nodeAtLevel[o], runtime::kNoIndex) << s.label << ": object " << o << " has no node at level " << level;
+
+        size_t hits = 0, exactViolations = 0, proxyViolations = 0;
+        double maxExcess = 0, maxDepth = 0;
+        for (size_t attempt = 0; hits < hitsPerLevel && attempt < 50 * hitsPerLevel; ++attempt) {
+            double u[3], o[3], d[3], target[3];
+            randomDirection(rng, u);
+            std::uniform_real_distribution<double> unit(0, 1);
+            for (int k = 0; k < 3; ++k) {
+                o[k] = s.center[k] + far * u[k];
+                target[k] = s.lo[k] + unit(rng) * (s.hi[k] - s.lo[k]);
+                d[k] = target[k] - o[k];
+            }
+            const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (double& x : d) x /= len;
+            const RayHit ho = originals.intersect(o, d);
+            if (!ho.hit()) continue;
+            ++hits;
+            const RayHit he = exact.intersect(o, d);
+            double excess = he.hit() ? double(he.t) - double(ho.t) : INFINITY;
+            if (excess > eps) {
+                // A later hit by more than eps along the ray. At grazing incidence on a face
+                // that the aggregate shares with the object (re-triangulated, float-rounded),
+                // a tiny offset h of the plane becomes h / sin(angle) along the ray: measure
+                // how far the original's hit point really lies outside the aggregate.
+                double p[3];
+                for (int k = 0; k < 3; ++k) p[k] = o[k] + double(ho.t) * d[k];
+                double outside = INFINITY;
+                for (const detail::TriangleBvh& b : exactBvh) outside = std::min(outside, detail::closestPoint(b, p).distance);
+                excess = outside;
+                ++total.grazing;
+                if (outside > eps) ++exactViolations;
+            }
+            maxExcess = std::max(maxExcess, excess);
+            // Proxies: a later hit (or none) leaves the original's hit point outside the
+            // proxy; its depth is that point's distance to the proxy of the object's node.
+            const RayHit hp = proxies.intersect(o, d);
+            if (!hp.hit() || double(hp.t) > double(ho.t) + eps) {
+                ++proxyViolations;
+                const uint32_t node = nodeAtLevel[ho.mesh];
+                double p[3];
+                for (int k = 0; k < 3; ++k) p[k] = o[k] + double(ho.t) * d[k];
+                const double depth = detail::closestPoint(bvhOfNode.at(node), p).distance;
+                maxDepth = std::max(maxDepth, depth);
+                total.maxProxyAlongRay = std::max(total.maxProxyAlongRay, hp.hit() ? double(hp.t) - double(ho.t) : INFINITY);
+                const double error = f.node(node).geometricError;
+                total.maxDepthOverError = std::max(total.maxDepthOverError, depth / error);
+                if (depth > error) ++total.depthOverError;
+            }
+        }
+        EXPECT_EQ(hits, hitsPerLevel) << s.label << " level " << level << ": too few rays hit the originals";
+        EXPECT_EQ(exactViolations, 0u) << s.label << " level " << level << ": the exact aggregate was hit after the original "
+                                       << exactViolations << " times, by up to " << maxExcess;
+        std::printf("%-10s level %u: %zu rays hitting originals; exact aggregates: %zu late hits (max excess %.3g, "
+                    "tolerance %.3g); proxies: %zu late hits (%.2f%%), max depth %.4g\n",
+                    s.label.c_str(), level, hits, exactViolations, maxExcess, eps, proxyViolations,
+                    100.0 * double(proxyViolations) / double(std::max<size_t>(hits, 1)), maxDepth);
+        total.rays += hits;
+        total.exactViolations += exactViolations;
+        total.proxyViolations += proxyViolations;
+        total.maxExactExcess = std::max(total.maxExactExcess, maxExcess);
+        total.maxProxyDepth = std::max(total.maxProxyDepth, maxDepth);
+    }
+}
+
+}  // namespace
+
+TEST(RuntimeScenes, ConservativeAggregatesAndProxiesWithinTheirError) {
+    ConservativeFigures total;
+    size_t scenes = 0;
+    for (SceneId id : {SceneId::Spheres15, SceneId::Chess, SceneId::TruckTown}) {
+        BakedScene& s = scene(id);
+        if (s.problem.rfind("absent", 0) == 0) continue;
+        ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
+        // 9000 rays per level and scene: >= 100k rays over the three scenes of 4 levels.
+        checkConservative(s, 9000, total);
+        ++scenes;
+    }
+    std::printf("conservative, %zu scenes: %zu rays; exact aggregates: %zu violations (%zu grazing hits later by > eps "
+                "along the ray but within eps of the surface); proxies: %zu late hits "
+                "(%.2f%%), max depth %.4g (max depth / stored error %.2f), max along the ray %.4g\n",
+                scenes, total.rays, total.exactViolations, total.grazing, total.proxyViolations,
+                100.0 * double(total.proxyViolations) / double(std::max<size_t>(total.rays, 1)), total.maxProxyDepth,
+                total.maxDepthOverError, total.maxProxyAlongRay);
+    if (scenes == 3) EXPECT_GE(total.rays, 100000u);
+    EXPECT_EQ(total.exactViolations, 0u);
+    EXPECT_EQ(total.depthOverError, 0u) << "a proxy misses an original by more than its stored error";
+}
+
+TEST(RuntimeScenes, SceneFileIsByteIdenticalAcrossBakesAndThreadCounts) {
+    for (SceneId id : {SceneId::Spheres15, SceneId::TruckTown}) {
+        BakedScene& s = scene(id);
+        REQUIRE_SCENE(s);
+        const std::string reference = readFile(s.dir / "out" / "scene.aglod");
+        ASSERT_GT(reference.size(), 0u);
+        // The cached bake ran with --threads 2: bake again with 2 and with 1.
+        for (const char* threads : {"2", "1"}) {
+            const fs::path out = s.dir / (std::string("again_t") + threads);
+            std::vector<std::string> argv = {AGGRELOD_CLI, "bake",
+                                             id == SceneId::TruckTown ? sharedData("3d/truck_town/town_model.gltf").string()
+                                                                      : (s.dir / "in.glb").string(),
+                                             "-o", out.string(), "--quiet", "--levels", "4", "--threads", threads};
+            if (id == SceneId::TruckTown) argv.insert(argv.end(), {"--exclude", "^(OuterGroundMesh|GrassMesh|RoadMesh)$"});
+            const RunResult r = runProgram(argv, s.dir);
+            ASSERT_TRUE(r.exited && r.exitCode == 0) << r.describe();
+            EXPECT_TRUE(readFile(out / "scene.aglod") == reference)
+                << s.label << ": scene.aglod differs with --threads " << threads;
+            EXPECT_TRUE(readFile(out / "levels.glb") == readFile(s.dir / "out" / "levels.glb"))
+                << s.label << ": levels.glb differs with --threads " << threads;
+        }
+    }
 }
