@@ -11,6 +11,7 @@
 #include "test_support.h"
 
 #include <aggrelod/runtime_file.h>
+#include <aggrelod/selection.h>
 #include <aggrelod/samples.h>
 
 #include <embree3/rtcore.h>
@@ -418,5 +419,199 @@ TEST(RuntimeScenes, SceneFileIsByteIdenticalAcrossBakesAndThreadCounts) {
             EXPECT_TRUE(readFile(out / "levels.glb") == readFile(s.dir / "out" / "levels.glb"))
                 << s.label << ": levels.glb differs with --threads " << threads;
         }
+    }
+}
+
+namespace {
+
+/// A camera position at a log-uniform distance in [near, far] x radius from the scene centre.
+void randomCameraPosition(std::mt19937_64& rng, const BakedScene& s, double nearFactor, double farFactor, float out[3]) {
+    double u[3];
+    randomDirection(rng, u);
+    std::uniform_real_distribution<double> t(std::log(nearFactor), std::log(farFactor));
+    const double r = s.radius * std::exp(t(rng));
+    for (int k = 0; k < 3; ++k) out[k] = float(s.center[k] + r * u[k]);
+}
+
+}  // namespace
+
+TEST(RuntimeScenes, ValidCutForRandomCameras) {
+    for (SceneId id : {SceneId::Spheres15, SceneId::Chess, SceneId::TruckTown}) {
+        BakedScene& s = scene(id);
+        if (s.problem.rfind("absent", 0) == 0) continue;
+        ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
+        const runtime::RuntimeFile& f = s.file;
+        runtime::Selector incremental(f), fresh(f);
+        std::mt19937_64 rng(777);
+        size_t withProxies = 0, withOriginals = 0, mixed = 0, totalCut = 0;
+        for (int camera = 0; camera < 1000; ++camera) {
+            runtime::Camera c;
+            // From inside the scene (0.05 R) to far away (200 R).
+            randomCameraPosition(rng, s, 0.05, 200, c.position);
+            c.fovY = float(60 * M_PI / 180);
+            c.viewportHeight = camera % 2 ? 1080.0f : 256.0f;
+            runtime::SelectionSettings settings;
+            settings.pixelTolerance = 1.0f;
+            incremental.select(c, settings);  // moves from the previous random camera
+            fresh.reset();
+            fresh.selectFull(c, settings);    // the pure rule, no history
+            for (const runtime::Selector* sel : {&incremental, &fresh}) {
+                std::vector<int> cover(f.objectCount(), 0);
+                for (uint32_t node : sel->cut())
+                    for (uint32_t o : f.sources(node)) ++cover[o];
+                for (uint32_t o = 0; o < f.objectCount(); ++o)
+                    ASSERT_EQ(cover[o], 1) << s.label << " camera " << camera << ": object '" << f.objectName(o)
+                                           << "' covered " << cover[o] << " times";
+                size_t fromLists = sel->originalObjects().size;
+                for (uint32_t node : sel->proxyNodes()) fromLists += f.sources(node).size;
+                ASSERT_EQ(fromLists, size_t(f.objectCount())) << "proxy and original lists disagree with the cut";
+            }
+            // The rule itself on the fresh cut: drawn proxies within tau, their parents above it.
+            for (uint32_t node : fresh.cut()) {
+                const runtime::NodeRecord& n = f.node(node);
+                if (n.childCount > 0) EXPECT_LE(fresh.screenSpaceErrorOf(node, c), 1.0f) << s.label << " node " << node;
+                if (n.parent != runtime::kNoIndex) EXPECT_GT(fresh.screenSpaceErrorOf(n.parent, c), 1.0f) << s.label << " node " << node;
+            }
+            const bool proxies = fresh.proxyNodes().size > 0, originals = fresh.originalObjects().size > 0;
+            withProxies += proxies;
+            withOriginals += originals;
+            mixed += proxies && originals;
+            totalCut += fresh.cut().size;
+        }
+        std::printf("%-10s 1000 cameras: every object covered exactly once (incremental with hysteresis and "
+                    "fresh); cuts with proxies %zu, with originals %zu, mixed %zu; mean cut %.1f of %u nodes\n",
+                    s.label.c_str(), withProxies, withOriginals, mixed, double(totalCut) / 1000, f.nodeCount());
+        EXPECT_GT(mixed, 0u) << s.label << ": no camera gave a cut mixing proxies and originals; the test would be weak";
+    }
+}
+
+namespace {
+
+/// A pinhole camera looking at `target`; rays through pixel centres of a width x height image.
+struct PinholeCamera {
+    double eye[3], forward[3], right[3], up[3];
+    double tanHalf;
+    int width, height;
+    PinholeCamera(const float position[3], const double target[3], double fovY, int w, int h)
+        : tanHalf(std::tan(fovY / 2)), width(w), height(h) {
+        for (int k = 0; k < 3; ++k) {
+            eye[k] = position[k];
+            forward[k] = target[k] - eye[k];
+        }
+        normalize(forward);
+        double worldUp[3] = {0, 0, 1};
+        if (std::fabs(forward[2]) > 0.95) worldUp[2] = 0, worldUp[1] = 1;
+        cross(forward, worldUp, right);
+        normalize(right);
+        cross(right, forward, up);
+    }
+    static void normalize(double v[3]) {
+        const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        for (int k = 0; k < 3; ++k) v[k] /= l;
+    }
+    static void cross(const double a[3], const double b[3], double out[3]) {
+        out[0] = a[1] * b[2] - a[2] * b[1];
+        out[1] = a[2] * b[0] - a[0] * b[2];
+        out[2] = a[0] * b[1] - a[1] * b[0];
+    }
+    void ray(int x, int y, double d[3]) const {
+        const double sx = ((x + 0.5) / width * 2 - 1) * tanHalf * double(width) / height;
+        const double sy = (1 - (y + 0.5) / height * 2) * tanHalf;
+        for (int k = 0; k < 3; ++k) d[k] = forward[k] + sx * right[k] + sy * up[k];
+        normalize(d);
+    }
+};
+
+/// Coverage (depth > 0) and depth along the ray of a 256 x 256 image; INFINITY = background.
+std::vector<float> renderDepth(const RayScene& scene, const PinholeCamera& cam) {
+    std::vector<float> depth(size_t(cam.width) * cam.height);
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            double d[3];
+            cam.ray(x, y, d);
+            depth[size_t(y) * cam.width + x] = scene.intersect(cam.eye, d).t;
+        }
+    return depth;
+}
+
+/// Distance in pixels from (x, y) to the nearest pixel whose coverage in `image` is `covered`
+/// (searched up to `limit`; returns limit + 1 beyond).
+double nearestWithCoverage(const std::vector<float>& image, int w, int h, int x, int y, bool covered, int limit) {
+    double best = limit + 1;
+    for (int dy = -limit; dy <= limit; ++dy)
+        for (int dx = -limit; dx <= limit; ++dx) {
+            const int px = x + dx, py = y + dy;
+            if (px < 0 || py < 0 || px >= w || py >= h) continue;
+            if (std::isfinite(image[size_t(py) * w + px]) != covered) continue;
+            best = std::min(best, std::sqrt(double(dx * dx + dy * dy)));
+        }
+    return best;
+}
+
+}  // namespace
+
+TEST(RuntimeScenes, ScreenSpacePromiseAtOnePixel) {
+    // Bound: a drawn proxy has sse = e * f / d <= tau (f = H / (2 tan(fovY/2)) pixels, d the
+    // distance to its bounding sphere, at most the distance r to any of its points), and every
+    // point of the proxy lies within e of an original and every original point outside the
+    // proxy within e of it (the stored error bounds both one-sided Hausdorff distances). A
+    // displacement e at distance r, seen at angle theta off the optical axis, moves its image
+    // by at most e * f / (r cos^2 theta) <= tau / cos^2 theta; in the corner of a square
+    // 60-degree image tan theta = tan 30 * sqrt 2, so 1 / cos^2 theta = 1.667. Coverage is
+    // sampled at pixel centres: + sqrt 2 for the nearest centre. Bound: 1.667 tau + 1.414 px.
+    const double tau = 1.0;
+    const double fovY = 60 * M_PI / 180;
+    const double bound = tau * (1 + std::pow(std::tan(fovY / 2) * std::sqrt(2.0), 2)) + std::sqrt(2.0);
+    const int size = 256;
+    for (SceneId id : {SceneId::Spheres15, SceneId::Chess, SceneId::TruckTown}) {
+        BakedScene& s = scene(id);
+        if (s.problem.rfind("absent", 0) == 0) continue;
+        ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
+        const runtime::RuntimeFile& f = s.file;
+        RayScene originals;
+        for (const InputObject& o : s.originals) originals.add(o);
+        originals.commit();
+        runtime::Selector selector(f);
+        std::mt19937_64 rng(4242);
+        size_t differing = 0, covered = 0, proxiesDrawn = 0;
+        double largestOffset = 0, largestDepthChange = 0;
+        for (int camera = 0; camera < 20; ++camera) {
+            runtime::Camera c;
+            randomCameraPosition(rng, s, 1.5, 12, c.position);
+            c.fovY = float(fovY);
+            c.viewportHeight = float(size);
+            runtime::SelectionSettings settings;
+            settings.pixelTolerance = float(tau);
+            selector.reset();
+            selector.selectFull(c, settings);
+            RayScene cut;
+            for (uint32_t node : selector.proxyNodes()) {
+                const auto v = f.vertices(node);
+                const auto t = f.triangles(node);
+                cut.add(v.data, v.size / 3, t.data, t.size / 3);
+            }
+            for (uint32_t o : selector.originalObjects()) cut.add(s.originals[o]);
+            cut.commit();
+            proxiesDrawn += selector.proxyNodes().size;
+            const PinholeCamera cam(c.position, s.center, fovY, size, size);
+            const std::vector<float> a = renderDepth(originals, cam), b = renderDepth(cut, cam);
+            for (int y = 0; y < size; ++y)
+                for (int x = 0; x < size; ++x) {
+                    const size_t i = size_t(y) * size + x;
+                    const bool inA = std::isfinite(a[i]), inB = std::isfinite(b[i]);
+                    covered += inA || inB;
+                    if (inA && inB) largestDepthChange = std::max(largestDepthChange, double(std::fabs(a[i] - b[i])));
+                    if (inA == inB) continue;
+                    ++differing;
+                    const double offset = nearestWithCoverage(inA ? b : a, size, size, x, y, true, 16);
+                    largestOffset = std::max(largestOffset, offset);
+                    EXPECT_LE(offset, bound) << s.label << " camera " << camera << " pixel " << x << "," << y;
+                }
+        }
+        std::printf("%-10s 20 cameras 256x256, tau = 1 px: %zu proxies drawn; %zu of %zu covered pixels differ "
+                    "(%.3f%% of all pixels); largest silhouette offset %.2f px (bound %.2f); largest depth change %.3g\n",
+                    s.label.c_str(), proxiesDrawn, differing, covered, 100.0 * double(differing) / (20.0 * size * size),
+                    largestOffset, bound, largestDepthChange);
+        EXPECT_GT(proxiesDrawn, 0u) << s.label << ": no proxy drawn; choose farther cameras";
     }
 }
