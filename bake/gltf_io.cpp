@@ -1222,7 +1222,9 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                     tinygltf::Value::Object proxyError;
                     proxyError["proxy_to_originals"] = tinygltf::Value(hn.error.proxyToOriginals);
                     proxyError["originals_to_proxy"] = tinygltf::Value(hn.error.originalsToProxy);
-                    proxyError["sample_spacing"] = tinygltf::Value(hn.error.sampleSpacing);
+                    proxyError["proxy_to_originals_found"] = tinygltf::Value(hn.error.proxyToOriginalsLower);
+                    proxyError["originals_to_proxy_found"] = tinygltf::Value(hn.error.originalsToProxyLower);
+                    proxyError["tolerance"] = tinygltf::Value(hn.error.tolerance);
                     proxyError["bound"] = tinygltf::Value(hn.error.bound());
                     extras["proxy_error"] = tinygltf::Value(std::move(proxyError));
                     extras["proxy_triangles"] = intValue(hn.indices.size() / 3);

@@ -40,7 +40,8 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 /// (the hierarchy nodes of the same bake), each aggregate's extras also carry its node of
 /// the runtime hierarchy: node, parent, children (node indices; index < object count = that
 /// original object), first_level, last_level, geometric_error (stored, monotone),
-/// proxy_error {proxy_to_originals, originals_to_proxy, sample_spacing, bound},
+/// proxy_error {proxy_to_originals, originals_to_proxy (certified upper bounds),
+/// proxy_to_originals_found, originals_to_proxy_found (largest distances found), tolerance, bound},
 /// proxy_triangles. World units throughout.
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                     const std::string& path, std::string& error,

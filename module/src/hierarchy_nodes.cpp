@@ -137,13 +137,18 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
                 groupOf[k][o] = static_cast<uint32_t>(g);
             }
         }
+        // An object the bake left out (e.g. a non-finite coordinate) is in no level; any
+        // other object is in every level.
         for (size_t o = 0; o < objectCount; ++o)
-            if (groupOf[k][o] == kNoNode) {
-                error = "object '" + objects[o].name + "' is in no aggregate of level " + std::to_string(k);
+            if ((groupOf[k][o] == kNoNode) != (groupOf[0][o] == kNoNode)) {
+                error = "object '" + objects[o].name + "' is in an aggregate of level " +
+                        std::to_string(groupOf[k][o] == kNoNode ? 0 : k) + " but in none of level " +
+                        std::to_string(groupOf[k][o] == kNoNode ? k : 0);
                 return false;
             }
         if (k > 0)  // groups only coarsen: one level-(k-1) group lies in one level-k group
             for (size_t o = 0; o < objectCount; ++o) {
+                if (groupOf[k][o] == kNoNode) continue;
                 const Aggregate& below = hierarchy.levels[k - 1].aggregates[groupOf[k - 1][o]];
                 if (groupOf[k][below.sourceObjects.front()] != groupOf[k][o]) {
                     error = "level " + std::to_string(k) + " splits a group of level " + std::to_string(k - 1) +
@@ -171,9 +176,15 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         HierarchyNode& n = nodes[o];
         n.leaf = true;
         n.sources = {static_cast<uint32_t>(o)};
-        n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
-        n.indices = objects[o].indices;
-        n.exactTriangleCount = n.indices.size() / 3;
+        n.exactTriangleCount = objects[o].indices.size() / 3;
+        // A left-out object keeps its leaf (a root) without geometry.
+        const bool inHierarchy = levelCount > 0 && groupOf[0][o] != kNoNode;
+        const bool finite = std::all_of(objects[o].positions.begin(), objects[o].positions.end(),
+                                        [](double x) { return std::isfinite(x); });
+        if (inHierarchy && finite) {
+            n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
+            n.indices = objects[o].indices;
+        }
     }
     // Aggregates, level by level; an aggregate that is the same solid as the one holding the
     // same objects one level finer is the same node (its level range grows).
@@ -206,7 +217,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     for (size_t i = 0; i < nodes.size(); ++i) {
         HierarchyNode& n = nodes[i];
         const size_t above = n.leaf ? 0 : size_t(n.lastLevel) + 1;
-        if (above < levelCount) {
+        if (above < levelCount && groupOf[above][n.sources.front()] != kNoNode) {
             n.parent = out.nodeOfAggregate[above][groupOf[above][n.sources.front()]];
             nodes[n.parent].children.push_back(static_cast<uint32_t>(i));
         } else {
@@ -225,8 +236,8 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         detail::simplifyMesh(exact, agg.indices, settings.simplifyFraction * n.delta, n.positions, n.indices);
         std::vector<const InputObject*> originals;
         for (uint32_t o : n.sources) originals.push_back(&objects[o]);
-        double spacing = settings.sampleSpacingFraction * n.delta;
-        n.error = measureProxyError(n.positions, n.indices, originals, spacing, settings.maxSamplesPerDirection);
+        n.error = measureProxyError(n.positions, n.indices, originals, settings.toleranceFraction * n.delta,
+                                    settings.maxRefinementsPerDirection);
     }, [&](size_t done) {
         if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
     });
@@ -238,7 +249,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         double e = n.leaf ? 0.0 : n.error.bound();
         for (uint32_t c : n.children) e = std::max(e, nodes[c].geometricError);
         n.geometricError = floatUp(e);
-        computeBounds(n, n.leaf ? objects[i].positions : aggregateOf(n).positions, nodes);
+        computeBounds(n, n.leaf ? (n.positions.empty() ? none : objects[i].positions) : aggregateOf(n).positions, nodes);
     }
     return true;
 }

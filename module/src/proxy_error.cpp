@@ -1,48 +1,44 @@
 // aggrelod module: geometric error of a proxy against the original objects (DESIGN 2.5,
-// "Geometric error of a proxy"): both one-sided Hausdorff distances, sampled.
-//
-// Samples: every vertex, plus a regular barycentric grid on every triangle whose step is at
-// most `spacing` (the triangle is cut into n^2 similar sub-triangles, n = ceil(longest edge
-// / spacing)), so every surface point lies within `spacing` of a sample and the sampling is
-// area-weighted and deterministic. The distance from a point to a surface (or to a solid) is
-// 1-Lipschitz in the point, hence the true Hausdorff distance is at most the sampled maximum
-// + spacing (ProxyError::bound()).
+// "Geometric error of a proxy"): both one-sided Hausdorff distances, with certified upper
+// bounds.
 //
 // Directions:
-// - proxy -> originals: distance from a proxy sample to the nearest original surface
+// - proxy -> originals: h(p) = distance from a proxy point to the nearest original surface
 //   (closest-point BVH query, mesh_distance.h);
-// - originals -> proxy: distance from an original sample to the proxy *solid*: 0 when the
-//   sample is inside the proxy (an original surface buried in the aggregate's fill is covered
-//   by it, not missing), else the distance to the proxy surface. Inside = odd number of
-//   crossings of a ray, majority of three rays in fixed directions (robust to a ray grazing
-//   an edge or a vertex).
+// - originals -> proxy: h(p) = distance from an original point to the proxy *solid*: 0 when
+//   the point is inside the proxy (an original surface buried in the aggregate's fill is
+//   covered by it, not missing), else the distance to the proxy surface. Inside = odd number
+//   of crossings of a ray, majority of three rays in fixed directions.
+//
+// Branch and bound over triangles (in the spirit of Tang et al., "Interactive Hausdorff
+// distance computation for general polygonal models", SIGGRAPH 2009): every triangle of the
+// measured mesh is a region; at its centroid c, h(c) is a lower bound of the maximum. An
+// upper bound of h over the region (ball of radius rho around c holding its corners) is the
+// smaller of
+//   - h(c) + rho, as h is 1-Lipschitz, and
+//   - max over the corners v of dist(v, T), T the target triangle nearest to c: the distance
+//     to one triangle is convex, so its maximum over the region is at a corner, and the
+//     distance to the whole target is at most the distance to T;
+// and 0 for originals -> proxy when c is inside and the ball misses the proxy surface. The
+// region with the largest upper bound is split into four (edge midpoints) until it is within
+// `tolerance` of the best lower bound or the evaluation budget is spent; the result is the
+// largest remaining upper bound: never below the true Hausdorff distance.
 #include "mesh_distance.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <queue>
 
 namespace aggrelod {
 
-double ProxyError::bound() const { return std::max(proxyToOriginals, originalsToProxy) + sampleSpacing; }
+double ProxyError::bound() const { return std::max(proxyToOriginals, originalsToProxy); }
 
 namespace {
 
 using detail::TriangleBvh;
-
-/// Number of grid steps along each side of a triangle with longest edge `longest`.
-size_t stepsFor(double longest, double spacing) {
-    if (!(spacing > 0) || !(longest > spacing)) return 1;
-    return static_cast<size_t>(std::ceil(longest / spacing));
-}
-
-double longestEdge(const double* a, const double* b, const double* c) {
-    auto d = [](const double* p, const double* q) {
-        return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
-    };
-    return std::max({d(a, b), d(b, c), d(c, a)});
-}
 
 /// A triangle mesh in doubles (positions 3 * n, indices 3 * t).
 struct Mesh {
@@ -51,31 +47,6 @@ struct Mesh {
     const double* corner(size_t t, int k) const { return &positions[3 * size_t(indices[3 * t + k])]; }
     size_t triangleCount() const { return indices.size() / 3; }
 };
-
-size_t sampleCount(const Mesh& m, double spacing) {
-    size_t count = 0;
-    for (size_t t = 0; t < m.triangleCount(); ++t) {
-        const size_t n = stepsFor(longestEdge(m.corner(t, 0), m.corner(t, 1), m.corner(t, 2)), spacing);
-        count += (n + 1) * (n + 2) / 2;
-    }
-    return count;
-}
-
-/// Calls visit(point) for every grid sample of every triangle (vertices included).
-template <class Visit>
-void forEachSample(const Mesh& m, double spacing, Visit&& visit) {
-    for (size_t t = 0; t < m.triangleCount(); ++t) {
-        const double *a = m.corner(t, 0), *b = m.corner(t, 1), *c = m.corner(t, 2);
-        const size_t n = stepsFor(longestEdge(a, b, c), spacing);
-        for (size_t i = 0; i <= n; ++i)
-            for (size_t j = 0; i + j <= n; ++j) {
-                const double u = double(i) / double(n), v = double(j) / double(n);
-                double p[3];
-                for (int k = 0; k < 3; ++k) p[k] = a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]);
-                visit(p);
-            }
-    }
-}
 
 /// Number of triangles of `bvh` crossed by the ray p + t d, t > 0 (Moller-Trumbore).
 size_t crossings(const TriangleBvh& bvh, const double p[3], const double d[3]) {
@@ -141,12 +112,101 @@ bool insideSolid(const TriangleBvh& bvh, const double p[3]) {
     return inside >= 2;
 }
 
+
+/// One region of the branch and bound: a triangle (corners), its bounds.
+struct Region {
+    std::array<double, 9> corners;
+    double upper;
+    uint64_t order;  ///< creation order: a full tie-break, so the refinement is deterministic
+};
+struct LowerUpperFirst {
+    bool operator()(const Region& a, const Region& b) const {
+        return a.upper != b.upper ? a.upper < b.upper : a.order > b.order;
+    }
+};
+
+struct DirectionResult {
+    double lower = 0, upper = 0;
+    size_t evaluations = 0;
+};
+
+/// Max over the surface `from` of h (distance to `target`'s surface, or to its solid when
+/// toSolid), within `tolerance`, spending at most about `budget` evaluations beyond one per
+/// triangle. `targetMesh` gives the target triangles' corners by original index.
+DirectionResult hausdorffBound(const Mesh& from, const TriangleBvh& target, const Mesh& targetMesh, bool toSolid,
+                               double tolerance, size_t budget) {
+    DirectionResult r;
+    std::priority_queue<Region, std::vector<Region>, LowerUpperFirst> open;
+    uint64_t order = 0;
+    auto evaluate = [&](const std::array<double, 9>& c) {
+        ++r.evaluations;
+        double centroid[3], rho = 0;
+        for (int k = 0; k < 3; ++k) centroid[k] = (c[k] + c[3 + k] + c[6 + k]) / 3;
+        for (int v = 0; v < 3; ++v) {
+            const double dx = c[3 * v] - centroid[0], dy = c[3 * v + 1] - centroid[1], dz = c[3 * v + 2] - centroid[2];
+            rho = std::max(rho, std::sqrt(dx * dx + dy * dy + dz * dz));
+        }
+        const detail::ClosestPoint cp = detail::closestPoint(target, centroid);
+        const double d = cp.distance;
+        double upper = d + rho;
+        if (cp.triangle != ~0u) {
+            const double* a = targetMesh.corner(cp.triangle, 0);
+            const double* b = targetMesh.corner(cp.triangle, 1);
+            const double* t = targetMesh.corner(cp.triangle, 2);
+            double corners = 0, q[3];
+            for (int v = 0; v < 3; ++v) corners = std::max(corners, detail::pointTriangleDistance(&c[3 * v], a, b, t, q));
+            upper = std::min(upper, corners);
+        }
+        double h = d;
+        if (toSolid && (d > rho || d > r.lower)) {
+            const bool inside = insideSolid(target, centroid);
+            if (inside) h = 0;
+            if (inside && d > rho) upper = 0;  // the ball lies inside the solid
+        }
+        r.lower = std::max(r.lower, h);
+        if (upper > r.lower + tolerance) open.push(Region{c, upper, order++});
+        else r.upper = std::max(r.upper, upper);
+    };
+    for (size_t t = 0; t < from.triangleCount(); ++t) {
+        std::array<double, 9> c;
+        for (int v = 0; v < 3; ++v)
+            for (int k = 0; k < 3; ++k) c[size_t(3 * v + k)] = from.corner(t, v)[k];
+        evaluate(c);
+    }
+    const size_t limit = r.evaluations + budget;
+    while (!open.empty() && open.top().upper > r.lower + tolerance && r.evaluations + 4 <= limit) {
+        const Region g = open.top();
+        open.pop();
+        const double* c = g.corners.data();
+        double m[3][3];  // edge midpoints 01, 12, 20
+        for (int k = 0; k < 3; ++k) {
+            m[0][k] = 0.5 * (c[k] + c[3 + k]);
+            m[1][k] = 0.5 * (c[3 + k] + c[6 + k]);
+            m[2][k] = 0.5 * (c[6 + k] + c[k]);
+        }
+        auto tri = [](const double* p, const double* q, const double* s) {
+            return std::array<double, 9>{p[0], p[1], p[2], q[0], q[1], q[2], s[0], s[1], s[2]};
+        };
+        evaluate(tri(c, m[0], m[2]));
+        evaluate(tri(m[0], c + 3, m[1]));
+        evaluate(tri(m[2], m[1], c + 6));
+        evaluate(tri(m[0], m[1], m[2]));
+    }
+    // What is left open keeps its upper bound.
+    while (!open.empty()) {
+        r.upper = std::max(r.upper, open.top().upper);
+        open.pop();
+    }
+    r.upper = std::max(r.upper, r.lower);
+    return r;
+}
+
 }  // namespace
 
 ProxyError measureProxyError(const std::vector<float>& proxyPositions,
                              const std::vector<uint32_t>& proxyIndices,
-                             const std::vector<const InputObject*>& originals, double spacing,
-                             size_t maxSamplesPerDirection) {
+                             const std::vector<const InputObject*>& originals, double tolerance,
+                             size_t maxRefinementsPerDirection) {
     Mesh proxy, orig;
     proxy.positions.assign(proxyPositions.begin(), proxyPositions.end());
     proxy.indices = proxyIndices;
@@ -156,32 +216,18 @@ ProxyError measureProxyError(const std::vector<float>& proxyPositions,
         for (uint32_t i : o->indices) orig.indices.push_back(base + i);
     }
     ProxyError e;
+    e.tolerance = tolerance;
     if (proxy.triangleCount() == 0 || orig.triangleCount() == 0) return e;
-
-    // Widen the spacing until both directions fit the sample budget.
-    const size_t budget = std::max<size_t>(maxSamplesPerDirection, 1);
-    if (!(spacing > 0)) spacing = 1e-3 * longestEdge(orig.corner(0, 0), orig.corner(0, 1), orig.corner(0, 2));
-    for (int round = 0; round < 64; ++round) {
-        const size_t most = std::max(sampleCount(proxy, spacing), sampleCount(orig, spacing));
-        if (most <= budget) break;
-        spacing *= std::max(1.05, std::sqrt(double(most) / double(budget)));
-    }
-    e.sampleSpacing = spacing;
-
     TriangleBvh proxyBvh, origBvh;
     proxyBvh.build(proxy.positions.data(), proxy.positions.size() / 3, proxy.indices.data(), proxy.triangleCount());
     origBvh.build(orig.positions.data(), orig.positions.size() / 3, orig.indices.data(), orig.triangleCount());
-
-    forEachSample(proxy, spacing, [&](const double* p) {
-        ++e.sampleCount;
-        e.proxyToOriginals = std::max(e.proxyToOriginals, detail::closestPoint(origBvh, p).distance);
-    });
-    forEachSample(orig, spacing, [&](const double* p) {
-        ++e.sampleCount;
-        const double d = detail::closestPoint(proxyBvh, p).distance;
-        // Only a sample that would raise the maximum needs the (costlier) inside test.
-        if (d > e.originalsToProxy && !insideSolid(proxyBvh, p)) e.originalsToProxy = d;
-    });
+    const DirectionResult forward = hausdorffBound(proxy, origBvh, orig, false, tolerance, maxRefinementsPerDirection);
+    const DirectionResult backward = hausdorffBound(orig, proxyBvh, proxy, true, tolerance, maxRefinementsPerDirection);
+    e.proxyToOriginals = forward.upper;
+    e.originalsToProxy = backward.upper;
+    e.proxyToOriginalsLower = forward.lower;
+    e.originalsToProxyLower = backward.lower;
+    e.evaluationCount = forward.evaluations + backward.evaluations;
     return e;
 }
 

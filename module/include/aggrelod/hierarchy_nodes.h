@@ -28,23 +28,26 @@ struct ProxySettings {
     /// meshoptimizer's target error for the proxy of a level-k aggregate, as a fraction of
     /// delta_k (world units once multiplied). 0 keeps the exact aggregate as its proxy.
     double simplifyFraction = 0.25;
-    /// Spacing of the error samples (world units) as a fraction of delta_k ...
-    double sampleSpacingFraction = 0.02;
-    /// ... widened so that one direction of one proxy takes at most about this many samples.
-    size_t maxSamplesPerDirection = 20000;
+    /// How far (world units, as a fraction of delta_k) the certified upper bound of the
+    /// error may exceed the largest distance actually found; the refinement stops there ...
+    double toleranceFraction = 0.02;
+    /// ... or after this many region evaluations per direction beyond one per triangle (the
+    /// bound stays certified, only looser).
+    size_t maxRefinementsPerDirection = 20000;
     int threadCount = 0;  ///< 0 = hardware concurrency; results identical for every count
     ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
 };
 
-/// One-sided sampled distances between a proxy and the original objects it stands for.
+/// One-sided Hausdorff distances between a proxy and the original objects it stands for:
+/// certified upper bounds (never below the true distance) and the largest distance found.
 struct ProxyError {
-    double proxyToOriginals = 0;  ///< max over proxy samples of the distance to the originals' surfaces
-    double originalsToProxy = 0;  ///< max over original samples of the distance to the proxy solid
-                                  ///<   (0 for a sample inside the proxy: it is covered)
-    double sampleSpacing = 0;     ///< every surface point lies within this distance of a sample
-    size_t sampleCount = 0;       ///< both directions together
-    /// Upper bound of both one-sided Hausdorff distances: the distance functions are
-    /// 1-Lipschitz, so the true maximum is at most the sampled one + sampleSpacing.
+    double proxyToOriginals = 0;  ///< upper bound: every proxy point is this close to an original surface
+    double originalsToProxy = 0;  ///< upper bound: every original point is inside the proxy or this close to it
+    double proxyToOriginalsLower = 0;  ///< largest distance found at an evaluated proxy point
+    double originalsToProxyLower = 0;  ///< largest distance found at an evaluated original point
+    double tolerance = 0;         ///< allowed gap between found and bound (world units)
+    size_t evaluationCount = 0;   ///< regions evaluated, both directions
+    /// max(proxyToOriginals, originalsToProxy), world units.
     double bound() const;
 };
 
@@ -57,7 +60,7 @@ struct HierarchyNode {
     int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
     uint32_t aggregateIndex = 0;       ///< index in levels[firstLevel].aggregates (aggregates only)
     double delta = 0;                  ///< delta of firstLevel, world units (0 for leaves)
-    std::vector<float> positions;      ///< proxy (leaf: the original), 3 * vertexCount, world units
+    std::vector<float> positions;      ///< proxy (leaf: the original; empty for a left-out object), 3 * vertexCount, world units
     std::vector<uint32_t> indices;     ///< 3 * triangleCount, outward
     size_t exactTriangleCount = 0;     ///< triangles of the unsimplified aggregate (leaf: of the object)
     ProxyError error;                  ///< measured error of this node's proxy (zeros for leaves)
@@ -84,18 +87,21 @@ struct HierarchyNodes {
 };
 
 /// Builds the node tree of `hierarchy`, baked from `objects` (same array, same order).
+/// An object the bake left out (in no aggregate of any level, e.g. for a non-finite
+/// coordinate) becomes a root leaf without geometry.
 /// Returns false with a message in `error` when the two do not match (a source index out of
-/// range, an object in no or in two aggregates of one level, a level not coarser than the
-/// previous one). Never throws for such input.
+/// range, an object in two aggregates of one level or in some levels only, a level not
+/// coarser than the previous one). Never throws for such input.
 bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                          const ProxySettings& settings, HierarchyNodes& out, std::string& error);
 
-/// Measures the error of `proxy` (float positions, 3 * vertexCount; indices 3 * triangleCount)
-/// against `originals` (closed meshes, world units) with sample spacing about `spacing`,
-/// widened to keep each direction under maxSamplesPerDirection. Deterministic, single thread.
+/// Measures the error of a proxy (float positions, 3 * vertexCount; indices 3 * triangleCount,
+/// closed) against `originals` (world units) by branch and bound over triangles: refines
+/// until the bounds are within `tolerance` (world units) or after maxRefinementsPerDirection
+/// evaluations per direction beyond one per triangle. Deterministic, single thread.
 ProxyError measureProxyError(const std::vector<float>& proxyPositions,
                              const std::vector<uint32_t>& proxyIndices,
-                             const std::vector<const InputObject*>& originals, double spacing,
-                             size_t maxSamplesPerDirection);
+                             const std::vector<const InputObject*>& originals, double tolerance,
+                             size_t maxRefinementsPerDirection);
 
 }  // namespace aggrelod
