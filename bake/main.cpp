@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -193,7 +194,9 @@ int runBake(BakeOptions o) {
         proxySettings.simplifyFraction = o.proxyError;
         proxySettings.threadCount = o.threads;
         proxySettings.progress = settings.progress;
+        const auto start = std::chrono::steady_clock::now();
         nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
+        hierarchy.timings.emplace_back("proxies", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
     progress.finish();
     cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
