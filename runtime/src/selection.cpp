@@ -10,6 +10,15 @@
 // Because errors and spheres nest, sse never grows going down a path, so a parent that stays
 // refined implies every ancestor does: the climb stops at the first refined parent, and the
 // result equals the walk from the roots (selectFull) for the same previous state.
+//
+// Leases make the steady state cost O(changes) instead of O(cut): a node's decision is
+// "camera inside the sphere of radius error*reach + radius around its centre", and its
+// parent's the same with the coarsen reach. Neither can change before the camera has moved
+// by the distance to the nearer of those two sphere boundaries (minus a rounding margin).
+// Each cut node gets that distance as a lease against an odometer (total camera path);
+// a frame pops the expired leases from a min-heap and handles only those nodes with the pass
+// above. The cut, proxy and original lists are kept with swap-removal. A change of tau, fov,
+// viewport height or coarsen ratio re-runs the O(cut) pass and grants every lease anew.
 #include <aggrelod/selection.h>
 
 #include <aggrelod/runtime.h>
@@ -21,18 +30,14 @@ namespace aggrelod::runtime {
 
 Selector::Selector(const RuntimeFile& file) : file_(&file) {
     const uint32_t n = file.nodeCount();
-    bounds_.resize(n);
-    childless_.resize(n);
+    sourceObjects_ = file.allSourceObjects().data;
+    hot_.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
         const NodeRecord& r = file.node(i);
-        bounds_[i] = {{r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2]},
-                      r.sphereRadius, r.geometricError, r.parent};
-        childless_[i] = r.childCount == 0;
+        hot_[i] = {{r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2]}, r.sphereRadius, r.geometricError,
+                   r.parent, r.firstSource, r.childCount == 0 ? r.sourceCount : 0u};
     }
-    refined_.assign(n, 0);
-    decidedStamp_.assign(n, 0);
-    decision_.assign(n, 0);
-    emittedStamp_.assign(n, 0);
+    state_.assign(n, State{0, 0, 0, 0});
     targetStamp_.assign(n, 0);
     target_.assign(n, kNoIndex);
     cut_.resize(n);
@@ -41,11 +46,17 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
     newlyRefined_.resize(n);
     proxies_.resize(n);
     originals_.resize(file.objectCount());
+    posInCut_.assign(n, kNoIndex);
+    posInProxies_.assign(n, kNoIndex);
+    posInOriginals_.assign(file.objectCount(), kNoIndex);
+    leaseSerial_.assign(n, 0);
+    heap_.reserve(2 * size_t(n) + 16);
     reset();
 }
 
 void Selector::reset() {
-    std::fill(refined_.begin(), refined_.end(), 0);
+    dropIndex();
+    for (State& st : state_) st.refined = 0;
     nextSize_ = proxyCount_ = originalCount_ = 0;
     for (uint32_t root : file_->roots()) emit(root);
     std::swap(cut_, nextCut_);
@@ -62,7 +73,7 @@ Selector::Frame Selector::makeFrame(const float p[3], float k, float tau, float 
 }
 
 float Selector::screenSpaceErrorOf(uint32_t node, const Camera& camera) const {
-    const Bound& b = bounds_[node];
+    const Hot& b = hot_[node];
     double d2 = 0;
     for (int k = 0; k < 3; ++k) {
         const double d = double(camera.position[k]) - b.center[k];
@@ -74,7 +85,7 @@ float Selector::screenSpaceErrorOf(uint32_t node, const Camera& camera) const {
 
 // sse > tau  <=>  error * k / tau > d  <=>  |p - c| < error * reach + radius (no sqrt, no divide).
 inline bool Selector::exceeds(uint32_t node, float reach) const {
-    const Bound& b = bounds_[node];
+    const Hot& b = hot_[node];
     if (!(b.error > 0.0f)) return false;
     const float dx = frameP_[0] - b.center[0], dy = frameP_[1] - b.center[1], dz = frameP_[2] - b.center[2];
     const float r = b.error * reach + b.radius;
@@ -82,19 +93,21 @@ inline bool Selector::exceeds(uint32_t node, float reach) const {
 }
 
 inline bool Selector::refine(uint32_t node, const Frame& f) {
-    if (decidedStamp_[node] == frame_) return decision_[node] != 0;
+    State& st = state_[node];
+    if (st.decidedStamp == frame_) return st.decision != 0;
     ++stats_.errorTests;
-    const bool yes = !childless_[node] &&
-                     (exceeds(node, f.reachRefine) || (refined_[node] && exceeds(node, f.reachCoarsen)));
-    decidedStamp_[node] = frame_;
-    decision_[node] = yes;
+    const bool yes = hot_[node].leafSources == 0 &&
+                     (exceeds(node, f.reachRefine) || (st.refined && exceeds(node, f.reachCoarsen)));
+    st.decidedStamp = frame_;
+    st.decision = yes;
     return yes;
 }
 
 inline void Selector::emit(uint32_t node) {
     nextCut_[nextSize_++] = node;
-    if (childless_[node]) {
-        for (uint32_t o : file_->sources(node)) originals_[originalCount_++] = o;
+    const Hot& h = hot_[node];
+    if (h.leafSources != 0) {
+        for (uint32_t k = 0; k < h.leafSources; ++k) originals_[originalCount_++] = sourceObjects_[h.firstSource + k];
     } else {
         proxies_[proxyCount_++] = node;
     }
@@ -106,7 +119,7 @@ void Selector::descend(uint32_t start, const Frame& f) {
     while (top > 0) {
         const uint32_t x = stack_[--top];
         if (refine(x, f)) {
-            refined_[x] = 1;
+            state_[x].refined = 1;
             ++stats_.refined;
             const Span<uint32_t> kids = file_->children(x);
             for (size_t i = kids.size; i-- > 0;) stack_[top++] = kids[i];
@@ -118,14 +131,12 @@ void Selector::descend(uint32_t start, const Frame& f) {
 
 void Selector::beginFrame(const Frame& f) {
     if (++frame_ == 0) {  // stamp wrap-around after 2^32 frames
-        std::fill(decidedStamp_.begin(), decidedStamp_.end(), 0);
-        std::fill(emittedStamp_.begin(), emittedStamp_.end(), 0);
+        for (State& st : state_) st.decidedStamp = st.emittedStamp = 0;
         std::fill(targetStamp_.begin(), targetStamp_.end(), 0);
         frame_ = 1;
     }
     for (int k = 0; k < 3; ++k) frameP_[k] = f.p[k];
     stats_ = {};
-    nextSize_ = proxyCount_ = originalCount_ = 0;
 }
 
 void Selector::endFrame() {
@@ -134,30 +145,32 @@ void Selector::endFrame() {
 }
 
 void Selector::runIncremental(const Frame& f) {
+    dropIndex();
     beginFrame(f);
+    nextSize_ = proxyCount_ = originalCount_ = 0;
     for (uint32_t i = 0; i < cutSize_; ++i) {
         const uint32_t n = cut_[i];
-        const uint32_t parent = bounds_[n].parent;
+        const uint32_t parent = hot_[n].parent;
         if (parent != kNoIndex && !refine(parent, f)) {
             uint32_t top;
             if (targetStamp_[parent] == frame_) {
                 top = target_[parent];  // a sibling already climbed from here
             } else {
                 top = parent;
-                for (uint32_t g = bounds_[top].parent; g != kNoIndex && !refine(g, f); g = bounds_[g].parent) top = g;
+                for (uint32_t g = hot_[top].parent; g != kNoIndex && !refine(g, f); g = hot_[g].parent) top = g;
                 targetStamp_[parent] = frame_;
                 target_[parent] = top;
-                for (uint32_t x = parent;; x = bounds_[x].parent) {
-                    refined_[x] = 0;
+                for (uint32_t x = parent;; x = hot_[x].parent) {
+                    state_[x].refined = 0;
                     if (x == top) break;
                 }
             }
-            if (emittedStamp_[top] != frame_) {
-                emittedStamp_[top] = frame_;
+            if (state_[top].emittedStamp != frame_) {
+                state_[top].emittedStamp = frame_;
                 ++stats_.coarsened;
                 emit(top);
             }
-        } else if (refine(n, f)) {
+        } else if (hot_[n].leafSources == 0 && refine(n, f)) {
             descend(n, f);
         } else {
             emit(n);
@@ -167,7 +180,9 @@ void Selector::runIncremental(const Frame& f) {
 }
 
 void Selector::runFull(const Frame& f) {
+    dropIndex();
     beginFrame(f);
+    nextSize_ = proxyCount_ = originalCount_ = 0;
     uint32_t top = 0, refinedCount = 0;
     const Span<uint32_t> roots = file_->roots();
     for (size_t i = roots.size; i-- > 0;) stack_[top++] = roots[i];
@@ -183,9 +198,9 @@ void Selector::runFull(const Frame& f) {
     }
     // Refined flags now describe the new cut: clear the old ancestors, mark the new ones.
     for (uint32_t i = 0; i < cutSize_; ++i)
-        for (uint32_t x = bounds_[cut_[i]].parent; x != kNoIndex && refined_[x]; x = bounds_[x].parent)
-            refined_[x] = 0;
-    for (uint32_t i = 0; i < refinedCount; ++i) refined_[newlyRefined_[i]] = 1;
+        for (uint32_t x = hot_[cut_[i]].parent; x != kNoIndex && state_[x].refined; x = hot_[x].parent)
+            state_[x].refined = 0;
+    for (uint32_t i = 0; i < refinedCount; ++i) state_[newlyRefined_[i]].refined = 1;
     stats_.refined = refinedCount;
     endFrame();
 }
@@ -196,8 +211,8 @@ static float projectionScale(const Camera& camera) {
 }
 
 void Selector::select(const Camera& camera, const SelectionSettings& settings) {
-    runIncremental(makeFrame(camera.position, projectionScale(camera), settings.pixelTolerance,
-                             settings.coarsenRatio));
+    selectLeased(makeFrame(camera.position, projectionScale(camera), settings.pixelTolerance,
+                           settings.coarsenRatio));
 }
 
 void Selector::selectFull(const Camera& camera, const SelectionSettings& settings) {
@@ -206,7 +221,176 @@ void Selector::selectFull(const Camera& camera, const SelectionSettings& setting
 }
 
 void Selector::selectByDistance(const float point[3], float maxErrorPerDistance, float coarsenRatio) {
-    runIncremental(makeFrame(point, 1.0f, maxErrorPerDistance, coarsenRatio));
+    selectLeased(makeFrame(point, 1.0f, maxErrorPerDistance, coarsenRatio));
+}
+
+// ---- leases -------------------------------------------------------------------------------
+
+void Selector::selectLeased(const Frame& f) {
+    if (leasesValid_ && f.reachRefine == leaseReach_[0] && f.reachCoarsen == leaseReach_[1]) {
+        runLeased(f);
+        return;
+    }
+    runIncremental(f);
+    indexCut(f);
+}
+
+// Forgets positions and leases of the current cut (before a pass that rebuilds the lists).
+void Selector::dropIndex() {
+    if (!leasesValid_) return;
+    for (uint32_t i = 0; i < cutSize_; ++i) {
+        const uint32_t x = cut_[i];
+        posInCut_[x] = posInProxies_[x] = kNoIndex;
+        ++leaseSerial_[x];
+        const Hot& h = hot_[x];
+        for (uint32_t k = 0; k < h.leafSources; ++k) posInOriginals_[sourceObjects_[h.firstSource + k]] = kNoIndex;
+    }
+    heap_.clear();
+    leasesValid_ = false;
+}
+
+void Selector::indexCut(const Frame& f) {
+    for (uint32_t i = 0; i < cutSize_; ++i) posInCut_[cut_[i]] = i;
+    for (uint32_t i = 0; i < proxyCount_; ++i) posInProxies_[proxies_[i]] = i;
+    for (uint32_t i = 0; i < originalCount_; ++i) posInOriginals_[originals_[i]] = i;
+    heap_.clear();
+    for (int k = 0; k < 3; ++k) leaseP_[k] = f.p[k];
+    for (uint32_t i = 0; i < cutSize_; ++i) grantLease(cut_[i], f);
+    leaseReach_[0] = f.reachRefine;
+    leaseReach_[1] = f.reachCoarsen;
+    leasesValid_ = true;
+}
+
+// Distance from the camera to the boundary of the sphere "decision changes here", minus a
+// margin for float rounding of the test in exceeds().
+inline float Selector::slack(uint32_t node, float reach, const Frame& f) const {
+    const Hot& h = hot_[node];
+    const float dx = f.p[0] - h.center[0], dy = f.p[1] - h.center[1], dz = f.p[2] - h.center[2];
+    const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    const float r = h.error * reach + h.radius;
+    return std::fabs(d - r) - 1e-5f * (d + r);
+}
+
+void Selector::grantLease(uint32_t node, const Frame& f) {
+    const Hot& h = hot_[node];
+    float s = INFINITY;
+    if (h.leafSources == 0 && h.error > 0.0f) s = slack(node, f.reachRefine, f);
+    if (h.parent != kNoIndex) s = std::min(s, slack(h.parent, f.reachCoarsen, f));
+    const uint32_t serial = ++leaseSerial_[node];
+    if (s == INFINITY) return;  // nothing can change this node's state
+    if (heap_.size() == heap_.capacity() || heap_.size() > 2 * size_t(cutSize_) + 64) {
+        // Drop stale entries (nodes that left the cut or got a newer lease): the valid ones
+        // are at most one per cut node, so this always frees room, and keeping the heap
+        // within twice the cut keeps its sifts in cache. Amortised by the pushes it undoes.
+        size_t kept = 0;
+        for (const Lease& l : heap_)
+            if (posInCut_[l.node] != kNoIndex && leaseSerial_[l.node] == l.serial) heap_[kept++] = l;
+        heap_.resize(kept);
+        std::make_heap(heap_.begin(), heap_.end(), [](const Lease& a, const Lease& b) { return a.expiry > b.expiry; });
+    }
+    heap_.push_back({odometer_ + double(std::max(s, 0.0f)), node, serial});
+    std::push_heap(heap_.begin(), heap_.end(), [](const Lease& a, const Lease& b) { return a.expiry > b.expiry; });
+}
+
+void Selector::insertNode(uint32_t node, const Frame& f) {
+    posInCut_[node] = cutSize_;
+    cut_[cutSize_++] = node;
+    const Hot& h = hot_[node];
+    if (h.leafSources != 0) {
+        for (uint32_t k = 0; k < h.leafSources; ++k) {
+            const uint32_t o = sourceObjects_[h.firstSource + k];
+            posInOriginals_[o] = originalCount_;
+            originals_[originalCount_++] = o;
+        }
+    } else {
+        posInProxies_[node] = proxyCount_;
+        proxies_[proxyCount_++] = node;
+    }
+    grantLease(node, f);
+}
+
+void Selector::removeNode(uint32_t node) {
+    const uint32_t i = posInCut_[node];
+    const uint32_t last = cut_[--cutSize_];
+    cut_[i] = last;
+    posInCut_[last] = i;
+    posInCut_[node] = kNoIndex;
+    ++leaseSerial_[node];
+    const Hot& h = hot_[node];
+    if (h.leafSources != 0) {
+        for (uint32_t k = 0; k < h.leafSources; ++k) {
+            const uint32_t o = sourceObjects_[h.firstSource + k];
+            const uint32_t j = posInOriginals_[o];
+            const uint32_t lastObject = originals_[--originalCount_];
+            originals_[j] = lastObject;
+            posInOriginals_[lastObject] = j;
+            posInOriginals_[o] = kNoIndex;
+        }
+    } else {
+        const uint32_t j = posInProxies_[node];
+        const uint32_t lastProxy = proxies_[--proxyCount_];
+        proxies_[j] = lastProxy;
+        posInProxies_[lastProxy] = j;
+        posInProxies_[node] = kNoIndex;
+    }
+}
+
+void Selector::handleExpired(uint32_t n, const Frame& f) {
+    const uint32_t parent = hot_[n].parent;
+    if (parent != kNoIndex && !refine(parent, f)) {
+        uint32_t top = parent;
+        for (uint32_t g = hot_[top].parent; g != kNoIndex && !refine(g, f); g = hot_[g].parent) top = g;
+        // Everything of the cut under `top` goes: walk down through the refined nodes (each
+        // of them is an ancestor of cut nodes, since the cut covers every path once).
+        uint32_t sp = 0;
+        stack_[sp++] = top;
+        while (sp > 0) {
+            const uint32_t x = stack_[--sp];
+            if (posInCut_[x] != kNoIndex) {
+                removeNode(x);
+            } else {
+                state_[x].refined = 0;
+                const Span<uint32_t> kids = file_->children(x);
+                for (size_t i = 0; i < kids.size; ++i) stack_[sp++] = kids[i];
+            }
+        }
+        ++stats_.coarsened;
+        insertNode(top, f);
+    } else if (hot_[n].leafSources == 0 && refine(n, f)) {
+        removeNode(n);
+        uint32_t sp = 0;
+        stack_[sp++] = n;
+        while (sp > 0) {
+            const uint32_t x = stack_[--sp];
+            if (refine(x, f)) {
+                state_[x].refined = 1;
+                ++stats_.refined;
+                const Span<uint32_t> kids = file_->children(x);
+                for (size_t i = 0; i < kids.size; ++i) stack_[sp++] = kids[i];
+            } else {
+                insertNode(x, f);
+            }
+        }
+    } else {
+        grantLease(n, f);
+    }
+}
+
+void Selector::runLeased(const Frame& f) {
+    beginFrame(f);
+    const double dx = double(f.p[0]) - leaseP_[0], dy = double(f.p[1]) - leaseP_[1], dz = double(f.p[2]) - leaseP_[2];
+    odometer_ += std::sqrt(dx * dx + dy * dy + dz * dz);
+    for (int k = 0; k < 3; ++k) leaseP_[k] = f.p[k];
+    const auto later = [](const Lease& a, const Lease& b) { return a.expiry > b.expiry; };
+    // Leases granted during this frame expire at >= odometer_: they are not popped again now.
+    while (!heap_.empty() && heap_.front().expiry < odometer_) {
+        const Lease l = heap_.front();
+        std::pop_heap(heap_.begin(), heap_.end(), later);
+        heap_.pop_back();
+        if (leaseSerial_[l.node] != l.serial || posInCut_[l.node] == kNoIndex) continue;  // stale
+        ++stats_.leasesExpired;
+        handleExpired(l.node, f);
+    }
 }
 
 }  // namespace aggrelod::runtime

@@ -60,6 +60,7 @@ struct HierarchyBuilder {
     runtime::BuildParams& p;
     const std::vector<SyntheticBox>& boxes;
     uint32_t branching;
+    float errorScale;
 
     // Builds the subtree over objects ids[first, last); returns its node index and height.
     std::pair<uint32_t, uint32_t> build(std::vector<uint32_t>& ids, size_t first, size_t last) {
@@ -136,7 +137,7 @@ struct HierarchyBuilder {
             radius = std::max(radius, std::sqrt(d2) + cn.sphereRadius);
         }
         node.sphereRadius = float(radius * (1.0 + 1e-6) + 1e-4);
-        node.geometricError = float(0.5 * std::sqrt(diag2));
+        node.geometricError = float(errorScale * 0.5 * std::sqrt(diag2));
         for (uint32_t c : kids) node.geometricError = std::max(node.geometricError, p.nodes[c].geometricError);
         appendBoxMesh(p, node, node.boundsMin, node.boundsMax);
         const uint32_t self = static_cast<uint32_t>(p.nodes.size());
@@ -158,15 +159,18 @@ struct HierarchyBuilder {
 }  // namespace detail
 
 /// A hierarchy over `objectCount` city boxes: about objectCount*b/(b-1) nodes. `roots` > 1
-/// splits the objects into that many separate trees.
+/// splits the objects into that many separate trees. An inner node's error is errorScale
+/// times half its box diagonal (1 = the box proxy's true one-sided distance bound; smaller
+/// values mimic proxies that hug their originals, as the bake's).
 inline runtime::BuildParams makeSyntheticHierarchy(uint32_t objectCount, uint32_t seed,
-                                                   uint32_t branching = 4, uint32_t roots = 1) {
+                                                   uint32_t branching = 4, uint32_t roots = 1,
+                                                   float errorScale = 1.0f) {
     runtime::BuildParams p;
     const std::vector<SyntheticBox> boxes = makeCityBoxes(objectCount, seed);
     for (uint32_t i = 0; i < objectCount; ++i) p.objectNames.push_back("box" + std::to_string(i));
     std::vector<uint32_t> ids(objectCount);
     std::iota(ids.begin(), ids.end(), 0u);
-    detail::HierarchyBuilder builder{p, boxes, branching};
+    detail::HierarchyBuilder builder{p, boxes, branching, errorScale};
     roots = std::max(1u, std::min(roots, objectCount));
     for (uint32_t r = 0; r < roots; ++r)
         builder.build(ids, size_t(objectCount) * r / roots, size_t(objectCount) * (r + 1) / roots);

@@ -104,6 +104,8 @@ public:
     Span<float> vertices(uint32_t node) const;  ///< 3 floats per vertex, world units
     Span<uint32_t> triangles(uint32_t node) const;  ///< 3 per triangle, relative to node's vertices
     bool isLeaf(uint32_t node) const { return nodes_.data[node].childCount == 0; }
+    /// The whole source-object array (NodeRecord::firstSource indexes it).
+    Span<uint32_t> allSourceObjects() const { return sourceObjects_; }
     /// Name of original object `object` (< objectCount()), UTF-8.
     std::string_view objectName(uint32_t object) const;
     /// Largest number of nodes on a root-to-leaf path.

@@ -33,6 +33,7 @@ struct SelectionStats {
     uint32_t errorTests = 0;  ///< nodes whose screen-space error was evaluated
     uint32_t refined = 0;     ///< nodes replaced by their children this frame
     uint32_t coarsened = 0;   ///< nodes that replaced their descendants this frame
+    uint32_t leasesExpired = 0;  ///< cut nodes re-examined because the camera moved enough
 };
 
 /// Per-file selection state. Allocates once (O(nodes + objects)) at construction; select()
@@ -76,11 +77,19 @@ public:
     float screenSpaceErrorOf(uint32_t node, const Camera& camera) const;
 
 private:
-    struct Bound {  // compact copy of what the rule reads, 24 bytes per node
+    struct Hot {  // what the rule and the output read, 32 bytes per node
         float center[3];
         float radius;
         float error;
         uint32_t parent;
+        uint32_t firstSource;
+        uint32_t leafSources;  // sourceCount for a leaf, 0 for an inner node
+    };
+    struct State {  // per-node frame state, 12 bytes
+        uint32_t decidedStamp;  // frame in which refine() was cached
+        uint32_t emittedStamp;  // frame in which the node was emitted by a coarsening
+        uint8_t decision;
+        uint8_t refined;        // refined in the previous (then current) frame
     };
     struct Frame {  // per-call parameters of the rule
         float p[3];
@@ -95,18 +104,37 @@ private:
     void endFrame();
     void runIncremental(const Frame& f);
     void runFull(const Frame& f);
+    // Leases (see selection.cpp): per cut node, how far the camera may travel before its
+    // decision (or its parent's) can change; only expired nodes are re-examined.
+    struct Lease {
+        double expiry;  // odometer value
+        uint32_t node;
+        uint32_t serial;
+    };
+    void selectLeased(const Frame& f);
+    void runLeased(const Frame& f);
+    void dropIndex();
+    void indexCut(const Frame& f);
+    void insertNode(uint32_t node, const Frame& f);
+    void removeNode(uint32_t node);
+    void grantLease(uint32_t node, const Frame& f);
+    void handleExpired(uint32_t node, const Frame& f);
+    float slack(uint32_t node, float reach, const Frame& f) const;
     static Frame makeFrame(const float p[3], float k, float tau, float coarsenRatio);
 
     const RuntimeFile* file_;
-    std::vector<Bound> bounds_;
-    std::vector<uint8_t> childless_;
-    std::vector<uint8_t> refined_;       // refined in the previous (then current) frame
-    std::vector<uint32_t> decidedStamp_; // frame in which refine() was cached
-    std::vector<uint8_t> decision_;
-    std::vector<uint32_t> emittedStamp_;
+    const uint32_t* sourceObjects_ = nullptr;
+    std::vector<Hot> hot_;
+    std::vector<State> state_;
     std::vector<uint32_t> targetStamp_, target_;  // per-frame memo of coarsening climbs
     float frameP_[3] = {0, 0, 0};
     std::vector<uint32_t> cut_, nextCut_, stack_, newlyRefined_, proxies_, originals_;
+    std::vector<uint32_t> posInCut_, posInProxies_, posInOriginals_, leaseSerial_;
+    std::vector<Lease> heap_;  // min-heap on expiry, capacity fixed at construction
+    double odometer_ = 0;      // camera path length since construction, world units
+    float leaseP_[3] = {0, 0, 0};
+    float leaseReach_[2] = {-1, -1};
+    bool leasesValid_ = false;
     uint32_t cutSize_ = 0, proxyCount_ = 0, originalCount_ = 0, nextSize_ = 0;
     uint32_t frame_ = 0;
     SelectionStats stats_;

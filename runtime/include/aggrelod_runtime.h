@@ -1,0 +1,126 @@
+/* aggrelod runtime, C API: open a baked `.aglod` file, select the nodes to draw for a camera,
+ * cast rays against a cut (optional collision library). For engines written in C or bound
+ * from other languages. Plain C99; every function is safe to call with NULL handles (it then
+ * returns an error or does nothing).
+ *
+ * Link: aggrelod_runtime (open, select) and aggrelod_runtime_collision (the aglod_collision_*
+ * and aglod_raycast functions; needs Embree 3).
+ *
+ * Memory: handles are created and destroyed by the pair functions below. Arrays returned in
+ * aglod_cut / aglod_hit are views owned by the selector / file: valid until the next call on
+ * the same selector, or until the file is closed. */
+#ifndef AGGRELOD_RUNTIME_H
+#define AGGRELOD_RUNTIME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Same values as aggrelod::runtime::FileStatus, plus AGLOD_INVALID_ARGUMENT. */
+typedef enum aglod_status {
+    AGLOD_OK = 0,
+    AGLOD_IO_ERROR = 1,
+    AGLOD_WRONG_MAGIC = 2,
+    AGLOD_WRONG_VERSION = 3,
+    AGLOD_TRUNCATED = 4,
+    AGLOD_CHECKSUM_MISMATCH = 5,
+    AGLOD_BAD_SECTION = 6,
+    AGLOD_INDEX_OUT_OF_RANGE = 7,
+    AGLOD_BAD_TREE = 8,
+    AGLOD_BAD_VALUE = 9,
+    AGLOD_MISALIGNED = 10,
+    AGLOD_UNSUPPORTED_HOST = 11,
+    AGLOD_INVALID_ARGUMENT = 100,
+    AGLOD_COLLISION_ERROR = 101
+} aglod_status;
+
+typedef struct aglod_file aglod_file;
+typedef struct aglod_selector aglod_selector;
+typedef struct aglod_collision aglod_collision;
+
+/* Marks leaves (original objects) in aglod_node_level, and "originals" in aglod_collision_use_level. */
+#define AGLOD_LEAF_LEVEL 0xFFFFu
+#define AGLOD_NO_INDEX 0xFFFFFFFFu
+
+/* Short name of a status, e.g. "checksum mismatch". Never NULL. */
+const char* aglod_status_string(aglod_status status);
+/* Detailed message of the last failing call on this thread (e.g. "scene.aglod: node 12: child
+ * 40 has parent 3"); "" when none. Valid until the next failing call on this thread. */
+const char* aglod_last_error(void);
+
+/* Maps `path` read-only and validates it; *out is NULL on failure. */
+aglod_status aglod_open_file(const char* path, aglod_file** out);
+/* Validates `size` bytes at `data` (16-byte aligned) and uses them in place: the caller keeps
+ * them alive and unchanged until aglod_close. */
+aglod_status aglod_open_memory(const void* data, size_t size, aglod_file** out);
+void aglod_close(aglod_file* file);
+
+uint32_t aglod_node_count(const aglod_file* file);
+uint32_t aglod_object_count(const aglod_file* file);
+/* Level of a node (AGLOD_LEAF_LEVEL for originals), AGLOD_NO_INDEX when out of range. */
+uint32_t aglod_node_level(const aglod_file* file, uint32_t node);
+/* Geometric error of a node, world units (-1 when out of range). */
+float aglod_node_error(const aglod_file* file, uint32_t node);
+/* Axis-aligned box of a node, world units; 0 when out of range, 1 otherwise. */
+int aglod_node_bounds(const aglod_file* file, uint32_t node, float min[3], float max[3]);
+/* Box of the whole scene (union of the roots' boxes), world units. 0 when file is NULL. */
+int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]);
+/* Name of an original object, NUL-terminated copy into buffer (capacity bytes); returns the
+ * full length of the name (excluding NUL), or 0 when out of range. */
+size_t aglod_object_name(const aglod_file* file, uint32_t object, char* buffer, size_t capacity);
+
+typedef struct aglod_camera {
+    float position[3];     /* world units */
+    float fov_y;           /* vertical field of view, radians */
+    float viewport_height; /* pixels */
+} aglod_camera;
+
+/* The nodes to draw. Views owned by the selector, valid until its next aglod_select. */
+typedef struct aglod_cut {
+    const uint32_t* nodes;     uint32_t node_count;     /* all nodes of the cut */
+    const uint32_t* proxies;   uint32_t proxy_count;    /* inner nodes: draw their proxy mesh */
+    const uint32_t* originals; uint32_t original_count; /* objects the engine draws itself */
+} aglod_cut;
+
+/* One selector per view; allocates at creation only. NULL on failure. */
+aglod_selector* aglod_selector_create(const aglod_file* file);
+void aglod_selector_destroy(aglod_selector* selector);
+/* Screen-space-error selection, incremental from the previous call (DESIGN section 3).
+ * pixel_tolerance: tau in pixels (> 0); coarsen_ratio in (0, 1]: hysteresis (1 = none). */
+aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera,
+                          float pixel_tolerance, float coarsen_ratio, aglod_cut* out);
+
+/* ---- collision (aggrelod_runtime_collision, Embree 3) ---- */
+
+typedef struct aglod_hit {
+    float distance;           /* from the ray origin, world units */
+    float normal[3];          /* unit, outward by the triangle's winding */
+    uint32_t node;            /* node whose mesh was hit */
+    uint32_t triangle;        /* triangle in that mesh */
+    const uint32_t* objects;  /* original objects the node stands for (view into the file) */
+    uint32_t object_count;
+} aglod_hit;
+
+/* Starts with the originals (AGLOD_LEAF_LEVEL) as the cut. NULL on failure (see aglod_last_error). */
+aglod_collision* aglod_collision_create(const aglod_file* file);
+void aglod_collision_destroy(aglod_collision* collision);
+/* Collide against one level (AGLOD_LEAF_LEVEL = the originals). */
+aglod_status aglod_collision_use_level(aglod_collision* collision, uint32_t level);
+/* Collide against a cut finer near `point`: node error <= max_error_per_distance * distance. */
+aglod_status aglod_collision_use_distance_cut(aglod_collision* collision, const float point[3],
+                                              float max_error_per_distance);
+/* Closest hit along origin + t * direction, t in [0, max_distance]. 1 on a hit, 0 otherwise. */
+int aglod_raycast(const aglod_collision* collision, const float origin[3], const float direction[3],
+                  float max_distance, aglod_hit* hit);
+/* 1 when anything lies on the ray within max_distance, 0 otherwise. */
+int aglod_occluded(const aglod_collision* collision, const float origin[3], const float direction[3],
+                   float max_distance);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* AGGRELOD_RUNTIME_H */

@@ -1,0 +1,168 @@
+// C API of the runtime (aggrelod_runtime.h): file and selection. Thin wrappers over
+// RuntimeFile and Selector; no exception crosses the C boundary.
+#include <aggrelod_runtime.h>
+
+#include <aggrelod/runtime_file.h>
+#include <aggrelod/selection.h>
+
+#include "c_api_internal.h"
+
+#include <algorithm>
+#include <cstring>
+#include <new>
+
+using namespace aggrelod::runtime;
+
+struct aglod_selector {
+    Selector selector;
+    explicit aglod_selector(const RuntimeFile& f) : selector(f) {}
+};
+
+namespace aggrelod::runtime::capi {
+std::string& lastError() {
+    thread_local std::string message;
+    return message;
+}
+aglod_status failWith(aglod_status status, const std::string& message) {
+    lastError() = message;
+    return status;
+}
+}  // namespace aggrelod::runtime::capi
+
+using aggrelod::runtime::capi::failWith;
+
+extern "C" {
+
+const char* aglod_status_string(aglod_status status) {
+    switch (status) {
+        case AGLOD_INVALID_ARGUMENT: return "invalid argument";
+        case AGLOD_COLLISION_ERROR: return "collision error";
+        default:
+            if (status >= AGLOD_OK && status <= AGLOD_UNSUPPORTED_HOST) return toString(FileStatus(status));
+            return "unknown status";
+    }
+}
+
+const char* aglod_last_error(void) { return aggrelod::runtime::capi::lastError().c_str(); }
+
+static aglod_status finishOpen(FileStatus status, const std::string& message, RuntimeFile&& file,
+                               aglod_file** out) {
+    if (status != FileStatus::Ok) return failWith(aglod_status(status), message);
+    *out = new (std::nothrow) aglod_file{std::move(file)};
+    if (!*out) return failWith(AGLOD_IO_ERROR, "out of memory");
+    return AGLOD_OK;
+}
+
+aglod_status aglod_open_file(const char* path, aglod_file** out) {
+    if (!out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_open_file: out is NULL");
+    *out = nullptr;
+    if (!path) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_open_file: path is NULL");
+    try {
+        RuntimeFile file;
+        std::string message;
+        const FileStatus status = RuntimeFile::openFile(path, file, message);
+        return finishOpen(status, message, std::move(file), out);
+    } catch (const std::exception& e) {
+        return failWith(AGLOD_IO_ERROR, e.what());
+    }
+}
+
+aglod_status aglod_open_memory(const void* data, size_t size, aglod_file** out) {
+    if (!out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_open_memory: out is NULL");
+    *out = nullptr;
+    try {
+        RuntimeFile file;
+        std::string message;
+        const FileStatus status = RuntimeFile::openMemory(data, size, file, message);
+        return finishOpen(status, message, std::move(file), out);
+    } catch (const std::exception& e) {
+        return failWith(AGLOD_IO_ERROR, e.what());
+    }
+}
+
+void aglod_close(aglod_file* file) { delete file; }
+
+uint32_t aglod_node_count(const aglod_file* file) { return file ? file->file.nodeCount() : 0; }
+uint32_t aglod_object_count(const aglod_file* file) { return file ? file->file.objectCount() : 0; }
+
+uint32_t aglod_node_level(const aglod_file* file, uint32_t node) {
+    if (!file || node >= file->file.nodeCount()) return AGLOD_NO_INDEX;
+    return file->file.node(node).level;
+}
+
+float aglod_node_error(const aglod_file* file, uint32_t node) {
+    if (!file || node >= file->file.nodeCount()) return -1.0f;
+    return file->file.node(node).geometricError;
+}
+
+int aglod_node_bounds(const aglod_file* file, uint32_t node, float min[3], float max[3]) {
+    if (!file || !min || !max || node >= file->file.nodeCount()) return 0;
+    const NodeRecord& r = file->file.node(node);
+    for (int k = 0; k < 3; ++k) {
+        min[k] = r.boundsMin[k];
+        max[k] = r.boundsMax[k];
+    }
+    return 1;
+}
+
+int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]) {
+    if (!file || !min || !max) return 0;
+    for (int k = 0; k < 3; ++k) {
+        min[k] = 3.4e38f;
+        max[k] = -3.4e38f;
+    }
+    for (uint32_t root : file->file.roots()) {
+        const NodeRecord& r = file->file.node(root);
+        for (int k = 0; k < 3; ++k) {
+            min[k] = std::min(min[k], r.boundsMin[k]);
+            max[k] = std::max(max[k], r.boundsMax[k]);
+        }
+    }
+    return 1;
+}
+
+size_t aglod_object_name(const aglod_file* file, uint32_t object, char* buffer, size_t capacity) {
+    if (!file || object >= file->file.objectCount()) return 0;
+    const std::string_view name = file->file.objectName(object);
+    if (buffer && capacity > 0) {
+        const size_t n = std::min(name.size(), capacity - 1);
+        std::memcpy(buffer, name.data(), n);
+        buffer[n] = '\0';
+    }
+    return name.size();
+}
+
+aglod_selector* aglod_selector_create(const aglod_file* file) {
+    if (!file) {
+        failWith(AGLOD_INVALID_ARGUMENT, "aglod_selector_create: file is NULL");
+        return nullptr;
+    }
+    try {
+        return new aglod_selector(file->file);
+    } catch (const std::exception& e) {
+        failWith(AGLOD_IO_ERROR, e.what());
+        return nullptr;
+    }
+}
+
+void aglod_selector_destroy(aglod_selector* selector) { delete selector; }
+
+aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera, float pixel_tolerance,
+                          float coarsen_ratio, aglod_cut* out) {
+    if (!selector || !camera || !out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_select: NULL argument");
+    if (!(pixel_tolerance > 0) || !(coarsen_ratio > 0 && coarsen_ratio <= 1) || !(camera->fov_y > 0 && camera->fov_y < 3.14159f) ||
+        !(camera->viewport_height > 0))
+        return failWith(AGLOD_INVALID_ARGUMENT,
+                        "aglod_select: need pixel_tolerance > 0, coarsen_ratio in (0,1], fov_y in (0,pi), viewport_height > 0");
+    Camera c;
+    std::memcpy(c.position, camera->position, sizeof(c.position));
+    c.fovY = camera->fov_y;
+    c.viewportHeight = camera->viewport_height;
+    selector->selector.select(c, SelectionSettings{pixel_tolerance, coarsen_ratio});
+    const Selector& s = selector->selector;
+    *out = {s.cut().data, uint32_t(s.cut().size), s.proxyNodes().data, uint32_t(s.proxyNodes().size),
+            s.originalObjects().data, uint32_t(s.originalObjects().size)};
+    return AGLOD_OK;
+}
+
+}  // extern "C"

@@ -1,0 +1,85 @@
+// C API of the optional collision part (aggrelod_runtime.h, aglod_collision_* and
+// aglod_raycast): thin wrappers over CollisionWorld.
+#include <aggrelod_runtime.h>
+
+#include <aggrelod/collision.h>
+
+#include "c_api_internal.h"
+
+#include <new>
+
+using namespace aggrelod::runtime;
+using aggrelod::runtime::capi::failWith;
+
+struct aglod_collision {
+    CollisionWorld world;
+    explicit aglod_collision(const RuntimeFile& f) : world(f, 0) {}
+};
+
+extern "C" {
+
+aglod_collision* aglod_collision_create(const aglod_file* file) {
+    if (!file) {
+        failWith(AGLOD_INVALID_ARGUMENT, "aglod_collision_create: file is NULL");
+        return nullptr;
+    }
+    try {
+        auto* c = new aglod_collision(file->file);
+        c->world.useLevel(kLeafLevel);
+        if (!c->world.ok()) {
+            failWith(AGLOD_COLLISION_ERROR, c->world.error());
+            delete c;
+            return nullptr;
+        }
+        return c;
+    } catch (const std::exception& e) {
+        failWith(AGLOD_COLLISION_ERROR, e.what());
+        return nullptr;
+    }
+}
+
+void aglod_collision_destroy(aglod_collision* collision) { delete collision; }
+
+aglod_status aglod_collision_use_level(aglod_collision* collision, uint32_t level) {
+    if (!collision) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_collision_use_level: NULL collision");
+    try {
+        collision->world.useLevel(level);
+    } catch (const std::exception& e) {
+        return failWith(AGLOD_COLLISION_ERROR, e.what());
+    }
+    return collision->world.ok() ? AGLOD_OK : failWith(AGLOD_COLLISION_ERROR, collision->world.error());
+}
+
+aglod_status aglod_collision_use_distance_cut(aglod_collision* collision, const float point[3],
+                                              float max_error_per_distance) {
+    if (!collision || !point || !(max_error_per_distance > 0))
+        return failWith(AGLOD_INVALID_ARGUMENT, "aglod_collision_use_distance_cut: NULL argument or ratio <= 0");
+    try {
+        collision->world.useDistanceCut(point, max_error_per_distance);
+    } catch (const std::exception& e) {
+        return failWith(AGLOD_COLLISION_ERROR, e.what());
+    }
+    return collision->world.ok() ? AGLOD_OK : failWith(AGLOD_COLLISION_ERROR, collision->world.error());
+}
+
+int aglod_raycast(const aglod_collision* collision, const float origin[3], const float direction[3],
+                  float max_distance, aglod_hit* hit) {
+    if (!collision || !origin || !direction || !hit) return 0;
+    CollisionHit h;
+    if (!collision->world.raycast(origin, direction, max_distance, h)) return 0;
+    hit->distance = h.distance;
+    for (int k = 0; k < 3; ++k) hit->normal[k] = h.normal[k];
+    hit->node = h.node;
+    hit->triangle = h.triangle;
+    hit->objects = h.objects.data;
+    hit->object_count = uint32_t(h.objects.size);
+    return 1;
+}
+
+int aglod_occluded(const aglod_collision* collision, const float origin[3], const float direction[3],
+                   float max_distance) {
+    if (!collision || !origin || !direction) return 0;
+    return collision->world.occluded(origin, direction, max_distance) ? 1 : 0;
+}
+
+}  // extern "C"

@@ -1,0 +1,190 @@
+// Collision queries with Embree (DESIGN section 3) against cuts of a synthetic hierarchy:
+// hits equal a brute-force ray/triangle search, coarser levels are conservative (their box
+// proxies contain the originals), segment and occlusion agree with the ray query, and a hit
+// names the original objects of its node.
+#include <aggrelod/runtime_file.h>
+
+#if __has_include(<aggrelod/collision.h>)
+#include <aggrelod/collision.h>
+#endif
+#include "synthetic_hierarchy.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#ifdef AGGRELOD_HAVE_COLLISION
+using namespace aggrelod::runtime;
+using aggrelod::testing::makeSyntheticHierarchy;
+
+namespace {
+
+struct BruteHit {
+    double t = INFINITY;
+    uint32_t node = kNoIndex;
+};
+
+// Moller-Trumbore in double over every triangle of the cut.
+BruteHit bruteForce(const RuntimeFile& file, const std::vector<uint32_t>& cut, const double o[3],
+                    const double d[3], double maxT) {
+    BruteHit best;
+    for (uint32_t node : cut) {
+        const Span<float> v = file.vertices(node);
+        const Span<uint32_t> t = file.triangles(node);
+        for (size_t i = 0; i < t.size; i += 3) {
+            const float* a = &v[3 * t[i]];
+            const float* b = &v[3 * t[i + 1]];
+            const float* c = &v[3 * t[i + 2]];
+            const double e1[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+            const double e2[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+            const double p[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+            const double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+            if (std::fabs(det) < 1e-12) continue;
+            const double s[3] = {o[0] - a[0], o[1] - a[1], o[2] - a[2]};
+            const double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+            if (u < 0 || u > 1) continue;
+            const double q[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
+            const double w = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+            if (w < 0 || u + w > 1) continue;
+            const double tt = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+            if (tt >= 0 && tt <= maxT && tt < best.t) best = {tt, node};
+        }
+    }
+    return best;
+}
+
+struct Fixture {
+    std::vector<uint8_t> bytes;
+    RuntimeFile file;
+    explicit Fixture(uint32_t objects, uint32_t seed) {
+        std::string error;
+        EXPECT_TRUE(writeRuntimeFile(makeSyntheticHierarchy(objects, seed, 3), bytes, error)) << error;
+        EXPECT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), file, error), FileStatus::Ok) << error;
+    }
+};
+
+// Rays from outside the scene box towards random points inside it.
+void randomRay(std::mt19937& rng, const RuntimeFile& file, double o[3], double d[3]) {
+    const NodeRecord& root = file.node(file.roots()[0]);
+    std::uniform_real_distribution<double> u(0, 1);
+    double target[3];
+    for (int k = 0; k < 3; ++k) target[k] = root.boundsMin[k] + u(rng) * (root.boundsMax[k] - root.boundsMin[k]);
+    double dir[3] = {u(rng) - 0.5, u(rng) * 0.6 - 0.1, u(rng) - 0.5};
+    const double len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    const double far = 2.0 * root.sphereRadius + 10.0;
+    for (int k = 0; k < 3; ++k) {
+        d[k] = -dir[k] / len;
+        o[k] = target[k] + dir[k] / len * far;
+    }
+}
+
+}  // namespace
+
+TEST(RuntimeCollision, RaycastAtEveryLevelMatchesBruteForce) {
+    Fixture f(150, 21);
+    CollisionWorld world(f.file, 1);
+    ASSERT_TRUE(world.ok()) << world.error();
+    std::vector<uint32_t> levels = levelsOf(f.file);
+    levels.push_back(kLeafLevel);
+    ASSERT_GE(levels.size(), 4u);
+    std::mt19937 rng(5);
+    for (uint32_t level : levels) {
+        world.useLevel(level);
+        std::vector<uint32_t> cut;
+        cutAtLevel(f.file, level, cut);
+        ASSERT_EQ(world.currentCut(), cut);
+        int hits = 0, mismatches = 0;
+        for (int i = 0; i < 500; ++i) {
+            double o[3], d[3];
+            randomRay(rng, f.file, o, d);
+            const float of[3] = {float(o[0]), float(o[1]), float(o[2])};
+            const float df[3] = {float(d[0]), float(d[1]), float(d[2])};
+            CollisionHit hit;
+            const bool got = world.raycast(of, df, 1e6f, hit);
+            const double od[3] = {of[0], of[1], of[2]}, dd[3] = {df[0], df[1], df[2]};
+            const double dl = std::sqrt(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
+            const double du[3] = {dd[0] / dl, dd[1] / dl, dd[2] / dl};
+            const BruteHit ref = bruteForce(f.file, cut, od, du, 1e6);
+            if (got != (ref.node != kNoIndex)) {
+                ++mismatches;
+                continue;
+            }
+            if (!got) continue;
+            ++hits;
+            EXPECT_NEAR(hit.distance, ref.t, 1e-3 * (1 + ref.t));
+            const double nlen = std::sqrt(hit.normal[0] * hit.normal[0] + hit.normal[1] * hit.normal[1] + hit.normal[2] * hit.normal[2]);
+            EXPECT_NEAR(nlen, 1.0, 1e-5);
+            // Outward box faces seen from outside face the ray.
+            EXPECT_LT(hit.normal[0] * du[0] + hit.normal[1] * du[1] + hit.normal[2] * du[2], 0.0);
+            ASSERT_EQ(hit.objects.size, f.file.sources(hit.node).size);
+            EXPECT_EQ(hit.objects.data, f.file.sources(hit.node).data);
+        }
+        EXPECT_LE(mismatches, 1) << "level " << level;  // grazing edge hits may differ
+        EXPECT_GT(hits, 100) << "level " << level;
+    }
+}
+
+TEST(RuntimeCollision, CoarserLevelsAreHitNoLaterThanTheOriginals) {
+    Fixture f(300, 22);
+    CollisionWorld originals(f.file, 1), level(f.file, 1);
+    originals.useLevel(kLeafLevel);
+    std::mt19937 rng(6);
+    for (uint32_t l : levelsOf(f.file)) {
+        level.useLevel(l);
+        int compared = 0, violations = 0;
+        for (int i = 0; i < 2000; ++i) {
+            double o[3], d[3];
+            randomRay(rng, f.file, o, d);
+            const float of[3] = {float(o[0]), float(o[1]), float(o[2])};
+            const float df[3] = {float(d[0]), float(d[1]), float(d[2])};
+            CollisionHit a, b;
+            if (!originals.raycast(of, df, 1e6f, a)) continue;
+            ++compared;
+            if (!level.raycast(of, df, 1e6f, b) || b.distance > a.distance + 1e-3f) ++violations;
+        }
+        EXPECT_EQ(violations, 0) << "level " << l;
+        EXPECT_GT(compared, 500) << "level " << l;
+    }
+}
+
+TEST(RuntimeCollision, SegmentAndOcclusionAgreeWithTheRay) {
+    Fixture f(120, 23);
+    CollisionWorld world(f.file, 1);
+    const float point[3] = {30, 5, 30};
+    world.useDistanceCut(point, 0.3f);
+    // The distance cut covers every object exactly once.
+    std::vector<int> cover(f.file.objectCount(), 0);
+    for (uint32_t n : world.currentCut())
+        for (uint32_t o : f.file.sources(n)) ++cover[o];
+    for (int c : cover) ASSERT_EQ(c, 1);
+    std::mt19937 rng(7);
+    int hits = 0;
+    for (int i = 0; i < 1000; ++i) {
+        double o[3], d[3];
+        randomRay(rng, f.file, o, d);
+        const float of[3] = {float(o[0]), float(o[1]), float(o[2])};
+        const float df[3] = {float(d[0]), float(d[1]), float(d[2])};
+        const float reach = std::uniform_real_distribution<float>(10.0f, 400.0f)(rng);
+        CollisionHit ray, seg;
+        const bool hitRay = world.raycast(of, df, reach, ray);
+        EXPECT_EQ(world.occluded(of, df, reach), hitRay);
+        const float end[3] = {of[0] + df[0] * reach, of[1] + df[1] * reach, of[2] + df[2] * reach};
+        const bool hitSeg = world.segment(of, end, seg);
+        EXPECT_EQ(hitSeg, hitRay);
+        if (hitRay && hitSeg) {
+            ++hits;
+            EXPECT_NEAR(seg.distance, ray.distance, 1e-3f * (1 + ray.distance));
+            EXPECT_EQ(seg.node, ray.node);
+        }
+    }
+    EXPECT_GT(hits, 100);
+    // Degenerate queries are refused without a hit, never a crash.
+    const float zero[3] = {0, 0, 0}, o[3] = {0, 0, 0};
+    CollisionHit hit;
+    EXPECT_FALSE(world.raycast(o, zero, 10.0f, hit));
+    EXPECT_FALSE(world.occluded(o, zero, 10.0f));
+}
+#else
+TEST(RuntimeCollision, NotBuilt) { GTEST_SKIP() << "Embree 3 not found: aggrelod_runtime_collision not built"; }
+#endif
