@@ -33,6 +33,7 @@ void simplifyMesh(const std::vector<float>& positions, const std::vector<uint32_
                                               vertexCount, 3 * sizeof(float), 0,
                                               static_cast<float>(targetError / extent), 0, nullptr);
         kept.resize(count);
+        if (kept.empty()) kept = indices;  // never simplify a mesh away: keep it exact
     } else {
         kept = indices;
     }

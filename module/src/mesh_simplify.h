@@ -11,7 +11,8 @@ namespace aggrelod::detail {
 /// until the next collapse would exceed `targetError` (world units; meshoptimizer's own
 /// quadric estimate, not a guarantee: measure the result). positions: 3 * vertexCount
 /// floats; indices: 3 * triangleCount. The output keeps only the used vertices, numbered
-/// by first use. targetError <= 0 or an empty mesh copies the input. Deterministic.
+/// by first use. targetError <= 0, an empty mesh or a mesh that would vanish copies the
+/// input. Deterministic.
 void simplifyMesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
                   double targetError, std::vector<float>& outPositions,
                   std::vector<uint32_t>& outIndices);

@@ -217,7 +217,21 @@ ProxyError measureProxyError(const std::vector<float>& proxyPositions,
     }
     ProxyError e;
     e.tolerance = tolerance;
-    if (proxy.triangleCount() == 0 || orig.triangleCount() == 0) return e;
+    if (orig.triangleCount() == 0) return e;
+    if (proxy.triangleCount() == 0) {
+        // Nothing drawn in place of the originals: they vanish, an error as large as their
+        // extent (the diagonal of their box), so the node is used only when all of it is
+        // below the tolerance on screen.
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i + 2 < orig.positions.size(); i += 3)
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::min(lo[k], orig.positions[i + k]);
+                hi[k] = std::max(hi[k], orig.positions[i + k]);
+            }
+        e.originalsToProxy = e.originalsToProxyLower =
+            std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        return e;
+    }
     TriangleBvh proxyBvh, origBvh;
     proxyBvh.build(proxy.positions.data(), proxy.positions.size() / 3, proxy.indices.data(), proxy.triangleCount());
     origBvh.build(orig.positions.data(), orig.positions.size() / 3, orig.indices.data(), orig.triangleCount());

@@ -182,7 +182,7 @@ TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
     }
 }
 
-TEST(HierarchyNodes, ProxiesAreSimplerAndTheirStoredErrorBoundsADenserMeasurement) {
+TEST(HierarchyNodes, ProxiesAreSimplerAndTheirStoredErrorBoundsAnIndependentMeasurement) {
     const Baked& b = spheres15();
     const auto& nodes = b.nodes.nodes;
     size_t exact = 0, proxy = 0, reduced = 0;
@@ -239,4 +239,30 @@ TEST(HierarchyNodes, MismatchedObjectsAreRefusedWithAMessage) {
     std::string error;
     EXPECT_FALSE(buildHierarchyNodes(b.hierarchy, fewer, ProxySettings{}, out, error));
     EXPECT_NE(error.find("refers to object 14"), std::string::npos) << error;
+}
+
+TEST(HierarchyNodes, ProxyErrorOfKnownShapes) {
+    // A unit cube as its own proxy: 0 both ways. A proxy shrunk by 10 % around the centre:
+    // proxy -> originals = originals -> proxy = the largest corner displacement, sqrt(3) * 0.05.
+    const InputObject cube = samples::makeBox("cube", {0, 0, 0}, {1, 1, 1});
+    const std::vector<float> same(cube.positions.begin(), cube.positions.end());
+    const ProxyError exact = measureProxyError(same, cube.indices, {&cube}, 1e-3, 20000);
+    EXPECT_LE(exact.bound(), 1e-3);
+    std::vector<float> shrunk;
+    for (double x : cube.positions) shrunk.push_back(float(0.5 + 0.9 * (x - 0.5)));
+    const ProxyError inner = measureProxyError(shrunk, cube.indices, {&cube}, 1e-4, 200000);
+    const double corner = std::sqrt(3.0) * 0.05;
+    EXPECT_NEAR(inner.proxyToOriginals, 0.05, 1e-3);   // a face centre of the shrunk cube
+    EXPECT_NEAR(inner.originalsToProxy, corner, 1e-3);  // an original corner
+    EXPECT_GE(inner.originalsToProxy, inner.originalsToProxyLower);
+    EXPECT_LE(inner.originalsToProxy - inner.originalsToProxyLower, 1e-4 + 1e-7);
+    // A proxy grown by 10 %: the originals are inside it (distance to the solid 0).
+    std::vector<float> grown;
+    for (double x : cube.positions) grown.push_back(float(0.5 + 1.1 * (x - 0.5)));
+    const ProxyError outer = measureProxyError(grown, cube.indices, {&cube}, 1e-4, 200000);
+    EXPECT_NEAR(outer.proxyToOriginals, corner, 1e-3);
+    EXPECT_LE(outer.originalsToProxy, 1e-4);
+    // Nothing drawn: the error is the originals' extent.
+    const ProxyError none = measureProxyError({}, {}, {&cube}, 1e-3, 100);
+    EXPECT_NEAR(none.bound(), std::sqrt(3.0), 1e-12);
 }

@@ -98,7 +98,8 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
 /// Measures the error of a proxy (float positions, 3 * vertexCount; indices 3 * triangleCount,
 /// closed) against `originals` (world units) by branch and bound over triangles: refines
 /// until the bounds are within `tolerance` (world units) or after maxRefinementsPerDirection
-/// evaluations per direction beyond one per triangle. Deterministic, single thread.
+/// evaluations per direction beyond one per triangle. An empty proxy (nothing drawn) gets
+/// originalsToProxy = the diagonal of the originals' box. Deterministic, single thread.
 ProxyError measureProxyError(const std::vector<float>& proxyPositions,
                              const std::vector<uint32_t>& proxyIndices,
                              const std::vector<const InputObject*>& originals, double tolerance,
