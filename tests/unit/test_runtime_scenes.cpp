@@ -20,9 +20,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -665,4 +667,33 @@ TEST(RuntimeScenes, InspectPrintsTheTreeAndRefusesABadFile) {
     const RunResult shortFile = runProgram({AGGRELOD_CLI, "inspect", (s.dir / "short.aglod").string()}, s.dir);
     EXPECT_TRUE(shortFile.exited && shortFile.exitCode == 2) << shortFile.describe();
     EXPECT_NE(lower(shortFile.err).find("truncated"), std::string::npos) << shortFile.describe();
+}
+
+TEST(RuntimeScenes, LevelsGlbExtrasNameTheRuntimeNodes) {
+    BakedScene& s = scene(SceneId::TruckTown);
+    REQUIRE_SCENE(s);
+    // The GLB's JSON chunk (tinygltf writes compact JSON with sorted keys).
+    const std::string glb = readFile(s.dir / "out" / "levels.glb");
+    ASSERT_GT(glb.size(), 20u);
+    uint32_t jsonLength = 0;
+    std::memcpy(&jsonLength, glb.data() + 12, 4);
+    const std::string json = glb.substr(20, jsonLength);
+    const std::regex entry("\"geometric_error\":([^,]+),\"group\":[0-9]+,\"last_level\":([0-9]+),\"level\":([0-9]+),"
+                           "\"node\":([0-9]+),\"parent\":(-?[0-9]+)");
+    size_t aggregates = 0, matched = 0;
+    for (const auto& level : s.levels) aggregates += level.size();
+    for (auto it = std::sregex_iterator(json.begin(), json.end(), entry); it != std::sregex_iterator(); ++it) {
+        ++matched;
+        const uint32_t node = uint32_t(std::stoul((*it)[4]));
+        ASSERT_LT(node, s.file.nodeCount());
+        const runtime::NodeRecord& n = s.file.node(node);
+        const uint32_t level = uint32_t(std::stoul((*it)[3]));
+        EXPECT_EQ(float(std::stod((*it)[1])), n.geometricError) << "node " << node;
+        EXPECT_LE(n.level, level);
+        EXPECT_GE(std::stoul((*it)[2]), level);
+        const long parent = std::stol((*it)[5]);
+        EXPECT_EQ(parent < 0 ? runtime::kNoIndex : uint32_t(parent), n.parent) << "node " << node;
+    }
+    EXPECT_EQ(matched, aggregates) << "every aggregate of levels.glb names its runtime node";
+    EXPECT_NE(json.find("\"proxy_error\":{\"bound\":"), std::string::npos);
 }
