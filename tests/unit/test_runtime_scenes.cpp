@@ -185,12 +185,15 @@ std::unique_ptr<BakedScene> bakeScene(const std::string& label, const fs::path& 
 }
 
 enum class SceneId { Spheres15, Chess, TruckTown };
+const char* const kSceneDirNames[] = {"spheres15", "chess", "truck_town"};
 
 BakedScene& scene(SceneId id) {
     static std::map<SceneId, std::unique_ptr<BakedScene>> cache;
     auto& slot = cache[id];
     if (slot) return *slot;
-    const fs::path dir = freshTestDir(std::string("RuntimeScenes_") + std::to_string(int(id)));
+    // Named after the test that bakes first: CTest runs every test in its own process, in
+    // parallel, so processes must not share a directory (within one process the bake is reused).
+    const fs::path dir = freshTestDir(currentTestName() + "_" + kSceneDirNames[int(id)]);
     std::string error;
     if (id == SceneId::Spheres15) {
         EXPECT_TRUE(io::writeObjectsGlb(samples::makeSpheres15(1), (dir / "in.glb").string(), error)) << error;
@@ -212,8 +215,6 @@ BakedScene& scene(SceneId id) {
     }
     return *slot;
 }
-
-const char* const kSceneNames[] = {"spheres15", "chess", "truck_town"};
 
 /// Skips the test when the scene is absent (truck_town lives in ../shared/data), fails it
 /// when the bake or the read-back failed.
