@@ -411,8 +411,10 @@ TEST(RuntimeScenes, SceneFileIsByteIdenticalAcrossBakesAndThreadCounts) {
         REQUIRE_SCENE(s);
         const std::string reference = readFile(s.dir / "out" / "scene.aglod");
         ASSERT_GT(reference.size(), 0u);
-        // The cached bake ran with --threads 2: bake again with 2 and with 1.
+        // The cached bake ran with --threads 2: bake again with 2 (spheres15: two identical
+        // bakes) and with 1 (both scenes: thread count).
         for (const char* threads : {"2", "1"}) {
+            if (id == SceneId::TruckTown && threads[0] == '2') continue;  // the slow one: once
             const fs::path out = s.dir / (std::string("again_t") + threads);
             std::vector<std::string> argv = {AGGRELOD_CLI, "bake",
                                              id == SceneId::TruckTown ? sharedData("3d/truck_town/town_model.gltf").string()
