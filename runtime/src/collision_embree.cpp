@@ -49,13 +49,25 @@ struct CollisionWorld::Impl {
     const RuntimeFile& file;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    std::vector<RTCGeometry> geometries;  // per node, created on first use
-    std::vector<uint8_t> enabled;
-    std::vector<uint32_t> cut;
+    RTCGeometry geometry = nullptr;       // all triangles of the cut, merged
+    std::vector<uint32_t> cut;            // nodes, increasing
+    // A hit is mapped back with two lookups (each likely a cache miss on big scenes):
+    struct TriangleRef {
+        uint32_t slot;   // position of the node in `cut`
+        uint32_t local;  // triangle within the node's mesh
+    };
+    struct SlotInfo {
+        const uint32_t* objects;
+        uint32_t objectCount;
+        uint32_t node;
+    };
+    std::vector<TriangleRef> triangleRefs;  // per merged triangle
+    std::vector<SlotInfo> slots;            // per cut node
     std::unique_ptr<Selector> distanceSelector;
     mutable std::mutex errorMutex;
     std::string lastError;
     bool failed = false;
+    bool committed = false;  // queries before the first cut find nothing
 
     static void onError(void* user, RTCError code, const char* text) {
         auto* self = static_cast<Impl*>(user);
@@ -74,63 +86,69 @@ struct CollisionWorld::Impl {
         }
         rtcSetDeviceErrorFunction(device, &Impl::onError, this);
         scene = rtcNewScene(device);
-        geometries.assign(file.nodeCount(), nullptr);
-        enabled.assign(file.nodeCount(), 0);
-        if (scene) rtcCommitScene(scene);
     }
     ~Impl() {
-        for (RTCGeometry g : geometries)
-            if (g) rtcReleaseGeometry(g);
+        if (geometry) rtcReleaseGeometry(geometry);
         if (scene) rtcReleaseScene(scene);
         if (device) rtcReleaseDevice(device);
     }
 
-    // Copies a node's mesh into Embree-owned (padded) buffers; nullptr for an empty mesh.
-    RTCGeometry makeGeometry(uint32_t node) {
-        const Span<float> v = file.vertices(node);
-        const Span<uint32_t> t = file.triangles(node);
-        if (t.size == 0 || v.size == 0) return nullptr;
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        if (!g) return nullptr;
-        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                               3 * sizeof(float), v.size / 3));
-        auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                  3 * sizeof(uint32_t), t.size / 3));
-        if (!vb || !ib) {
-            rtcReleaseGeometry(g);
-            return nullptr;
-        }
-        std::memcpy(vb, v.data, v.size * sizeof(float));
-        std::memcpy(ib, t.data, t.size * sizeof(uint32_t));
-        rtcCommitGeometry(g);
-        rtcAttachGeometryByID(scene, g, node);  // geomID == node index
-        rtcDisableGeometry(g);
-        return g;
-    }
-
+    // One Embree geometry holding every triangle of the cut: Embree rebuilds the scene BVH on
+    // each commit anyway, so per-node geometries bought nothing but bookkeeping.
     void setCut(std::vector<uint32_t> nodes) {
         if (!scene) return;
         std::sort(nodes.begin(), nodes.end());
         nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
         while (!nodes.empty() && nodes.back() >= file.nodeCount()) nodes.pop_back();
-        for (uint32_t n : cut)
-            if (geometries[n] && !std::binary_search(nodes.begin(), nodes.end(), n)) {
-                rtcDisableGeometry(geometries[n]);
-                enabled[n] = 0;
-            }
-        for (uint32_t n : nodes) {
-            if (!geometries[n]) geometries[n] = makeGeometry(n);
-            if (geometries[n] && !enabled[n]) {
-                rtcEnableGeometry(geometries[n]);
-                enabled[n] = 1;
-            }
+        if (geometry) {
+            rtcDetachGeometry(scene, 0);
+            rtcReleaseGeometry(geometry);
+            geometry = nullptr;
         }
         cut = std::move(nodes);
+        triangleRefs.clear();
+        slots.clear();
+        size_t vertexTotal = 0;
+        for (uint32_t slot = 0; slot < cut.size(); ++slot) {
+            const uint32_t n = cut[slot];
+            const Span<uint32_t> objects = file.sources(n);
+            slots.push_back({objects.data, uint32_t(objects.size), n});
+            vertexTotal += file.vertices(n).size / 3;
+            const uint32_t triangles = uint32_t(file.triangles(n).size / 3);
+            for (uint32_t t = 0; t < triangles; ++t) triangleRefs.push_back({slot, t});
+        }
+        const size_t triangleTotal = triangleRefs.size();
+        if (triangleTotal > 0) {
+            geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            auto* vb = geometry ? static_cast<float*>(rtcSetNewGeometryBuffer(
+                                      geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertexTotal))
+                                : nullptr;
+            auto* ib = geometry ? static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+                                      geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangleTotal))
+                                : nullptr;
+            if (!vb || !ib) {
+                if (geometry) rtcReleaseGeometry(geometry);
+                geometry = nullptr;
+            } else {
+                size_t v = 0, t = 0;
+                for (uint32_t n : cut) {
+                    const Span<float> verts = file.vertices(n);
+                    const Span<uint32_t> tris = file.triangles(n);
+                    std::memcpy(vb + 3 * v, verts.data, verts.size * sizeof(float));
+                    for (size_t k = 0; k < tris.size; ++k) ib[t + k] = tris[k] + uint32_t(v);
+                    v += verts.size / 3;
+                    t += tris.size;
+                }
+                rtcCommitGeometry(geometry);
+                rtcAttachGeometryByID(scene, geometry, 0);
+            }
+        }
         rtcCommitScene(scene);
+        committed = true;
     }
 
     bool intersect(const float o[3], const float d[3], float maxDistance, CollisionHit& hit) const {
-        if (!scene || failed) return false;
+        if (!scene || failed || !committed) return false;
         const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         if (!(len > 0) || !(maxDistance >= 0)) return false;
         RTCRayHit rh;
@@ -149,27 +167,22 @@ struct CollisionWorld::Impl {
         rtcInitIntersectContext(&context);
         rtcIntersect1(scene, &context, &rh);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+        const TriangleRef ref = triangleRefs[rh.hit.primID];
+        const SlotInfo& info = slots[ref.slot];
         hit.distance = rh.ray.tfar;
-        hit.node = rh.hit.geomID;
-        hit.triangle = rh.hit.primID;
-        hit.objects = file.sources(hit.node);
-        // Normal from the stored triangle (outward by winding), not Embree's Ng convention.
-        const Span<float> v = file.vertices(hit.node);
-        const Span<uint32_t> t = file.triangles(hit.node);
-        const float* a = &v[3 * t[3 * hit.triangle]];
-        const float* b = &v[3 * t[3 * hit.triangle + 1]];
-        const float* c = &v[3 * t[3 * hit.triangle + 2]];
-        const double e1[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
-        const double e2[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
-        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                             e1[0] * e2[1] - e1[1] * e2[0]};
-        const double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        for (int k = 0; k < 3; ++k) hit.normal[k] = nl > 0 ? float(n[k] / nl) : 0.0f;
+        hit.node = info.node;
+        hit.triangle = ref.local;
+        hit.objects = {info.objects, info.objectCount};
+        // Embree's unnormalised geometric normal points to the side from which the triangle's
+        // vertices run counter-clockwise (checked by RuntimeCollision.*): outward for our meshes.
+        const float n[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+        const float nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; ++k) hit.normal[k] = nl > 0 ? n[k] / nl : 0.0f;
         return true;
     }
 
     bool occluded(const float o[3], const float d[3], float maxDistance) const {
-        if (!scene || failed) return false;
+        if (!scene || failed || !committed) return false;
         const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         if (!(len > 0) || !(maxDistance >= 0)) return false;
         RTCRay ray;

@@ -167,38 +167,38 @@ struct FileValidator {
         const uint64_t vertexCount = out.positions_.size / 3;
         for (uint64_t i = 0; i < n; ++i) {
             const NodeRecord& r = nodes[i];
-            const std::string where = "node " + std::to_string(i);
+            auto where = [i] { return "node " + std::to_string(i); };  // built only on failure
             if (r.parent != kNoIndex && r.parent >= n)
-                return fail(FileStatus::IndexOutOfRange, where + ": parent " + std::to_string(r.parent) +
+                return fail(FileStatus::IndexOutOfRange, where() + ": parent " + std::to_string(r.parent) +
                                                              " >= node count " + std::to_string(n));
-            if (r.parent == i) return fail(FileStatus::BadTree, where + " is its own parent");
+            if (r.parent == i) return fail(FileStatus::BadTree, where() + " is its own parent");
             if (!inRange(r.firstChild, r.childCount, out.childIndices_.size))
-                return fail(FileStatus::IndexOutOfRange, where + ": children outside the child array");
+                return fail(FileStatus::IndexOutOfRange, where() + ": children outside the child array");
             if (!inRange(r.firstSource, r.sourceCount, out.sourceObjects_.size))
-                return fail(FileStatus::IndexOutOfRange, where + ": sources outside the source array");
+                return fail(FileStatus::IndexOutOfRange, where() + ": sources outside the source array");
             if (!inRange(r.firstVertex, r.vertexCount, vertexCount))
-                return fail(FileStatus::IndexOutOfRange, where + ": vertices outside the position array");
+                return fail(FileStatus::IndexOutOfRange, where() + ": vertices outside the position array");
             if (!inRange(r.firstIndex, r.indexCount, out.indices_.size))
-                return fail(FileStatus::IndexOutOfRange, where + ": triangles outside the index array");
+                return fail(FileStatus::IndexOutOfRange, where() + ": triangles outside the index array");
             if (r.indexCount % 3 != 0)
-                return fail(FileStatus::BadValue, where + ": index count " + std::to_string(r.indexCount) +
+                return fail(FileStatus::BadValue, where() + ": index count " + std::to_string(r.indexCount) +
                                                       " is not a multiple of 3");
             for (uint32_t k = 0; k < r.indexCount; ++k)
                 if (out.indices_[r.firstIndex + k] >= r.vertexCount)
                     return fail(FileStatus::IndexOutOfRange,
-                                where + ": triangle index " + std::to_string(out.indices_[r.firstIndex + k]) +
+                                where() + ": triangle index " + std::to_string(out.indices_[r.firstIndex + k]) +
                                     " >= its vertex count " + std::to_string(r.vertexCount));
             const float values[] = {r.delta, r.geometricError, r.boundsMin[0], r.boundsMin[1],
                                     r.boundsMin[2], r.boundsMax[0], r.boundsMax[1], r.boundsMax[2],
                                     r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2],
                                     r.sphereRadius};
             for (float v : values)
-                if (!std::isfinite(v)) return fail(FileStatus::BadValue, where + ": NaN or infinite value");
+                if (!std::isfinite(v)) return fail(FileStatus::BadValue, where() + ": NaN or infinite value");
             if (r.geometricError < 0 || r.sphereRadius < 0 || r.delta < 0)
-                return fail(FileStatus::BadValue, where + ": negative error, radius or delta");
+                return fail(FileStatus::BadValue, where() + ": negative error, radius or delta");
             for (int k = 0; k < 3; ++k)
                 if (r.boundsMin[k] > r.boundsMax[k])
-                    return fail(FileStatus::BadValue, where + ": box min > max");
+                    return fail(FileStatus::BadValue, where() + ": box min > max");
         }
         for (size_t i = 0; i < out.positions_.size; ++i)
             if (!std::isfinite(out.positions_[i]))

@@ -37,6 +37,36 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
         hot_[i] = {{r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2]}, r.sphereRadius, r.geometricError,
                    r.parent, r.firstSource, r.childCount == 0 ? r.sourceCount : 0u};
     }
+    // The incremental pass and the leases rely on sse never growing down a path. The file
+    // guarantees nesting up to a 1e-5 relative slack; close that slack here, children before
+    // parents (reverse preorder), by growing a parent's sphere and error just enough
+    // (plus 1e-6 relative so float evaluation of the test cannot break the order either).
+    {
+        std::vector<uint32_t> order;
+        order.reserve(n);
+        std::vector<uint32_t> stack(file.roots().begin(), file.roots().end());
+        while (!stack.empty()) {
+            const uint32_t x = stack.back();
+            stack.pop_back();
+            order.push_back(x);
+            for (uint32_t c : file.children(x)) stack.push_back(c);
+        }
+        for (size_t i = order.size(); i-- > 0;) {
+            const uint32_t x = order[i];
+            Hot& parent = hot_[x];
+            for (uint32_t c : file.children(x)) {
+                const Hot& child = hot_[c];
+                double d2 = 0;
+                for (int k = 0; k < 3; ++k) {
+                    const double d = double(parent.center[k]) - child.center[k];
+                    d2 += d * d;
+                }
+                const double needed = (std::sqrt(d2) + child.radius) * (1.0 + 1e-6);
+                if (needed > parent.radius) parent.radius = static_cast<float>(needed);
+                parent.error = std::max(parent.error, child.error);
+            }
+        }
+    }
     state_.assign(n, State{0, 0, 0, 0});
     targetStamp_.assign(n, 0);
     target_.assign(n, kNoIndex);

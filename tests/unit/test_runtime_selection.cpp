@@ -248,3 +248,76 @@ TEST(RuntimeSelection, LeasedSelectionStaysExactAcrossSettingChangesAndMixedCall
         expectExactCover(h.file, mixed);
     }
 }
+
+TEST(RuntimeSelection, ExactWithSpheresThatNestOnlyWithinTheFileSlack) {
+    // Parent spheres shrunk to just below the children's extent (inside the reader's slack),
+    // all inner errors equal, and cameras placed alternately at a node's centre and just
+    // inside its refine sphere on the side away from its parent's centre (where the file's
+    // raw sse is larger for the child than for the parent: near-tie decisions). Incremental
+    // and full selection must agree at every frame, with an exact cover.
+    BuildParams p = makeSyntheticHierarchy(600, 21, 2, 1, 0.02f);
+    for (size_t i = 0; i < p.nodes.size(); ++i) {  // children come first (post-order)
+        BuildNode& node = p.nodes[i];
+        if (node.childCount == 0) continue;
+        node.geometricError = 1.0f;
+        double reach = 0;
+        for (uint32_t k = 0; k < node.childCount; ++k) {
+            const BuildNode& c = p.nodes[p.childIndices[node.firstChild + k]];
+            double d2 = 0;
+            for (int a = 0; a < 3; ++a) d2 += std::pow(double(c.sphereCenter[a]) - node.sphereCenter[a], 2);
+            reach = std::max(reach, std::sqrt(d2) + c.sphereRadius);
+        }
+        // The reader's slack is 1e-5 * (1 + max(radius, |centre coordinates|)): use half of it.
+        double scale = reach;
+        for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(double(node.sphereCenter[a])));
+        node.sphereRadius = float(reach - 0.5e-5 * (scale + 1.0));
+    }
+    OpenedHierarchy h(p);
+    ASSERT_TRUE(h.file.isOpen());
+    Selector incremental(h.file), full(h.file);
+    SelectionSettings settings;
+    settings.coarsenRatio = 1.0f;  // both thresholds on the same boundary
+    Camera cam;
+    const double k = cam.viewportHeight / (2.0 * std::tan(cam.fovY * 0.5));
+    std::mt19937 rng(4);
+    std::vector<uint32_t> innerWithParent;
+    for (uint32_t i = 0; i < h.file.nodeCount(); ++i)
+        if (!h.file.isLeaf(i) && h.file.node(i).parent != kNoIndex) innerWithParent.push_back(i);
+    size_t changes = 0;
+    std::vector<uint32_t> previous;
+    uint32_t c = innerWithParent[0];
+    for (int frame = 0; frame < 3000; ++frame) {
+        if (frame % 2 == 0) {
+            // First at the centre of a random node: its region gets refined.
+            c = innerWithParent[rng() % innerWithParent.size()];
+            for (int a = 0; a < 3; ++a) cam.position[a] = h.file.node(c).sphereCenter[a];
+        } else {
+            // Then just inside its refine sphere, on the side away from its parent's centre.
+            const NodeRecord& child = h.file.node(c);
+            const NodeRecord& parent = h.file.node(child.parent);
+            double u[3], len = 0;
+            for (int a = 0; a < 3; ++a) {
+                u[a] = double(child.sphereCenter[a]) - parent.sphereCenter[a];
+                len += u[a] * u[a];
+            }
+            len = std::sqrt(len);
+            if (len < 1e-9) {
+                u[0] = 1;
+                len = 1;
+            }
+            const double reach = child.geometricError * k / settings.pixelTolerance + child.sphereRadius;
+            double scale = parent.sphereRadius;
+            for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(double(parent.sphereCenter[a])));
+            const double inside = reach - 0.2e-5 * (scale + 1.0);
+            for (int a = 0; a < 3; ++a) cam.position[a] = float(child.sphereCenter[a] + u[a] / len * inside);
+        }
+        incremental.select(cam, settings);
+        full.selectFull(cam, settings);
+        const std::vector<uint32_t> cut = sortedCut(full);
+        ASSERT_EQ(sortedCut(incremental), cut) << "frame " << frame;
+        changes += cut != previous;
+        previous = cut;
+    }
+    expectExactCover(h.file, incremental);
+    EXPECT_GT(changes, 100u);
+}

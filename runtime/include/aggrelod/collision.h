@@ -31,9 +31,9 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
 /// Levels present in the file, increasing (aggregate levels; the originals are kLeafLevel).
 std::vector<uint32_t> levelsOf(const RuntimeFile& file);
 
-/// An Embree scene over a cut. Node meshes are turned into Embree geometries the first time a
-/// cut uses them and kept; changing the cut enables/disables them and rebuilds the BVH.
-/// Queries are const and may run from several threads at once; changing the cut may not.
+/// An Embree scene over a cut: the cut's node meshes merged into one Embree geometry (rebuilt,
+/// with the BVH, when the cut changes). Queries are const and may run from several threads at
+/// once; changing the cut may not.
 class CollisionWorld {
 public:
     /// buildThreads: threads Embree may use to build (0 = all cores).
@@ -53,6 +53,9 @@ public:
     void useLevel(uint32_t level);
     /// Uses a cut that is finer near `point`: a node is used when its geometric error is at
     /// most maxErrorPerDistance * its distance to `point` (world units / world units).
+    /// The cut itself is incremental (a Selector), but a changed cut rebuilds the merged mesh
+    /// and the BVH (O(triangles of the cut)): call it when the agent has moved appreciably,
+    /// not for every query.
     void useDistanceCut(const float point[3], float maxErrorPerDistance);
     /// Nodes of the current cut, increasing.
     const std::vector<uint32_t>& currentCut() const;
