@@ -1241,4 +1241,71 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
     }
 }
 
+bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                     const std::string& path, std::string& error) {
+    if (nodes.objectCount != objects.size() || nodes.nodes.size() < objects.size()) {
+        error = path + ": the hierarchy nodes do not belong to these objects";
+        return false;
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        int levelCount = 0;
+        for (const HierarchyNode& n : nodes.nodes) levelCount = std::max(levelCount, n.lastLevel + 1);
+        for (int k = 0; k < levelCount; ++k) {
+            tinygltf::Material material;
+            material.name = "level" + std::to_string(k);
+            material.pbrMetallicRoughness.baseColorFactor = levelColour(size_t(k), size_t(levelCount));
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.8;
+            model.materials.push_back(std::move(material));
+        }
+        // glTF node i = hierarchy node i; the glTF tree is the hierarchy.
+        for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+            const HierarchyNode& n = nodes.nodes[i];
+            tinygltf::Node node;
+            tinygltf::Value::Object extras;
+            tinygltf::Value::Array sources, sourceIds;
+            for (uint32_t o : n.sources) {
+                if (o >= objects.size()) {
+                    error = path + ": node " + std::to_string(i) + " refers to object " + std::to_string(o);
+                    return false;
+                }
+                sources.push_back(tinygltf::Value(objects[o].name));
+                sourceIds.push_back(intValue(objects[o].id));
+            }
+            extras["node"] = intValue(i);
+            extras["sources"] = tinygltf::Value(std::move(sources));
+            extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+            extras["geometric_error"] = tinygltf::Value(n.geometricError);
+            tinygltf::Value::Array sphere;
+            for (int k = 0; k < 3; ++k) sphere.push_back(tinygltf::Value(n.sphereCenter[k]));
+            sphere.push_back(tinygltf::Value(n.sphereRadius));
+            extras["bounding_sphere"] = tinygltf::Value(std::move(sphere));
+            if (n.leaf) {
+                // The original object itself: the engine draws its own mesh.
+                node.name = "object_" + objects[i].name;
+                extras["leaf"] = tinygltf::Value(true);
+            } else {
+                node.name = "node" + std::to_string(i) + "_level" + std::to_string(n.firstLevel);
+                extras["level"] = tinygltf::Value(n.firstLevel);
+                extras["last_level"] = tinygltf::Value(n.lastLevel);
+                extras["delta"] = tinygltf::Value(n.delta);
+                extras["proxy_error_bound"] = tinygltf::Value(n.error.bound());
+                extras["exact_triangles"] = intValue(n.exactTriangleCount);
+                const std::vector<double> positions(n.positions.begin(), n.positions.end());
+                node.mesh = glb.addMesh(node.name, positions, n.indices, n.firstLevel);
+            }
+            for (uint32_t c : n.children) node.children.push_back(int(c));
+            node.extras = tinygltf::Value(std::move(extras));
+            glb.addNode(std::move(node));
+        }
+        std::vector<int> roots(nodes.roots.begin(), nodes.roots.end());
+        return glb.write(path, roots, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
 }  // namespace aggrelod::io

@@ -94,7 +94,7 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
         "bake", "Bake a glTF scene (.glb or .gltf) into a level-of-detail hierarchy of aggregates");
     cmd->add_option("scene", o.scene, "Input scene, .glb or .gltf")->required();
     cmd->add_option("-o,--output", o.outDir,
-                    "Output directory (created if missing); receives levels.glb and scene.aglod (the runtime file)")
+                    "Output directory (created if missing); receives levels.glb, proxies.glb and scene.aglod (the runtime file)")
         ->required();
     CLI::Option* delta =
         cmd->add_option("--delta", o.deltas,
@@ -226,11 +226,20 @@ int runBake(BakeOptions o) {
         printError(error);
         return kFileError;
     }
+    const fs::path proxiesPath = outDir / "proxies.glb";
+    const fs::path proxiesTmp = outDir / "proxies.glb.tmp";
+    if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) {
+        removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
+        printError(error);
+        return kFileError;
+    }
     const fs::path runtimePath = outDir / "scene.aglod";
     const fs::path runtimeTmp = outDir / "scene.aglod.tmp";
     if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
                                runtimeTmp.string(), error)) {
         removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
         removeQuietly(runtimeTmp);
         printError(error);
         return kFileError;
@@ -243,6 +252,7 @@ int runBake(BakeOptions o) {
         if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, statsTmp.string(),
                                 error)) {
             removeQuietly(levelsTmp);
+            removeQuietly(proxiesTmp);
             removeQuietly(runtimeTmp);
             removeQuietly(statsTmp);
             printError(error);
@@ -251,6 +261,14 @@ int runBake(BakeOptions o) {
     }
     if (!renameOver(levelsTmp, levelsPath, error)) {
         removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
+        removeQuietly(runtimeTmp);
+        if (!statsTmp.empty()) removeQuietly(statsTmp);
+        printError(error);
+        return kFileError;
+    }
+    if (!renameOver(proxiesTmp, proxiesPath, error)) {
+        removeQuietly(proxiesTmp);
         removeQuietly(runtimeTmp);
         if (!statsTmp.empty()) removeQuietly(statsTmp);
         printError(error);
@@ -283,7 +301,8 @@ int runBake(BakeOptions o) {
                     "(exact aggregates %zu)\n",
                     nodes.nodes.size(), nodes.nodes.size() - nodes.objectCount, nodes.roots.size(), proxyTriangles,
                     exactTriangles);
-        std::printf("wrote %s, %s%s%s\n", levelsPath.string().c_str(), runtimePath.string().c_str(),
+        std::printf("wrote %s, %s, %s%s%s\n", levelsPath.string().c_str(), proxiesPath.string().c_str(),
+                    runtimePath.string().c_str(),
                     statsPath.empty() ? "" : " and ", statsPath.string().c_str());
         std::fflush(stdout);
     }

@@ -47,6 +47,15 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                     const std::string& path, std::string& error,
                     const HierarchyNodes* nodes = nullptr);
 
+/// Writes OUTDIR/proxies.glb: glTF node i = hierarchy node i, nested as the hierarchy (scene
+/// roots = its roots). Aggregate nodes carry their simplified proxy as a mesh (one material
+/// per level) and extras {node, level, last_level, delta, geometric_error, proxy_error_bound,
+/// exact_triangles, bounding_sphere [x, y, z, r], sources, source_ids}; leaves (the original
+/// objects, named "object_<name>") have no mesh and extras {node, leaf, geometric_error 0,
+/// bounding_sphere, sources, source_ids}. World units.
+bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                     const std::string& path, std::string& error);
+
 /// Writes the stats JSON (see README "Stats file"). Timings are written last, in their
 /// own object, so determinism checks can drop them.
 bool writeStatsJson(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,

@@ -700,3 +700,26 @@ TEST(RuntimeScenes, LevelsGlbExtrasNameTheRuntimeNodes) {
     EXPECT_EQ(matched, aggregates) << "every aggregate of levels.glb names its runtime node";
     EXPECT_NE(json.find("\"proxy_error\":{\"bound\":"), std::string::npos);
 }
+
+TEST(RuntimeScenes, ProxiesGlbMirrorsTheRuntimeTreeAndIsValid) {
+    BakedScene& s = scene(SceneId::Spheres15);
+    REQUIRE_SCENE(s);
+    const fs::path proxies = s.dir / "out" / "proxies.glb";
+    io::SceneReadResult back;
+    std::string error;
+    ASSERT_TRUE(io::readGltfScene(proxies.string(), {}, back, error)) << error;
+    // One mesh object per aggregate node ("node<i>_level<k>"), the same triangles as the file.
+    size_t aggregates = 0;
+    for (uint32_t i = 0; i < s.file.nodeCount(); ++i) aggregates += s.file.node(i).level != runtime::kLeafLevel;
+    EXPECT_EQ(back.objects.size(), aggregates);
+    for (const InputObject& o : back.objects) {
+        ASSERT_EQ(o.name.rfind("node", 0), 0u) << o.name;
+        const uint32_t node = uint32_t(std::stoul(o.name.substr(4)));
+        ASSERT_LT(node, s.file.nodeCount());
+        EXPECT_EQ(o.indices.size(), size_t(s.file.node(node).indexCount)) << o.name;
+        const auto v = s.file.vertices(node);
+        ASSERT_EQ(o.positions.size(), v.size) << o.name;
+        for (size_t k = 0; k < v.size; ++k) EXPECT_EQ(float(o.positions[k]), v[k]) << o.name;
+    }
+    validateGltf({proxies}, s.dir);
+}
