@@ -39,7 +39,9 @@ struct ProxySettings {
 };
 
 /// One-sided Hausdorff distances between a proxy and the original objects it stands for:
-/// certified upper bounds (never below the true distance) and the largest distance found.
+/// certified upper bounds (never below the true distance, up to double rounding; for
+/// originals -> proxy this assumes a closed proxy, as inside-ness is decided by ray parity)
+/// and the largest distance found.
 struct ProxyError {
     double proxyToOriginals = 0;  ///< upper bound: every proxy point is this close to an original surface
     double originalsToProxy = 0;  ///< upper bound: every original point is inside the proxy or this close to it
