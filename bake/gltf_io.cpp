@@ -1143,7 +1143,11 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 }
 
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                    const std::string& path, std::string& error) {
+                    const std::string& path, std::string& error, const HierarchyNodes* nodes) {
+    if (nodes && (nodes->nodeOfAggregate.size() != hierarchy.levels.size() || nodes->objectCount != objects.size())) {
+        error = path + ": the hierarchy nodes do not belong to this hierarchy";
+        return false;
+    }
     try {
         GlbBuilder glb;
         tinygltf::Model& model = glb.model();
@@ -1200,11 +1204,103 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 extras["components"] = tinygltf::Value(agg.componentCount);
                 extras["volume"] = tinygltf::Value(agg.measures.volume);
                 extras["volume_original"] = tinygltf::Value(agg.volumeOriginal);
+                if (nodes) {
+                    if (g >= nodes->nodeOfAggregate[k].size()) {
+                        error = path + ": " + name + " has no hierarchy node";
+                        return false;
+                    }
+                    const uint32_t nodeIndex = nodes->nodeOfAggregate[k][g];
+                    const HierarchyNode& hn = nodes->nodes[nodeIndex];
+                    tinygltf::Value::Array children;
+                    for (uint32_t c : hn.children) children.push_back(intValue(c));
+                    extras["node"] = intValue(nodeIndex);
+                    extras["parent"] = hn.parent == kNoNode ? tinygltf::Value(-1) : intValue(hn.parent);
+                    extras["children"] = tinygltf::Value(std::move(children));
+                    extras["first_level"] = tinygltf::Value(hn.firstLevel);
+                    extras["last_level"] = tinygltf::Value(hn.lastLevel);
+                    extras["geometric_error"] = tinygltf::Value(hn.geometricError);
+                    tinygltf::Value::Object proxyError;
+                    proxyError["proxy_to_originals"] = tinygltf::Value(hn.error.proxyToOriginals);
+                    proxyError["originals_to_proxy"] = tinygltf::Value(hn.error.originalsToProxy);
+                    proxyError["proxy_to_originals_found"] = tinygltf::Value(hn.error.proxyToOriginalsLower);
+                    proxyError["originals_to_proxy_found"] = tinygltf::Value(hn.error.originalsToProxyLower);
+                    proxyError["tolerance"] = tinygltf::Value(hn.error.tolerance);
+                    proxyError["bound"] = tinygltf::Value(hn.error.bound());
+                    extras["proxy_error"] = tinygltf::Value(std::move(proxyError));
+                    extras["proxy_triangles"] = intValue(hn.indices.size() / 3);
+                }
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
             }
             model.nodes[size_t(levelIndex)].children = std::move(children);
         }
+        return glb.write(path, roots, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                     const std::string& path, std::string& error) {
+    if (nodes.objectCount != objects.size() || nodes.nodes.size() < objects.size()) {
+        error = path + ": the hierarchy nodes do not belong to these objects";
+        return false;
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        int levelCount = 0;
+        for (const HierarchyNode& n : nodes.nodes) levelCount = std::max(levelCount, n.lastLevel + 1);
+        for (int k = 0; k < levelCount; ++k) {
+            tinygltf::Material material;
+            material.name = "level" + std::to_string(k);
+            material.pbrMetallicRoughness.baseColorFactor = levelColour(size_t(k), size_t(levelCount));
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.8;
+            model.materials.push_back(std::move(material));
+        }
+        // glTF node i = hierarchy node i; the glTF tree is the hierarchy.
+        for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+            const HierarchyNode& n = nodes.nodes[i];
+            tinygltf::Node node;
+            tinygltf::Value::Object extras;
+            tinygltf::Value::Array sources, sourceIds;
+            for (uint32_t o : n.sources) {
+                if (o >= objects.size()) {
+                    error = path + ": node " + std::to_string(i) + " refers to object " + std::to_string(o);
+                    return false;
+                }
+                sources.push_back(tinygltf::Value(objects[o].name));
+                sourceIds.push_back(intValue(objects[o].id));
+            }
+            extras["node"] = intValue(i);
+            extras["sources"] = tinygltf::Value(std::move(sources));
+            extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+            extras["geometric_error"] = tinygltf::Value(n.geometricError);
+            tinygltf::Value::Array sphere;
+            for (int k = 0; k < 3; ++k) sphere.push_back(tinygltf::Value(n.sphereCenter[k]));
+            sphere.push_back(tinygltf::Value(n.sphereRadius));
+            extras["bounding_sphere"] = tinygltf::Value(std::move(sphere));
+            if (n.leaf) {
+                // The original object itself: the engine draws its own mesh.
+                node.name = "object_" + objects[i].name;
+                extras["leaf"] = tinygltf::Value(true);
+            } else {
+                node.name = "node" + std::to_string(i) + "_level" + std::to_string(n.firstLevel);
+                extras["level"] = tinygltf::Value(n.firstLevel);
+                extras["last_level"] = tinygltf::Value(n.lastLevel);
+                extras["delta"] = tinygltf::Value(n.delta);
+                extras["proxy_error_bound"] = tinygltf::Value(n.error.bound());
+                extras["exact_triangles"] = intValue(n.exactTriangleCount);
+                const std::vector<double> positions(n.positions.begin(), n.positions.end());
+                node.mesh = glb.addMesh(node.name, positions, n.indices, n.firstLevel);
+            }
+            for (uint32_t c : n.children) node.children.push_back(int(c));
+            node.extras = tinygltf::Value(std::move(extras));
+            glb.addNode(std::move(node));
+        }
+        std::vector<int> roots(nodes.roots.begin(), nodes.roots.end());
         return glb.write(path, roots, error);
     } catch (const std::exception& e) {
         error = path + ": " + e.what();

@@ -5,12 +5,16 @@
 //
 // Each subcommand has an options struct, an add<Name>Command() that declares its
 // options, and a run<Name>() that does the work; add new subcommands the same way.
+#include "runtime_export.h"
 #include "scene_io.h"
 #include "terminal.h"
+
+#include <aggrelod/runtime_file.h>
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -67,14 +71,30 @@ struct BakeOptions {
     std::string statsPath;
     double touchTolerance = -1;
     int threads = 0;
+    double proxyError = 0.25;
     bool quiet = false;
 };
+
+/// The settings that shape the outputs, as canonical text (hashed into scene.aglod so that an
+/// engine can tell a stale bake). Thread count and verbosity are left out: they change nothing.
+std::string settingsText(const BakeOptions& o) {
+    char buffer[64];
+    std::string text = "aggrelod-bake;function=" + o.function + ";distance=" + o.distance + ";levels=" +
+                       std::to_string(o.levels) + ";object=" + o.objectUnit + ";exclude=" + o.exclude + ";deltas=";
+    for (double d : o.deltas) {
+        std::snprintf(buffer, sizeof buffer, "%.17g,", d);
+        text += buffer;
+    }
+    std::snprintf(buffer, sizeof buffer, ";touch=%.17g;proxy=%.17g", o.touchTolerance, o.proxyError);
+    return text + buffer;
+}
 
 CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
     CLI::App* cmd = app.add_subcommand(
         "bake", "Bake a glTF scene (.glb or .gltf) into a level-of-detail hierarchy of aggregates");
     cmd->add_option("scene", o.scene, "Input scene, .glb or .gltf")->required();
-    cmd->add_option("-o,--output", o.outDir, "Output directory (created if missing); receives levels.glb")
+    cmd->add_option("-o,--output", o.outDir,
+                    "Output directory (created if missing); receives levels.glb, proxies.glb and scene.aglod (the runtime file)")
         ->required();
     CLI::Option* delta =
         cmd->add_option("--delta", o.deltas,
@@ -104,6 +124,10 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--threads", o.threads, "Threads for the parallel stages (default 0: all cores); output is identical for any count")
         ->check(CLI::Range(0, 1024));
+    cmd->add_option("--proxy-error", o.proxyError,
+                    "Simplification target of each level's proxies, as a fraction of the level's delta "
+                    "(default 0.25; 0 keeps the exact aggregates)")
+        ->check(CLI::Range(0.0, 10.0));
     cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
     return cmd;
 }
@@ -161,11 +185,28 @@ int runBake(BakeOptions o) {
     };
     Hierarchy3D hierarchy;
     const bool ok = buildHierarchy3D(scene.objects, settings, hierarchy);
+    HierarchyNodes nodes;
+    std::string nodeError;
+    bool nodesOk = false;
+    if (ok) {
+        // Proxies, their errors and the node tree for the runtime (DESIGN 2.6).
+        ProxySettings proxySettings;
+        proxySettings.simplifyFraction = o.proxyError;
+        proxySettings.threadCount = o.threads;
+        proxySettings.progress = settings.progress;
+        const auto start = std::chrono::steady_clock::now();
+        nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
+        hierarchy.timings.emplace_back("proxies", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
     progress.finish();
     cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
     if (!ok) {
         printError(o.scene + ": baking failed; nothing was written");
         return kBakeFailed;
+    }
+    if (!nodesOk) {
+        printError(o.scene + ": building the runtime hierarchy failed: " + nodeError + "; nothing was written");
+        return kInternal;
     }
 
     // Write: temporary files first, then rename over the old outputs, so that a failure
@@ -180,8 +221,26 @@ int runBake(BakeOptions o) {
     }
     const fs::path levelsPath = outDir / "levels.glb";
     const fs::path levelsTmp = outDir / "levels.glb.tmp";
-    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error)) {
+    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes)) {
         removeQuietly(levelsTmp);
+        printError(error);
+        return kFileError;
+    }
+    const fs::path proxiesPath = outDir / "proxies.glb";
+    const fs::path proxiesTmp = outDir / "proxies.glb.tmp";
+    if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) {
+        removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
+        printError(error);
+        return kFileError;
+    }
+    const fs::path runtimePath = outDir / "scene.aglod";
+    const fs::path runtimeTmp = outDir / "scene.aglod.tmp";
+    if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
+                               runtimeTmp.string(), error)) {
+        removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
+        removeQuietly(runtimeTmp);
         printError(error);
         return kFileError;
     }
@@ -193,6 +252,8 @@ int runBake(BakeOptions o) {
         if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, statsTmp.string(),
                                 error)) {
             removeQuietly(levelsTmp);
+            removeQuietly(proxiesTmp);
+            removeQuietly(runtimeTmp);
             removeQuietly(statsTmp);
             printError(error);
             return kFileError;
@@ -200,6 +261,21 @@ int runBake(BakeOptions o) {
     }
     if (!renameOver(levelsTmp, levelsPath, error)) {
         removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
+        removeQuietly(runtimeTmp);
+        if (!statsTmp.empty()) removeQuietly(statsTmp);
+        printError(error);
+        return kFileError;
+    }
+    if (!renameOver(proxiesTmp, proxiesPath, error)) {
+        removeQuietly(proxiesTmp);
+        removeQuietly(runtimeTmp);
+        if (!statsTmp.empty()) removeQuietly(statsTmp);
+        printError(error);
+        return kFileError;
+    }
+    if (!renameOver(runtimeTmp, runtimePath, error)) {
+        removeQuietly(runtimeTmp);
         if (!statsTmp.empty()) removeQuietly(statsTmp);
         printError(error);
         return kFileError;
@@ -216,10 +292,105 @@ int runBake(BakeOptions o) {
                     cli::formatNumber(hierarchy.originals.volume).c_str(),
                     cli::formatNumber(hierarchy.originals.sphericity).c_str());
         std::fputs(cli::formatLevelTable(hierarchy).c_str(), stdout);
-        std::printf("wrote %s%s%s\n", levelsPath.string().c_str(),
+        size_t proxyTriangles = 0, exactTriangles = 0;
+        for (size_t i = nodes.objectCount; i < nodes.nodes.size(); ++i) {
+            proxyTriangles += nodes.nodes[i].indices.size() / 3;
+            exactTriangles += nodes.nodes[i].exactTriangleCount;
+        }
+        std::printf("runtime hierarchy: %zu nodes (%zu aggregates, %zu roots); proxies %zu triangles "
+                    "(exact aggregates %zu)\n",
+                    nodes.nodes.size(), nodes.nodes.size() - nodes.objectCount, nodes.roots.size(), proxyTriangles,
+                    exactTriangles);
+        std::printf("wrote %s, %s, %s%s%s\n", levelsPath.string().c_str(), proxiesPath.string().c_str(),
+                    runtimePath.string().c_str(),
                     statsPath.empty() ? "" : " and ", statsPath.string().c_str());
         std::fflush(stdout);
     }
+    return kOk;
+}
+
+// ---------------------------------------------------------------------------
+// inspect
+
+struct InspectOptions {
+    std::string file;
+    bool noLeaves = false;
+    int maxSources = 8;
+};
+
+CLI::App* addInspectCommand(CLI::App& app, InspectOptions& o) {
+    CLI::App* cmd = app.add_subcommand("inspect", "Print the node tree of a runtime file (.aglod)");
+    cmd->add_option("file", o.file, "Runtime file written by `aggrelod bake` (OUTDIR/scene.aglod)")->required();
+    cmd->add_flag("--no-leaves", o.noLeaves, "Do not print the original objects (the leaves)");
+    cmd->add_option("--max-sources", o.maxSources, "Object names printed per node (default 8; 0: all)")
+        ->check(CLI::NonNegativeNumber);
+    return cmd;
+}
+
+/// One node and, indented below it, its children (depth first, children in file order).
+void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int depth, const InspectOptions& o) {
+    const runtime::NodeRecord& n = file.node(index);
+    const bool leaf = n.level == runtime::kLeafLevel;
+    if (leaf && o.noLeaves) return;
+    const std::string indent(size_t(2 * depth), ' ');
+    const auto sources = file.sources(index);
+    if (leaf) {
+        std::printf("%sobject %u '%.*s'  triangles %u  sphere r %s\n", indent.c_str(), sources.empty() ? 0u : sources[0],
+                    sources.empty() ? 0 : int(file.objectName(sources[0]).size()),
+                    sources.empty() ? "" : file.objectName(sources[0]).data(), n.indexCount / 3,
+                    cli::formatNumber(n.sphereRadius).c_str());
+    } else {
+        std::printf("%snode %u  level %u  delta %s  error %s  triangles %u  box [%s %s %s]..[%s %s %s]  sphere r %s  "
+                    "%u objects:",
+                    indent.c_str(), index, n.level, cli::formatNumber(n.delta).c_str(),
+                    cli::formatNumber(n.geometricError).c_str(), n.indexCount / 3,
+                    cli::formatNumber(n.boundsMin[0]).c_str(), cli::formatNumber(n.boundsMin[1]).c_str(),
+                    cli::formatNumber(n.boundsMin[2]).c_str(), cli::formatNumber(n.boundsMax[0]).c_str(),
+                    cli::formatNumber(n.boundsMax[1]).c_str(), cli::formatNumber(n.boundsMax[2]).c_str(),
+                    cli::formatNumber(n.sphereRadius).c_str(), unsigned(sources.size));
+        size_t shown = 0;
+        for (uint32_t s : sources) {
+            if (o.maxSources > 0 && shown == size_t(o.maxSources)) {
+                std::printf(" ...");
+                break;
+            }
+            const std::string_view name = file.objectName(s);
+            std::printf(" %.*s", int(name.size()), name.data());
+            ++shown;
+        }
+        std::printf("\n");
+    }
+    for (uint32_t c : file.children(index)) printInspectNode(file, c, depth + 1, o);
+}
+
+int runInspect(const InspectOptions& o) {
+    runtime::RuntimeFile file;
+    std::string message;
+    const runtime::FileStatus status = runtime::RuntimeFile::openFile(o.file, file, message);
+    if (status != runtime::FileStatus::Ok) {
+        printError(o.file + ": " + runtime::toString(status) + (message.empty() ? "" : ": " + message));
+        return kFileError;
+    }
+    uint32_t aggregates = 0, leaves = 0;
+    uint64_t proxyTriangles = 0, leafTriangles = 0;
+    for (const runtime::NodeRecord& n : file.nodes()) {
+        if (n.level == runtime::kLeafLevel) {
+            ++leaves;
+            leafTriangles += n.indexCount / 3;
+        } else {
+            ++aggregates;
+            proxyTriangles += n.indexCount / 3;
+        }
+    }
+    std::printf("%s: format %u.%u, tool %.*s, settings hash %016llx, %zu bytes\n", o.file.c_str(),
+                unsigned(file.versionMajor()), unsigned(file.versionMinor()), int(file.toolVersion().size()),
+                file.toolVersion().data(), static_cast<unsigned long long>(file.settingsHash()), file.byteSize());
+    std::printf("%u nodes: %u aggregates (%llu proxy triangles), %u original objects (%llu triangles); "
+                "%zu roots, depth %u\n",
+                file.nodeCount(), aggregates, static_cast<unsigned long long>(proxyTriangles), leaves,
+                static_cast<unsigned long long>(leafTriangles), file.roots().size, file.depth());
+    for (uint32_t r : file.roots()) printInspectNode(file, r, 0, o);
+    std::fflush(stdout);
     return kOk;
 }
 
@@ -232,6 +403,8 @@ int run(int argc, char** argv) {
 
     BakeOptions bake;
     CLI::App* bakeCommand = addBakeCommand(app, bake);
+    InspectOptions inspect;
+    CLI::App* inspectCommand = addInspectCommand(app, inspect);
 
     if (argc <= 1) {
         std::fputs(app.help().c_str(), stderr);
@@ -244,6 +417,7 @@ int run(int argc, char** argv) {
         return code == 0 ? kOk : kUsage;
     }
     if (bakeCommand->parsed()) return runBake(bake);
+    if (inspectCommand->parsed()) return runInspect(inspect);
     return kUsage;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/hierarchy_nodes.h>
 
 #include <string>
 #include <vector>
@@ -35,9 +36,25 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
                      std::string& error);
 
 /// Writes OUTDIR/levels.glb: one node per aggregate per level, grouped under one parent
-/// node per level; extras {level, delta, sources: [input object names]}.
+/// node per level; extras {level, delta, sources: [input object names]}. With `nodes`
+/// (the hierarchy nodes of the same bake), each aggregate's extras also carry its node of
+/// the runtime hierarchy: node, parent, children (node indices; index < object count = that
+/// original object), first_level, last_level, geometric_error (stored, monotone),
+/// proxy_error {proxy_to_originals, originals_to_proxy (certified upper bounds),
+/// proxy_to_originals_found, originals_to_proxy_found (largest distances found), tolerance, bound},
+/// proxy_triangles. World units throughout.
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                    const std::string& path, std::string& error);
+                    const std::string& path, std::string& error,
+                    const HierarchyNodes* nodes = nullptr);
+
+/// Writes OUTDIR/proxies.glb: glTF node i = hierarchy node i, nested as the hierarchy (scene
+/// roots = its roots). Aggregate nodes carry their simplified proxy as a mesh (one material
+/// per level) and extras {node, level, last_level, delta, geometric_error, proxy_error_bound,
+/// exact_triangles, bounding_sphere [x, y, z, r], sources, source_ids}; leaves (the original
+/// objects, named "object_<name>") have no mesh and extras {node, leaf, geometric_error 0,
+/// bounding_sphere, sources, source_ids}. World units.
+bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                     const std::string& path, std::string& error);
 
 /// Writes the stats JSON (see README "Stats file"). Timings are written last, in their
 /// own object, so determinism checks can drop them.

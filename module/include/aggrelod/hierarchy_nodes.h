@@ -1,0 +1,110 @@
+// aggrelod module: the hierarchy of a 3D bake as a tree of nodes for real-time use
+// (DESIGN sections 2.5 and 2.6).
+//
+// Leaves are the original objects (geometric error 0). Inner nodes are the aggregates of
+// the levels of a Hierarchy3D; the parent of an aggregate is the aggregate that contains
+// its objects at the next coarser level. An aggregate that does not change from one level
+// to the next (same objects, same solid: same vertices, volume and area, whatever the
+// triangulation of flat faces) is one node spanning those levels. Every
+// aggregate gets a proxy simplified with meshoptimizer (target error a fraction of the
+// level's delta) and its measured geometric error against the original objects.
+//
+// Units: every length is in world units (those of the input objects).
+// Determinism: the same Hierarchy3D, objects and settings give bit-identical nodes,
+// whatever the thread count.
+#pragma once
+
+#include <aggrelod/aggregate3d.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace aggrelod {
+
+constexpr uint32_t kNoNode = 0xFFFFFFFFu;
+
+struct ProxySettings {
+    /// meshoptimizer's target error for the proxy of a level-k aggregate, as a fraction of
+    /// delta_k (world units once multiplied). 0 keeps the exact aggregate as its proxy.
+    double simplifyFraction = 0.25;
+    /// How far (world units, as a fraction of delta_k) the certified upper bound of the
+    /// error may exceed the largest distance actually found; the refinement stops there ...
+    double toleranceFraction = 0.02;
+    /// ... or after this many region evaluations per direction beyond one per triangle (the
+    /// bound stays certified, only looser).
+    size_t maxRefinementsPerDirection = 20000;
+    int threadCount = 0;  ///< 0 = hardware concurrency; results identical for every count
+    ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
+};
+
+/// One-sided Hausdorff distances between a proxy and the original objects it stands for:
+/// certified upper bounds (never below the true distance, up to double rounding; for
+/// originals -> proxy this assumes a closed proxy, as inside-ness is decided by ray parity)
+/// and the largest distance found.
+struct ProxyError {
+    double proxyToOriginals = 0;  ///< upper bound: every proxy point is this close to an original surface
+    double originalsToProxy = 0;  ///< upper bound: every original point is inside the proxy or this close to it
+    double proxyToOriginalsLower = 0;  ///< largest distance found at an evaluated proxy point
+    double originalsToProxyLower = 0;  ///< largest distance found at an evaluated original point
+    double tolerance = 0;         ///< allowed gap between found and bound (world units)
+    size_t evaluationCount = 0;   ///< regions evaluated, both directions
+    /// max(proxyToOriginals, originalsToProxy), world units.
+    double bound() const;
+};
+
+struct HierarchyNode {
+    uint32_t parent = kNoNode;         ///< index in HierarchyNodes::nodes; kNoNode for roots
+    std::vector<uint32_t> children;    ///< node indices, ascending (all smaller than this node's)
+    std::vector<uint32_t> sources;     ///< original object indices, ascending
+    bool leaf = false;                 ///< an original object (node index = object index)
+    int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
+    int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
+    uint32_t aggregateIndex = 0;       ///< index in levels[firstLevel].aggregates (aggregates only)
+    double delta = 0;                  ///< delta of firstLevel, world units (0 for leaves)
+    std::vector<float> positions;      ///< proxy (leaf: the original; empty for a left-out object), 3 * vertexCount, world units
+    std::vector<uint32_t> indices;     ///< 3 * triangleCount, outward
+    size_t exactTriangleCount = 0;     ///< triangles of the unsimplified aggregate (leaf: of the object)
+    ProxyError error;                  ///< measured error of this node's proxy (zeros for leaves)
+    /// Stored geometric error, world units: max(error.bound(), every child's geometricError),
+    /// so it never decreases towards the roots. Exactly representable as a float (rounded up).
+    double geometricError = 0;
+    /// Axis-aligned box containing the proxy and every child's box; float-representable,
+    /// rounded outwards.
+    double boundsMin[3] = {0, 0, 0}, boundsMax[3] = {0, 0, 0};
+    /// Sphere containing the proxy and every child's sphere; centre float-representable,
+    /// radius rounded up so that the nesting holds when read back as floats.
+    double sphereCenter[3] = {0, 0, 0};
+    double sphereRadius = 0;
+};
+
+struct HierarchyNodes {
+    /// Leaves first (node i = object i for i < objectCount), then the aggregate nodes by
+    /// firstLevel and aggregate index. Children always come before their parent.
+    std::vector<HierarchyNode> nodes;
+    std::vector<uint32_t> roots;       ///< ascending
+    size_t objectCount = 0;
+    /// nodeOfAggregate[k][g]: node standing for levels[k].aggregates[g].
+    std::vector<std::vector<uint32_t>> nodeOfAggregate;
+};
+
+/// Builds the node tree of `hierarchy`, baked from `objects` (same array, same order).
+/// An object the bake left out (in no aggregate of any level, e.g. for a non-finite
+/// coordinate) becomes a root leaf without geometry.
+/// Returns false with a message in `error` when the two do not match (a source index out of
+/// range, an object in two aggregates of one level or in some levels only, a level not
+/// coarser than the previous one). Never throws for such input.
+bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                         const ProxySettings& settings, HierarchyNodes& out, std::string& error);
+
+/// Measures the error of a proxy (float positions, 3 * vertexCount; indices 3 * triangleCount,
+/// closed) against `originals` (world units) by branch and bound over triangles: refines
+/// until the bounds are within `tolerance` (world units) or after maxRefinementsPerDirection
+/// evaluations per direction beyond one per triangle. An empty proxy (nothing drawn) gets
+/// originalsToProxy = the diagonal of the originals' box. Deterministic, single thread.
+ProxyError measureProxyError(const std::vector<float>& proxyPositions,
+                             const std::vector<uint32_t>& proxyIndices,
+                             const std::vector<const InputObject*>& originals, double tolerance,
+                             size_t maxRefinementsPerDirection);
+
+}  // namespace aggrelod

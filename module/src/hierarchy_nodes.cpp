@@ -1,0 +1,257 @@
+// aggrelod module: hierarchy nodes for real-time use (DESIGN sections 2.5 and 2.6).
+// Builds the tree (leaves = original objects, inner nodes = aggregates, unchanged aggregates
+// collapsed across levels), simplifies every aggregate into a proxy (mesh_simplify.cpp),
+// measures its error (proxy_error.cpp), and makes bounds nested and errors monotone so that
+// the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
+#include "mesh_simplify.h"
+#include "parallel_for.h"
+
+#include <aggrelod/hierarchy_nodes.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace aggrelod {
+
+namespace {
+
+/// Smallest float >= x (as a double).
+double floatUp(double x) {
+    float f = static_cast<float>(x);
+    if (double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
+}
+/// Largest float <= x (as a double).
+double floatDown(double x) {
+    float f = static_cast<float>(x);
+    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    return f;
+}
+
+void growBox(double lo[3], double hi[3], const double p[3]) {
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], p[k]);
+        hi[k] = std::max(hi[k], p[k]);
+    }
+}
+
+double distance(const double a[3], const double b[3]) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/// Fills box and sphere of `node` from its own vertices (float proxy and, for aggregates,
+/// the exact double mesh) and its children, rounded to float outwards.
+void computeBounds(HierarchyNode& node, const std::vector<double>& exactPositions,
+                   const std::vector<HierarchyNode>& nodes) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i + 2 < node.positions.size(); i += 3) {
+        const double p[3] = {node.positions[i], node.positions[i + 1], node.positions[i + 2]};
+        growBox(lo, hi, p);
+    }
+    for (size_t i = 0; i + 2 < exactPositions.size(); i += 3) growBox(lo, hi, &exactPositions[i]);
+    for (uint32_t c : node.children) {
+        growBox(lo, hi, nodes[c].boundsMin);
+        growBox(lo, hi, nodes[c].boundsMax);
+    }
+    if (!(lo[0] <= hi[0])) {  // nothing at all (cannot happen for a validated hierarchy)
+        for (int k = 0; k < 3; ++k) lo[k] = hi[k] = 0;
+    }
+    for (int k = 0; k < 3; ++k) {
+        node.boundsMin[k] = floatDown(lo[k]);
+        node.boundsMax[k] = floatUp(hi[k]);
+        node.sphereCenter[k] = static_cast<float>(0.5 * (lo[k] + hi[k]));
+    }
+    double r = 0;
+    for (size_t i = 0; i + 2 < node.positions.size(); i += 3) {
+        const double p[3] = {node.positions[i], node.positions[i + 1], node.positions[i + 2]};
+        r = std::max(r, distance(node.sphereCenter, p));
+    }
+    for (size_t i = 0; i + 2 < exactPositions.size(); i += 3) r = std::max(r, distance(node.sphereCenter, &exactPositions[i]));
+    for (uint32_t c : node.children)
+        r = std::max(r, distance(node.sphereCenter, nodes[c].sphereCenter) + nodes[c].sphereRadius);
+    // A relative margin keeps the nesting true when a reader recomputes it in float.
+    node.sphereRadius = floatUp(r * (1 + 1e-6));
+}
+
+/// Vertex coordinates as sorted xyz triples.
+std::vector<std::array<double, 3>> sortedVertices(const Aggregate& a) {
+    std::vector<std::array<double, 3>> v(a.positions.size() / 3);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = {a.positions[3 * i], a.positions[3 * i + 1], a.positions[3 * i + 2]};
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+bool nearlyEqual(double x, double y) { return std::fabs(x - y) <= 1e-9 * std::max(std::fabs(x), std::fabs(y)); }
+
+/// The same solid: same objects, same vertices, same volume and area. This tells apart real
+/// changes of the fill and ignores a flat face (e.g. a planar quad of an object, filled by a
+/// zero-volume sliver) split along its other diagonal at another level.
+bool sameSolid(const Aggregate& a, const Aggregate& b) {
+    if (a.sourceObjects != b.sourceObjects || a.positions.size() != b.positions.size()) return false;
+    if (a.indices == b.indices && a.positions == b.positions) return true;
+    return nearlyEqual(a.measures.volume, b.measures.volume) && nearlyEqual(a.measures.area, b.measures.area) &&
+           sortedVertices(a) == sortedVertices(b);
+}
+
+}  // namespace
+
+bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                         const ProxySettings& settings, HierarchyNodes& out, std::string& error) {
+    out = HierarchyNodes{};
+    const size_t objectCount = objects.size();
+    const size_t levelCount = hierarchy.levels.size();
+    out.objectCount = objectCount;
+
+    // groupOf[k][o]: the aggregate of level k holding object o. Checks the partition.
+    std::vector<std::vector<uint32_t>> groupOf(levelCount, std::vector<uint32_t>(objectCount, kNoNode));
+    for (size_t k = 0; k < levelCount; ++k) {
+        const Level& level = hierarchy.levels[k];
+        for (size_t g = 0; g < level.aggregates.size(); ++g) {
+            const Aggregate& agg = level.aggregates[g];
+            const std::string where = "level " + std::to_string(k) + " aggregate " + std::to_string(g);
+            if (agg.sourceObjects.empty()) {
+                error = where + " stands for no object";
+                return false;
+            }
+            if (agg.positions.size() % 3 || agg.indices.size() % 3) {
+                error = where + ": positions or indices size is not a multiple of 3";
+                return false;
+            }
+            for (uint32_t i : agg.indices)
+                if (i >= agg.positions.size() / 3) {
+                    error = where + ": vertex index " + std::to_string(i) + " out of range";
+                    return false;
+                }
+            for (uint32_t o : agg.sourceObjects) {
+                if (o >= objectCount) {
+                    error = where + " refers to object " + std::to_string(o) + " but there are " +
+                            std::to_string(objectCount) + " objects";
+                    return false;
+                }
+                if (groupOf[k][o] != kNoNode) {
+                    error = "object '" + objects[o].name + "' is in two aggregates of level " + std::to_string(k);
+                    return false;
+                }
+                groupOf[k][o] = static_cast<uint32_t>(g);
+            }
+        }
+        // An object the bake left out (e.g. a non-finite coordinate) is in no level; any
+        // other object is in every level.
+        for (size_t o = 0; o < objectCount; ++o)
+            if ((groupOf[k][o] == kNoNode) != (groupOf[0][o] == kNoNode)) {
+                error = "object '" + objects[o].name + "' is in an aggregate of level " +
+                        std::to_string(groupOf[k][o] == kNoNode ? 0 : k) + " but in none of level " +
+                        std::to_string(groupOf[k][o] == kNoNode ? k : 0);
+                return false;
+            }
+        if (k > 0)  // groups only coarsen: one level-(k-1) group lies in one level-k group
+            for (size_t o = 0; o < objectCount; ++o) {
+                if (groupOf[k][o] == kNoNode) continue;
+                const Aggregate& below = hierarchy.levels[k - 1].aggregates[groupOf[k - 1][o]];
+                if (groupOf[k][below.sourceObjects.front()] != groupOf[k][o]) {
+                    error = "level " + std::to_string(k) + " splits a group of level " + std::to_string(k - 1) +
+                            " (object '" + objects[o].name + "')";
+                    return false;
+                }
+            }
+    }
+    for (size_t o = 0; o < objectCount; ++o) {
+        if (objects[o].positions.size() % 3 || objects[o].indices.size() % 3) {
+            error = "object '" + objects[o].name + "': positions or indices size is not a multiple of 3";
+            return false;
+        }
+        for (uint32_t i : objects[o].indices)
+            if (i >= objects[o].positions.size() / 3) {
+                error = "object '" + objects[o].name + "': vertex index " + std::to_string(i) + " out of range";
+                return false;
+            }
+    }
+
+    // Leaves: the original objects.
+    std::vector<HierarchyNode>& nodes = out.nodes;
+    nodes.resize(objectCount);
+    for (size_t o = 0; o < objectCount; ++o) {
+        HierarchyNode& n = nodes[o];
+        n.leaf = true;
+        n.sources = {static_cast<uint32_t>(o)};
+        n.exactTriangleCount = objects[o].indices.size() / 3;
+        // A left-out object keeps its leaf (a root) without geometry.
+        const bool inHierarchy = levelCount > 0 && groupOf[0][o] != kNoNode;
+        const bool finite = std::all_of(objects[o].positions.begin(), objects[o].positions.end(),
+                                        [](double x) { return std::isfinite(x); });
+        if (inHierarchy && finite) {
+            n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
+            n.indices = objects[o].indices;
+        }
+    }
+    // Aggregates, level by level; an aggregate that is the same solid as the one holding the
+    // same objects one level finer is the same node (its level range grows).
+    out.nodeOfAggregate.resize(levelCount);
+    for (size_t k = 0; k < levelCount; ++k) {
+        const Level& level = hierarchy.levels[k];
+        out.nodeOfAggregate[k].resize(level.aggregates.size());
+        for (size_t g = 0; g < level.aggregates.size(); ++g) {
+            const Aggregate& agg = level.aggregates[g];
+            if (k > 0) {
+                const uint32_t previous = groupOf[k - 1][agg.sourceObjects.front()];
+                if (sameSolid(hierarchy.levels[k - 1].aggregates[previous], agg)) {
+                    const uint32_t node = out.nodeOfAggregate[k - 1][previous];
+                    nodes[node].lastLevel = static_cast<int>(k);
+                    out.nodeOfAggregate[k][g] = node;
+                    continue;
+                }
+            }
+            HierarchyNode n;
+            n.firstLevel = n.lastLevel = static_cast<int>(k);
+            n.aggregateIndex = static_cast<uint32_t>(g);
+            n.delta = level.delta;
+            n.sources = agg.sourceObjects;
+            n.exactTriangleCount = agg.indices.size() / 3;
+            out.nodeOfAggregate[k][g] = static_cast<uint32_t>(nodes.size());
+            nodes.push_back(std::move(n));
+        }
+    }
+    // Parents: the node holding the first object one level above the last level spanned.
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        HierarchyNode& n = nodes[i];
+        const size_t above = n.leaf ? 0 : size_t(n.lastLevel) + 1;
+        if (above < levelCount && groupOf[above][n.sources.front()] != kNoNode) {
+            n.parent = out.nodeOfAggregate[above][groupOf[above][n.sources.front()]];
+            nodes[n.parent].children.push_back(static_cast<uint32_t>(i));
+        } else {
+            out.roots.push_back(static_cast<uint32_t>(i));
+        }
+    }
+
+    // Proxies and their errors: independent per aggregate node, each writes its own node.
+    auto aggregateOf = [&](const HierarchyNode& n) -> const Aggregate& {
+        return hierarchy.levels[size_t(n.firstLevel)].aggregates[n.aggregateIndex];
+    };
+    detail::parallelFor(nodes.size() - objectCount, settings.threadCount, [&](size_t j) {
+        HierarchyNode& n = nodes[objectCount + j];
+        const Aggregate& agg = aggregateOf(n);
+        const std::vector<float> exact(agg.positions.begin(), agg.positions.end());
+        detail::simplifyMesh(exact, agg.indices, settings.simplifyFraction * n.delta, n.positions, n.indices);
+        std::vector<const InputObject*> originals;
+        for (uint32_t o : n.sources) originals.push_back(&objects[o]);
+        n.error = measureProxyError(n.positions, n.indices, originals, settings.toleranceFraction * n.delta,
+                                    settings.maxRefinementsPerDirection);
+    }, [&](size_t done) {
+        if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
+    });
+
+    // Errors and bounds, children first (children have smaller indices than their parent).
+    const std::vector<double> none;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        HierarchyNode& n = nodes[i];
+        double e = n.leaf ? 0.0 : n.error.bound();
+        for (uint32_t c : n.children) e = std::max(e, nodes[c].geometricError);
+        n.geometricError = floatUp(e);
+        computeBounds(n, n.leaf ? (n.positions.empty() ? none : objects[i].positions) : aggregateOf(n).positions, nodes);
+    }
+    return true;
+}
+
+}  // namespace aggrelod

@@ -1,0 +1,268 @@
+// Tests of the hierarchy nodes for real-time use (issue 4, deliverable 1; DESIGN 2.5, 2.6):
+// bounds nested, errors monotone, every original object under exactly one root path,
+// proxies simpler than the exact aggregates, an independent denser error measurement below
+// the stored error, collapsed unchanged aggregates, determinism over thread counts.
+#include <aggrelod/aggregate3d.h>
+#include <aggrelod/hierarchy_nodes.h>
+#include <aggrelod/samples.h>
+
+#include "mesh_distance.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+using namespace aggrelod;
+
+namespace {
+
+struct Baked {
+    std::vector<InputObject> objects;
+    Hierarchy3D hierarchy;
+    HierarchyNodes nodes;
+};
+
+/// The 15-spheres scene at the paper's deltas, baked once for the whole file.
+const Baked& spheres15() {
+    static const Baked baked = [] {
+        Baked b;
+        b.objects = samples::makeSpheres15(1);
+        Settings3D s;
+        s.deltas = {1, 1.5, 2, 3, 4};
+        s.threadCount = 2;
+        EXPECT_TRUE(buildHierarchy3D(b.objects, s, b.hierarchy));
+        ProxySettings p;
+        p.threadCount = 2;
+        std::string error;
+        EXPECT_TRUE(buildHierarchyNodes(b.hierarchy, b.objects, p, b.nodes, error)) << error;
+        return b;
+    }();
+    return baked;
+}
+
+bool boxInside(const HierarchyNode& inner, const HierarchyNode& outer) {
+    for (int k = 0; k < 3; ++k)
+        if (inner.boundsMin[k] < outer.boundsMin[k] || inner.boundsMax[k] > outer.boundsMax[k]) return false;
+    return true;
+}
+
+/// Sphere nesting evaluated in float, as a runtime reading the file would.
+bool sphereInsideFloat(const HierarchyNode& inner, const HierarchyNode& outer) {
+    float d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float d = float(inner.sphereCenter[k]) - float(outer.sphereCenter[k]);
+        d2 += d * d;
+    }
+    return std::sqrt(d2) + float(inner.sphereRadius) <= float(outer.sphereRadius);
+}
+
+// Generalized winding number of a closed float mesh at q (about 1 inside, 0 outside).
+double windingNumber(const std::vector<float>& pos, const std::vector<uint32_t>& idx, const double* q) {
+    double total = 0;
+    for (size_t t = 0; t < idx.size(); t += 3) {
+        double r[3][3], len[3];
+        for (int k = 0; k < 3; ++k) {
+            for (int d = 0; d < 3; ++d) r[k][d] = pos[3 * idx[t + k] + d] - q[d];
+            len[k] = std::sqrt(r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2]);
+        }
+        const double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+                           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+        auto dot = [&](int i, int j) { return r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2]; };
+        const double den = len[0] * len[1] * len[2] + dot(0, 1) * len[2] + dot(1, 2) * len[0] + dot(2, 0) * len[1];
+        total += 2 * std::atan2(det, den);
+    }
+    return total / (4 * M_PI);
+}
+
+/// Calls visit(point) for a 15-point barycentric grid (step 1/4) on every triangle.
+template <class Positions, class Visit>
+void forEachGridPoint(const Positions& pos, const std::vector<uint32_t>& idx, Visit&& visit) {
+    for (size_t t = 0; t < idx.size(); t += 3)
+        for (int i = 0; i <= 4; ++i)
+            for (int j = 0; i + j <= 4; ++j) {
+                double p[3];
+                for (int k = 0; k < 3; ++k) {
+                    const double a = pos[3 * idx[t] + k], b = pos[3 * idx[t + 1] + k], c = pos[3 * idx[t + 2] + k];
+                    p[k] = a + 0.25 * i * (b - a) + 0.25 * j * (c - a);
+                }
+                visit(p);
+            }
+}
+
+/// max(proxy -> originals, originals -> proxy solid) over grid points.
+double gridMeasuredError(const HierarchyNode& n, const std::vector<const InputObject*>& originals) {
+    std::vector<double> op;
+    std::vector<uint32_t> oi;
+    for (const InputObject* o : originals) {
+        const uint32_t base = uint32_t(op.size() / 3);
+        op.insert(op.end(), o->positions.begin(), o->positions.end());
+        for (uint32_t i : o->indices) oi.push_back(base + i);
+    }
+    detail::TriangleBvh origBvh, proxyBvh;
+    origBvh.build(op.data(), op.size() / 3, oi.data(), oi.size() / 3);
+    const std::vector<double> pp(n.positions.begin(), n.positions.end());
+    proxyBvh.build(pp.data(), pp.size() / 3, n.indices.data(), n.indices.size() / 3);
+    double worst = 0;
+    forEachGridPoint(n.positions, n.indices, [&](const double* p) { worst = std::max(worst, detail::closestPoint(origBvh, p).distance); });
+    forEachGridPoint(op, oi, [&](const double* p) {
+        const double d = detail::closestPoint(proxyBvh, p).distance;
+        if (d > worst && windingNumber(n.positions, n.indices, p) < 0.5) worst = d;
+    });
+    return worst;
+}
+
+}  // namespace
+
+TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
+    const Baked& b = spheres15();
+    const auto& nodes = b.nodes.nodes;
+    ASSERT_EQ(b.nodes.objectCount, b.objects.size());
+    ASSERT_GT(nodes.size(), b.objects.size());
+    size_t aggregates = 0;
+    for (const Level& l : b.hierarchy.levels) aggregates += l.aggregates.size();
+    std::printf("spheres15: %zu objects, %zu aggregates over %zu levels -> %zu aggregate nodes, %zu roots\n",
+                b.objects.size(), aggregates, b.hierarchy.levels.size(), nodes.size() - b.objects.size(),
+                b.nodes.roots.size());
+    // Unchanged aggregates are collapsed: fewer nodes than aggregates, and each aggregate maps
+    // to a node spanning its level with the same objects.
+    EXPECT_LT(nodes.size() - b.objects.size(), aggregates);
+    for (size_t k = 0; k < b.hierarchy.levels.size(); ++k)
+        for (size_t g = 0; g < b.hierarchy.levels[k].aggregates.size(); ++g) {
+            const HierarchyNode& n = nodes[b.nodes.nodeOfAggregate[k][g]];
+            EXPECT_LE(n.firstLevel, int(k));
+            EXPECT_GE(n.lastLevel, int(k));
+            EXPECT_EQ(n.sources, b.hierarchy.levels[k].aggregates[g].sourceObjects);
+        }
+
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const HierarchyNode& n = nodes[i];
+        EXPECT_EQ(n.leaf, i < b.objects.size());
+        if (n.leaf) {
+            EXPECT_EQ(n.geometricError, 0.0);
+            EXPECT_TRUE(n.children.empty());
+        } else {
+            // Children partition the node's objects.
+            std::vector<uint32_t> fromChildren;
+            for (uint32_t c : n.children) fromChildren.insert(fromChildren.end(), nodes[c].sources.begin(), nodes[c].sources.end());
+            std::sort(fromChildren.begin(), fromChildren.end());
+            EXPECT_EQ(fromChildren, n.sources) << "node " << i;
+            EXPECT_GE(n.geometricError, n.error.bound()) << "node " << i;
+            EXPECT_EQ(double(float(n.geometricError)), n.geometricError);
+        }
+        for (uint32_t c : n.children) {
+            EXPECT_LT(c, i);
+            EXPECT_EQ(nodes[c].parent, i);
+            EXPECT_GE(n.geometricError, nodes[c].geometricError) << "error not monotone at node " << i;
+            EXPECT_TRUE(boxInside(nodes[c], n)) << "box of node " << c << " not inside its parent " << i;
+            EXPECT_TRUE(sphereInsideFloat(nodes[c], n)) << "sphere of node " << c << " not inside its parent " << i;
+        }
+        // The node's own proxy lies in its box.
+        for (size_t v = 0; v < n.positions.size(); v += 3)
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_GE(n.positions[v + k], n.boundsMin[k]);
+                EXPECT_LE(n.positions[v + k], n.boundsMax[k]);
+            }
+    }
+    // Every original object lies under exactly one root, on one path of parents.
+    std::vector<int> rootHits(b.objects.size(), 0);
+    for (uint32_t r : b.nodes.roots) {
+        EXPECT_EQ(nodes[r].parent, kNoNode);
+        for (uint32_t o : nodes[r].sources) ++rootHits[o];
+    }
+    for (size_t o = 0; o < b.objects.size(); ++o) {
+        EXPECT_EQ(rootHits[o], 1) << b.objects[o].name;
+        size_t steps = 0;
+        for (uint32_t n = uint32_t(o); nodes[n].parent != kNoNode; n = nodes[n].parent) {
+            ASSERT_LT(++steps, nodes.size()) << "cycle above object " << o;
+            EXPECT_TRUE(std::binary_search(nodes[nodes[n].parent].sources.begin(), nodes[nodes[n].parent].sources.end(), uint32_t(o)));
+        }
+    }
+}
+
+TEST(HierarchyNodes, ProxiesAreSimplerAndTheirStoredErrorBoundsAnIndependentMeasurement) {
+    const Baked& b = spheres15();
+    const auto& nodes = b.nodes.nodes;
+    size_t exact = 0, proxy = 0, reduced = 0;
+    double worstRatio = 0, found = 1;
+    for (size_t i = b.objects.size(); i < nodes.size(); ++i) {
+        const HierarchyNode& n = nodes[i];
+        exact += n.exactTriangleCount;
+        proxy += n.indices.size() / 3;
+        EXPECT_LE(n.indices.size() / 3, n.exactTriangleCount);
+        EXPECT_GT(n.indices.size(), 0u);
+        reduced += n.indices.size() / 3 < n.exactTriangleCount;
+        // An independent measurement: a 15-point barycentric grid on every triangle of both
+        // meshes, exact closest points, inside-ness by the winding number. Its maximum never
+        // exceeds the certified bound stored in the node.
+        std::vector<const InputObject*> originals;
+        for (uint32_t o : n.sources) originals.push_back(&b.objects[o]);
+        const double measured = gridMeasuredError(n, originals);
+        EXPECT_LE(measured, n.geometricError) << "node " << i;
+        EXPECT_LE(measured, n.error.bound()) << "node " << i;
+        worstRatio = std::max(worstRatio, measured / n.geometricError);
+        found = std::min(found, std::max(n.error.proxyToOriginalsLower, n.error.originalsToProxyLower) / n.error.bound());
+        EXPECT_GT(n.error.proxyToOriginals, 0.0) << "an aggregate adds fill: its proxy is away from the originals somewhere";
+    }
+    std::printf("spheres15 proxies: %zu -> %zu triangles (%.0f%%), %zu of %zu simplified; "
+                "grid measurement / stored error <= %.2f; found / certified bound >= %.2f\n",
+                exact, proxy, 100.0 * double(proxy) / double(exact), reduced, nodes.size() - b.objects.size(), worstRatio,
+                found);
+    EXPECT_LT(proxy, exact * 3 / 4);
+    EXPECT_GT(reduced, 0u);
+}
+
+TEST(HierarchyNodes, SameNodesForOneAndTwoThreads) {
+    const Baked& b = spheres15();
+    ProxySettings p;
+    p.threadCount = 1;
+    HierarchyNodes single;
+    std::string error;
+    ASSERT_TRUE(buildHierarchyNodes(b.hierarchy, b.objects, p, single, error)) << error;
+    ASSERT_EQ(single.nodes.size(), b.nodes.nodes.size());
+    for (size_t i = 0; i < single.nodes.size(); ++i) {
+        const HierarchyNode &x = single.nodes[i], &y = b.nodes.nodes[i];
+        EXPECT_EQ(x.positions, y.positions);
+        EXPECT_EQ(x.indices, y.indices);
+        EXPECT_EQ(x.geometricError, y.geometricError);
+        EXPECT_EQ(x.sphereRadius, y.sphereRadius);
+        EXPECT_EQ(x.children, y.children);
+    }
+}
+
+TEST(HierarchyNodes, MismatchedObjectsAreRefusedWithAMessage) {
+    const Baked& b = spheres15();
+    std::vector<InputObject> fewer(b.objects.begin(), b.objects.end() - 1);
+    HierarchyNodes out;
+    std::string error;
+    EXPECT_FALSE(buildHierarchyNodes(b.hierarchy, fewer, ProxySettings{}, out, error));
+    EXPECT_NE(error.find("refers to object 14"), std::string::npos) << error;
+}
+
+TEST(HierarchyNodes, ProxyErrorOfKnownShapes) {
+    // A unit cube as its own proxy: 0 both ways. A proxy shrunk by 10 % around the centre:
+    // proxy -> originals = originals -> proxy = the largest corner displacement, sqrt(3) * 0.05.
+    const InputObject cube = samples::makeBox("cube", {0, 0, 0}, {1, 1, 1});
+    const std::vector<float> same(cube.positions.begin(), cube.positions.end());
+    const ProxyError exact = measureProxyError(same, cube.indices, {&cube}, 1e-3, 20000);
+    EXPECT_LE(exact.bound(), 1e-3);
+    std::vector<float> shrunk;
+    for (double x : cube.positions) shrunk.push_back(float(0.5 + 0.9 * (x - 0.5)));
+    const ProxyError inner = measureProxyError(shrunk, cube.indices, {&cube}, 1e-4, 200000);
+    const double corner = std::sqrt(3.0) * 0.05;
+    EXPECT_NEAR(inner.proxyToOriginals, 0.05, 1e-3);   // a face centre of the shrunk cube
+    EXPECT_NEAR(inner.originalsToProxy, corner, 1e-3);  // an original corner
+    EXPECT_GE(inner.originalsToProxy, inner.originalsToProxyLower);
+    EXPECT_LE(inner.originalsToProxy - inner.originalsToProxyLower, 1e-4 + 1e-7);
+    // A proxy grown by 10 %: the originals are inside it (distance to the solid 0).
+    std::vector<float> grown;
+    for (double x : cube.positions) grown.push_back(float(0.5 + 1.1 * (x - 0.5)));
+    const ProxyError outer = measureProxyError(grown, cube.indices, {&cube}, 1e-4, 200000);
+    EXPECT_NEAR(outer.proxyToOriginals, corner, 1e-3);
+    EXPECT_LE(outer.originalsToProxy, 1e-4);
+    // Nothing drawn: the error is the originals' extent.
+    const ProxyError none = measureProxyError({}, {}, {&cube}, 1e-3, 100);
+    EXPECT_NEAR(none.bound(), std::sqrt(3.0), 1e-12);
+}
