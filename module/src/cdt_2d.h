@@ -1,0 +1,31 @@
+// Constrained Delaunay triangulation of a planar point set with constraint segments
+// (DESIGN 2.1, 2D; paper Section 3.1). The only place that knows CGAL's 2D triangulation.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace aggrelod::detail {
+
+/// Flat triangulation of the convex hull of the input points.
+struct Triangulation2D {
+    std::vector<double> points;     ///< 2 * vertexCount, x y pairs
+    std::vector<int> vertexInput;   ///< per vertex: index of an input point at the same place, -1 for a Steiner point
+    std::vector<int> faces;         ///< 3 * faceCount vertex indices, counter-clockwise
+    std::vector<int> neighbors;     ///< 3 * faceCount: face across the edge opposite corner i, -1 outside the hull
+    std::vector<char> constrained;  ///< 3 * faceCount: edge opposite corner i lies on a constraint
+    size_t vertexCount() const { return points.size() / 2; }
+    size_t faceCount() const { return faces.size() / 3; }
+};
+
+/// Triangulates `points` (2 * n, x y pairs) with the segments `segments` (pairs of point
+/// indices) as constraints, all inserted in one batch. Crossing constraints are split at
+/// their intersections (new Steiner vertices). Duplicate points become one vertex.
+/// Returns false with a message when the triangulator fails (never throws).
+bool triangulateConstrained(const std::vector<double>& points,
+                            const std::vector<std::pair<size_t, size_t>>& segments,
+                            Triangulation2D& out, std::string& error);
+
+}  // namespace aggrelod::detail

@@ -1,0 +1,487 @@
+// The 2D pipeline (paper Sections 3.1-3.3 and 4.2; DESIGN 2.1-2.5 in 2D):
+// check input -> one constrained Delaunay triangulation -> inside/outside by winding ->
+// models (touching / overlapping polygons merged) -> neighbourhood graph -> Kruskal
+// dendrogram (shared with 3D) -> per level: sculpt, polygons, measures and baselines.
+#include "free_space_2d.h"
+#include "polygon_check_2d.h"
+#include "sculpt_2d.h"
+
+#include <aggrelod/aggregate2d.h>
+#include <aggrelod/dendrogram.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <numeric>
+#include <string>
+#include <tuple>
+
+namespace aggrelod {
+
+double circularity(double area, double perimeter) {
+    return perimeter > 0 ? 4 * M_PI * area / (perimeter * perimeter) : 0;
+}
+
+Measures2D normalizedMeasures(const Measures2D& m, const Measures2D& o) {
+    Measures2D r;
+    r.area = o.area > 0 ? m.area / o.area : 0;
+    r.perimeter = o.perimeter > 0 ? m.perimeter / o.perimeter : 0;
+    r.circularity = o.circularity > 0 ? m.circularity / o.circularity : 0;
+    return r;
+}
+
+namespace {
+using namespace detail;
+using Clock = std::chrono::steady_clock;
+
+uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+}
+void unite(std::vector<uint32_t>& parent, uint32_t a, uint32_t b) {
+    a = findRoot(parent, a);
+    b = findRoot(parent, b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+}
+
+/// Input vertices as one array, with the ring structure needed to orient constraints.
+struct InputVertices {
+    std::vector<double> points;            // 2 * n
+    std::vector<uint32_t> part;            // per vertex
+    std::vector<uint32_t> ringStart, ringSize;  // per vertex: its ring's first vertex and size
+    std::vector<std::pair<size_t, size_t>> segments;
+    std::vector<size_t> sorted;            // by (x, y, index)
+
+    size_t next(size_t v) const { return ringStart[v] + (v - ringStart[v] + 1) % ringSize[v]; }
+    size_t prev(size_t v) const { return ringStart[v] + (v - ringStart[v] + ringSize[v] - 1) % ringSize[v]; }
+    double x(size_t v) const { return points[2 * v]; }
+    double y(size_t v) const { return points[2 * v + 1]; }
+
+    // Input vertices at (px, py): a range of `sorted`.
+    std::pair<size_t, size_t> at(double px, double py) const {
+        auto less = [&](size_t a, std::pair<double, double> k) { return x(a) < k.first || (x(a) == k.first && y(a) < k.second); };
+        auto lo = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(px, py), less);
+        auto hi = lo;
+        while (hi != sorted.end() && x(*hi) == px && y(*hi) == py) ++hi;
+        return {static_cast<size_t>(lo - sorted.begin()), static_cast<size_t>(hi - sorted.begin())};
+    }
+};
+
+// True when point (qx, qy) lies on the segment from vertex a to b, beyond a.
+bool onInputSegment(const InputVertices& in, size_t a, size_t b, double qx, double qy) {
+    const double dx = in.x(b) - in.x(a), dy = in.y(b) - in.y(a);
+    const double ex = qx - in.x(a), ey = qy - in.y(a);
+    const double len2 = dx * dx + dy * dy;
+    const double dot = dx * ex + dy * ey;
+    if (dot <= 0 || dot > len2 * (1 + 1e-12)) return false;
+    const double cross = dx * ey - dy * ex;
+    return std::fabs(cross) <= 1e-9 * len2;
+}
+
+// Change of the winding count when crossing the triangulation edge u->v from its left side
+// (the face) to its right: -1 per input ring running u->v (its interior is on the left),
+// +1 per ring running v->u.
+int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, int v) {
+    const double ux = tri.points[2 * u], uy = tri.points[2 * u + 1];
+    const double vx = tri.points[2 * v], vy = tri.points[2 * v + 1];
+    std::vector<std::tuple<size_t, int>> found;  // (segment start vertex, sign)
+    auto scan = [&](double ax, double ay, double bx, double by, int signForward) {
+        auto [lo, hi] = in.at(ax, ay);
+        for (size_t i = lo; i < hi; ++i) {
+            const size_t a = in.sorted[i];
+            const size_t n = in.next(a), p = in.prev(a);
+            if (onInputSegment(in, a, n, bx, by)) found.emplace_back(a, signForward);
+            if (onInputSegment(in, a, p, bx, by)) found.emplace_back(p, -signForward);
+        }
+    };
+    scan(ux, uy, vx, vy, -1);  // ring a->n along u->v: leaving (-1)
+    scan(vx, vy, ux, uy, +1);  // ring a->n along v->u: entering (+1)
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end(),
+                            [](const auto& a, const auto& b) { return std::get<0>(a) == std::get<0>(b); }),
+                found.end());
+    int change = 0;
+    for (auto& f : found) change += std::get<1>(f);
+    return change;
+}
+
+std::string joinNames(const std::vector<Feature2D>& features, const std::vector<uint32_t>& ids) {
+    std::string s;
+    const size_t shown = std::min<size_t>(ids.size(), 6);
+    for (size_t i = 0; i < shown; ++i) s += (i ? ", " : "") + features[ids[i]].name;
+    if (ids.size() > shown) s += " and " + std::to_string(ids.size() - shown) + " more";
+    return s;
+}
+
+double pointSegmentDistance(const double* p, const double* a, const double* b) {
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double len2 = dx * dx + dy * dy;
+    double t = len2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2 : 0;
+    t = std::clamp(t, 0.0, 1.0);
+    return std::hypot(p[0] - (a[0] + t * dx), p[1] - (a[1] + t * dy));
+}
+
+}  // namespace
+
+bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& settings, Hierarchy2D& out) {
+    out = Hierarchy2D{};
+    out.featureModel.assign(features.size(), -1);
+    auto progress = [&](const char* stage, double fraction) {
+        if (settings.progress) settings.progress(stage, fraction);
+    };
+    auto stageStart = Clock::now();
+    auto endStage = [&](const char* name) {
+        const auto now = Clock::now();
+        out.timings.emplace_back(name, std::chrono::duration<double>(now - stageStart).count());
+        stageStart = now;
+    };
+    auto fail = [&](const std::string& message) {
+        out.diagnostics.push_back({Diagnostic::Severity::Error, "", message});
+        return false;
+    };
+    for (double d : settings.deltas)
+        if (!std::isfinite(d) || d < 0) return fail("every threshold delta must be a finite number >= 0");
+
+    // 1. Input checks.
+    progress("checking input", 0);
+    CheckedPolygons checked;
+    checkPolygons(features, checked, out.diagnostics);
+    if (checked.parts.empty()) return fail("no usable polygon in the input");
+    InputVertices in;
+    for (uint32_t p = 0; p < checked.parts.size(); ++p) {
+        const Polygon2D& poly = checked.parts[p];
+        out.originals.area += ringSignedArea(poly.exterior);
+        out.originals.perimeter += ringLength(poly.exterior);
+        for (int h = -1; h < static_cast<int>(poly.holes.size()); ++h) {
+            const std::vector<double>& ring = h < 0 ? poly.exterior : poly.holes[h];
+            if (h >= 0) {
+                out.originals.area += ringSignedArea(ring);
+                out.originals.perimeter += ringLength(ring);
+            }
+            const uint32_t start = static_cast<uint32_t>(in.part.size()), n = static_cast<uint32_t>(ring.size() / 2);
+            for (uint32_t i = 0; i < n; ++i) {
+                in.points.push_back(ring[2 * i]);
+                in.points.push_back(ring[2 * i + 1]);
+                in.part.push_back(p);
+                in.ringStart.push_back(start);
+                in.ringSize.push_back(n);
+                in.segments.emplace_back(start + i, start + (i + 1) % n);
+            }
+        }
+    }
+    out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
+    in.sorted.resize(in.part.size());
+    std::iota(in.sorted.begin(), in.sorted.end(), size_t{0});
+    std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
+        return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
+    });
+    endStage("check input");
+
+    // 2. Triangulation.
+    progress("triangulating", 0);
+    FreeSpace2D space;
+    std::string error;
+    if (!triangulateConstrained(in.points, in.segments, space.tri, error)) return fail(error);
+    const Triangulation2D& tri = space.tri;
+    const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
+    out.vertexCount = vertexCount;
+    out.triangleCount = faceCount;
+    endStage("triangulate");
+
+    // 3. Inside / outside by winding count, flooding from the outside of the hull.
+    progress("marking free space", 0);
+    std::vector<int> winding(faceCount, INT32_MIN);
+    std::deque<int> queue;
+    for (size_t f = 0; f < faceCount; ++f)
+        for (int j = 0; j < 3; ++j)
+            if (tri.neighbors[3 * f + j] < 0 && winding[f] == INT32_MIN) {
+                const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
+                winding[f] = tri.constrained[3 * f + j] ? -windingChange(in, tri, u, v) : 0;
+                queue.push_back(static_cast<int>(f));
+            }
+    while (!queue.empty()) {
+        const int f = queue.front();
+        queue.pop_front();
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || winding[n] != INT32_MIN) continue;
+            int w = winding[f];
+            if (tri.constrained[3 * f + j])
+                w += windingChange(in, tri, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3]);
+            winding[n] = w;
+            queue.push_back(n);
+        }
+    }
+    // Part of each vertex and of each interior face.
+    std::vector<int> vertexPart(vertexCount, -1);
+    for (size_t v = 0; v < vertexCount; ++v)
+        if (tri.vertexInput[v] >= 0) vertexPart[v] = static_cast<int>(in.part[tri.vertexInput[v]]);
+    std::vector<int> facePart(faceCount, -1);
+    for (size_t f = 0; f < faceCount; ++f) {
+        if (winding[f] < 1) continue;
+        for (int k = 0; k < 3 && facePart[f] < 0; ++k) facePart[f] = vertexPart[tri.faces[3 * f + k]];
+    }
+    for (bool changed = true; changed;) {  // interior faces with only Steiner vertices
+        changed = false;
+        for (size_t f = 0; f < faceCount; ++f) {
+            if (winding[f] < 1 || facePart[f] >= 0) continue;
+            for (int j = 0; j < 3; ++j) {
+                const int n = tri.neighbors[3 * f + j];
+                if (n >= 0 && winding[n] >= 1 && facePart[n] >= 0) {
+                    facePart[f] = facePart[n];
+                    changed = true;
+                    break;
+                }
+            }
+        }
+    }
+
+    // 4. Models: parts of one feature, touching or overlapping parts, parts nested in others.
+    const uint32_t partCount = static_cast<uint32_t>(checked.parts.size());
+    std::vector<uint32_t> parent(partCount);
+    std::iota(parent.begin(), parent.end(), 0u);
+    for (uint32_t p = 1; p < partCount; ++p)
+        if (checked.partFeature[p] == checked.partFeature[p - 1]) unite(parent, p, p - 1);
+    std::vector<char> partTouches(partCount, 0);
+    for (auto [a, b] : checked.touchingParts) {
+        if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
+        unite(parent, a, b);
+    }
+    for (size_t f = 0; f < faceCount; ++f)
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || facePart[f] < 0 || facePart[n] < 0 || facePart[f] == facePart[n]) continue;
+            const uint32_t a = facePart[f], b = facePart[n];
+            if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
+            unite(parent, a, b);
+        }
+    std::vector<int> modelOfRoot(partCount, -1), partModel(partCount);
+    for (uint32_t p = 0; p < partCount; ++p) {
+        const uint32_t r = findRoot(parent, p);
+        if (modelOfRoot[r] < 0) modelOfRoot[r] = static_cast<int>(space.modelCount++);
+        partModel[p] = modelOfRoot[r];
+        out.featureModel[checked.partFeature[p]] = partModel[p];
+    }
+    out.modelCount = space.modelCount;
+    {
+        std::vector<std::vector<uint32_t>> modelFeatures(space.modelCount);
+        std::vector<char> modelTouches(space.modelCount, 0);
+        for (uint32_t p = 0; p < partCount; ++p) {
+            auto& list = modelFeatures[partModel[p]];
+            if (list.empty() || list.back() != checked.partFeature[p]) list.push_back(checked.partFeature[p]);
+            if (partTouches[p]) modelTouches[partModel[p]] = 1;
+        }
+        for (size_t m = 0; m < space.modelCount; ++m)
+            if (modelTouches[m] && modelFeatures[m].size() > 1)
+                out.diagnostics.push_back({Diagnostic::Severity::Note, joinNames(features, modelFeatures[m]),
+                                           "these " + std::to_string(modelFeatures[m].size()) +
+                                               " features touch or overlap; merged into one model"});
+    }
+    space.vertexModel.assign(vertexCount, -1);
+    for (size_t v = 0; v < vertexCount; ++v)
+        if (vertexPart[v] >= 0) space.vertexModel[v] = partModel[vertexPart[v]];
+    space.faceModel.assign(faceCount, -1);
+    for (size_t f = 0; f < faceCount; ++f)
+        if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;
+    space.modelPoints.resize(space.modelCount);
+    for (size_t v = 0; v < in.part.size(); ++v) {
+        auto& pts = space.modelPoints[partModel[in.part[v]]];
+        pts.push_back(in.x(v));
+        pts.push_back(in.y(v));
+    }
+
+    // Voids: free faces not reachable from the hull through free faces (input holes, or
+    // gaps enclosed by touching polygons) and owned by one model only: never filled.
+    space.faceVoid.assign(faceCount, 0);
+    {
+        std::vector<char> reached(faceCount, 0);
+        std::vector<int> stack;
+        for (size_t f = 0; f < faceCount; ++f)
+            if (space.faceModel[f] < 0)
+                for (int j = 0; j < 3; ++j)
+                    if (tri.neighbors[3 * f + j] < 0 && !reached[f]) {
+                        reached[f] = 1;
+                        stack.push_back(static_cast<int>(f));
+                    }
+        while (!stack.empty()) {
+            const int f = stack.back();
+            stack.pop_back();
+            for (int j = 0; j < 3; ++j) {
+                const int n = tri.neighbors[3 * f + j];
+                if (n >= 0 && !reached[n] && space.faceModel[n] < 0) {
+                    reached[n] = 1;
+                    stack.push_back(n);
+                }
+            }
+        }
+        for (size_t f = 0; f < faceCount; ++f) {
+            if (space.faceModel[f] >= 0 || reached[f]) continue;
+            int model = -1;
+            bool single = true;
+            for (int k = 0; k < 3; ++k) {
+                const int m = space.vertexModel[tri.faces[3 * f + k]];
+                if (m < 0) continue;
+                if (model < 0) model = m;
+                else if (m != model) single = false;
+            }
+            space.faceVoid[f] = single ? 1 : 0;
+        }
+    }
+    endStage("mark free space");
+
+    // 5. Neighbourhood graph: per model pair the free edges joining them; weight = the
+    // shortest connection seen in a free triangle (edge, or vertex to a model's boundary edge).
+    progress("building the neighbourhood graph", 0);
+    space.faceArea.resize(faceCount);
+    space.edgeLength.resize(3 * faceCount);
+    space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
+    struct PairEntry {
+        uint32_t a, b;
+        double length;   // free edge length, or -1 for a distance-only entry
+        double distance;
+        int face;
+    };
+    std::vector<PairEntry> entries;
+    auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
+    for (size_t f = 0; f < faceCount; ++f) {
+        const int* v = &tri.faces[3 * f];
+        space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
+                                   (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
+        for (int j = 0; j < 3; ++j) {
+            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+            space.edgeLength[3 * f + j] = std::hypot(P(w)[0] - P(u)[0], P(w)[1] - P(u)[1]);
+        }
+        if (space.faceModel[f] >= 0) continue;
+        for (int j = 0; j < 3; ++j) {
+            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+            const int mu = space.vertexModel[u], mw = space.vertexModel[w];
+            if (mu < 0 || mw < 0 || mu == mw) continue;
+            const int n = tri.neighbors[3 * f + j];
+            const uint32_t a = std::min(mu, mw), b = std::max(mu, mw);
+            const double len = space.edgeLength[3 * f + j];
+            // Count each undirected edge once (from its smaller free face, or its only one).
+            const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
+            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f)});
+        }
+        // Vertex to the opposite edge when that edge is another model's boundary.
+        for (int k = 0; k < 3; ++k) {
+            const int j1 = (k + 1) % 3, j2 = (k + 2) % 3;
+            const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
+            if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
+            const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
+            entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
+                               static_cast<int>(f)});
+        }
+    }
+    std::sort(entries.begin(), entries.end(), [](const PairEntry& x, const PairEntry& y) {
+        return std::tie(x.a, x.b, x.distance, x.face) < std::tie(y.a, y.b, y.distance, y.face);
+    });
+    for (size_t i = 0; i < entries.size();) {
+        size_t e = i;
+        ModelPair2D pair;
+        pair.a = entries[i].a;
+        pair.b = entries[i].b;
+        pair.minDistance = entries[i].distance;
+        pair.bestFace[0] = entries[i].face;
+        for (; e < entries.size() && entries[e].a == pair.a && entries[e].b == pair.b; ++e) {
+            if (entries[e].length >= 0) pair.lengths.push_back(entries[e].length);
+            if (pair.bestFace[1] < 0 && entries[e].distance == pair.minDistance && entries[e].face != pair.bestFace[0])
+                pair.bestFace[1] = entries[e].face;
+        }
+        std::sort(pair.lengths.begin(), pair.lengths.end());
+        pair.prefixSum.assign(pair.lengths.size() + 1, 0);
+        pair.prefixSumSquares.assign(pair.lengths.size() + 1, 0);
+        for (size_t k = 0; k < pair.lengths.size(); ++k) {
+            pair.prefixSum[k + 1] = pair.prefixSum[k] + pair.lengths[k];
+            pair.prefixSumSquares[k + 1] = pair.prefixSumSquares[k] + pair.lengths[k] * pair.lengths[k];
+        }
+        space.pairs.push_back(std::move(pair));
+        i = e;
+    }
+    for (size_t f = 0; f < faceCount; ++f)
+        for (int j = 0; j < 3; ++j) {
+            const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
+            const int mu = space.vertexModel[u], mw = space.vertexModel[w];
+            if (mu < 0 || mw < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
+            else if (mu != mw) space.edgePair[3 * f + j] = space.pairIndex(mu, mw);
+        }
+    std::vector<GraphEdge> graph;
+    graph.reserve(space.pairs.size());
+    for (const ModelPair2D& p : space.pairs) graph.push_back(GraphEdge{p.a, p.b, p.minDistance});
+    out.merges = kruskalMerges(space.modelCount, std::move(graph));
+    endStage("neighbourhood graph");
+
+    // 6. Levels.
+    std::vector<double> deltas = settings.deltas;
+    std::sort(deltas.begin(), deltas.end());
+    deltas.erase(std::unique(deltas.begin(), deltas.end()), deltas.end());
+    if (deltas.empty()) deltas = automaticDeltas(out.merges, settings.automaticLevelCount);
+    if (deltas.empty()) deltas.push_back(0);  // a single model: one level, the originals
+    const AggregateFunction primary = settings.customFunction ? settings.customFunction
+                                                              : makeAggregateFunction(settings.function);
+    const AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
+    const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
+    std::vector<int> label;
+    for (size_t li = 0; li < deltas.size(); ++li) {
+        progress("sculpting levels", static_cast<double>(li) / deltas.size());
+        Level2D level;
+        level.delta = deltas[li];
+        size_t groupCount = 0;
+        const std::vector<uint32_t> modelGroup = groupsAtThreshold(space.modelCount, out.merges, level.delta, &groupCount);
+        std::vector<int> joined;
+        for (const Merge& m : out.merges) {
+            if (!(m.height < level.delta)) break;
+            joined.push_back(space.pairIndex(m.modelA, m.modelB));
+        }
+        level.aggregates.resize(groupCount);
+        // Sources and hulls of every group.
+        for (size_t f = 0; f < features.size(); ++f)
+            if (out.featureModel[f] >= 0)
+                level.aggregates[modelGroup[out.featureModel[f]]].sourceFeatures.push_back(static_cast<uint32_t>(f));
+        std::vector<std::vector<double>> hulls;
+        if (settings.computeBaselines || settings.shape == Shape2D::ConvexHull) {
+            std::vector<std::vector<double>> groupPoints(groupCount);
+            for (size_t m = 0; m < space.modelCount; ++m) {
+                auto& gp = groupPoints[modelGroup[m]];
+                gp.insert(gp.end(), space.modelPoints[m].begin(), space.modelPoints[m].end());
+            }
+            hulls.resize(groupCount);
+            for (size_t g = 0; g < groupCount; ++g) {
+                hulls[g] = convexHull2D(std::move(groupPoints[g]));
+                level.hull.area += ringSignedArea(hulls[g]);
+                level.hull.perimeter += ringLength(hulls[g]);
+            }
+            level.hull.circularity = circularity(level.hull.area, level.hull.perimeter);
+        }
+        if (settings.shape == Shape2D::ConvexHull) {
+            for (size_t g = 0; g < groupCount; ++g) {
+                Aggregate2D& agg = level.aggregates[g];
+                agg.polygons.push_back(Polygon2D{hulls[g], {}});
+                agg.measures.area = ringSignedArea(hulls[g]);
+                agg.measures.perimeter = ringLength(hulls[g]);
+                agg.measures.circularity = circularity(agg.measures.area, agg.measures.perimeter);
+            }
+        } else {
+            sculptLevel2D(space, modelGroup, computeEdgeLimits2D(space, level.delta, primary), joined, label);
+            extractPolygons2D(space, label, groupCount, level.aggregates);
+        }
+        for (const Aggregate2D& agg : level.aggregates) {
+            level.measures.area += agg.measures.area;
+            level.measures.perimeter += agg.measures.perimeter;
+        }
+        level.measures.circularity = circularity(level.measures.area, level.measures.perimeter);
+        if (settings.computeBaselines) {
+            sculptLevel2D(space, modelGroup, computeEdgeLimits2D(space, level.delta, constant), joined, label);
+            level.constant = measureLabels2D(space, label);
+            sculptLevel2D(space, modelGroup, computeEdgeLimits2D(space, level.delta, adaptive), joined, label);
+            level.adaptive = measureLabels2D(space, label);
+        }
+        out.levels.push_back(std::move(level));
+    }
+    progress("sculpting levels", 1);
+    endStage("sculpt levels");
+    return true;
+}
+
+}  // namespace aggrelod
