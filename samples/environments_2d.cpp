@@ -53,17 +53,34 @@ std::vector<double> box(double cx, double cy, double hx, double hy, double angle
     return ring;
 }
 
-// Tree: a fractal tree whose trunk and branches are separate thin quads (gaps at the forks)
-// with leaf blobs at the twig ends; extent about 40 units, gaps 0.2-1.5.
+// Tree: a fractal tree whose trunk and branches are separate tapered quads (gaps at the
+// forks) with leaf blobs at the twig ends; extent about 40 units, gaps from 0.2 up.
+// A branch (with its subtree) that would come within 0.2 of anything placed is left out.
+bool branchFits(const std::vector<Placed>& placed, double x, double y, double ex, double ey, double width,
+                std::vector<Placed>& circles) {
+    circles.clear();
+    const double len = std::hypot(ex - x, ey - y);
+    const int n = std::max(2, static_cast<int>(std::ceil(len / std::max(width, 0.2))) + 1);
+    for (int i = 0; i < n; ++i) {
+        const double t = static_cast<double>(i) / (n - 1);
+        circles.push_back({x + t * (ex - x), y + t * (ey - y), width / 2 + 0.05});
+    }
+    for (const Placed& c : circles)
+        if (!fits(placed, c.x, c.y, c.r, 0.2)) return false;
+    return true;
+}
+
 void tree(Random& rnd, std::vector<Feature2D>& out, std::vector<Placed>& placed, double x, double y, double angle,
           double length, double width, int depth) {
     const double ex = x + length * std::cos(angle), ey = y + length * std::sin(angle);
     const double nx = -std::sin(angle) * width / 2, ny = std::cos(angle) * width / 2;
-    const double tx = std::cos(angle) * 0.35, ty = std::sin(angle) * 0.35;  // gap at both ends
     const double taper = 0.7;
+    std::vector<Placed> circles;
+    if (!branchFits(placed, x, y, ex, ey, width, circles)) return;
+    placed.insert(placed.end(), circles.begin(), circles.end());
     out.push_back(feature("branch", out.size(),
-                          {x + tx + nx, y + ty + ny, x + tx - nx, y + ty - ny, ex - tx - nx * taper, ey - ty - ny * taper,
-                           ex - tx + nx * taper, ey - ty + ny * taper}));
+                          {x + nx, y + ny, x - nx, y - ny, ex - nx * taper, ey - ny * taper, ex + nx * taper,
+                           ey + ny * taper}));
     if (depth == 0) {
         const double r = rnd.uniform(0.8, 1.4);
         const double cx = ex + (r + 0.5) * std::cos(angle), cy = ey + (r + 0.5) * std::sin(angle);
@@ -74,10 +91,15 @@ void tree(Random& rnd, std::vector<Feature2D>& out, std::vector<Placed>& placed,
         return;
     }
     const int children = depth > 3 ? 2 : rnd.uniformInt(2, 3);
+    const double childWidth = width * taper;
+    const double minAngle = children == 2 ? 0.9 : 0.5;  // between sibling directions
+    // Children start far enough from the fork that siblings keep a gap of 0.3.
+    const double startGap = (childWidth / 2 + 0.15) / std::sin(minAngle / 2) + 0.3;
     for (int c = 0; c < children; ++c) {
         const double spread = children == 2 ? (c == 0 ? -0.45 : 0.45) : (c - 1) * 0.5;
-        tree(rnd, out, placed, ex, ey, angle + spread + rnd.uniform(-0.12, 0.12), length * rnd.uniform(0.68, 0.8),
-             width * taper, depth - 1);
+        const double a = angle + spread;
+        tree(rnd, out, placed, ex + startGap * std::cos(a), ey + startGap * std::sin(a), a + rnd.uniform(-0.05, 0.05),
+             length * rnd.uniform(0.68, 0.8), childWidth, depth - 1);
     }
 }
 

@@ -8,7 +8,8 @@
 // a stack gives the same result as any order (linear time).
 // Step 4: for every pair joined at this level, the triangle holding their shortest connection
 // and a fan of triangles to an edge of each model are never removed, so joined models come
-// out as one polygon (edge-connected), unless only a single-point contact exists.
+// out as one polygon (edge-connected) where the fan's faces are no longer than delta;
+// otherwise they touch at a point and come out as two polygons of one MultiPolygon.
 #include "sculpt_2d.h"
 
 #include "polygon_check_2d.h"
@@ -45,6 +46,7 @@ EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const A
     same.sameModel = true;
     limits.sameModel = function(same);
     limits.unpaired = limits.sameModel;
+    limits.delta = delta;
     limits.pair.resize(space.pairs.size());
     for (size_t p = 0; p < space.pairs.size(); ++p) {
         const ModelPair2D& pair = space.pairs[p];
@@ -109,14 +111,16 @@ struct Sculptor2D {
     }
 
     // A fan of kept free faces around a vertex of `model`, from face f to a face sharing an
-    // edge with the model's interior; protects the shortest one found.
+    // edge with the model's interior; protects the smallest one found.
     void protectFanTo(int f, int model, int group) {
         for (int j = 0; j < 3; ++j) {
             const int n = tri().neighbors[3 * f + j];
             if (n >= 0 && space.faceModel[n] == model) return;  // already shares an edge
         }
+        // The fan of least total area: the one hugging the corner, not a sliver along a side.
         std::vector<int> best, path;
         bool found = false;
+        double bestArea = INFINITY;
         for (int k = 0; k < 3; ++k) {
             const int v = tri().faces[3 * f + k];
             if (space.vertexModel[v] != model) continue;
@@ -129,11 +133,21 @@ struct Sculptor2D {
                     const int n = tri().neighbors[3 * cur + (kv + side) % 3];
                     if (n < 0) break;
                     if (space.faceModel[n] == model) {
-                        if (!found || path.size() < best.size()) best = path;
+                        double area = 0;
+                        for (int p : path) area += space.faceArea[p];
+                        if (!found || area < bestArea) {
+                            best = path;
+                            bestArea = area;
+                        }
                         found = true;
                         break;
                     }
                     if (!isKeptFree(n, group) || n == f) break;
+                    // Only small faces: a fan through a sliver spanning the gap would fill far
+                    // more than the connection (the models then touch at a point instead).
+                    double longest = 0;
+                    for (int e = 0; e < 3; ++e) longest = std::max(longest, space.edgeLength[3 * static_cast<size_t>(n) + e]);
+                    if (longest > limits.delta) break;
                     path.push_back(n);
                     cur = n;
                 }

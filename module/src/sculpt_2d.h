@@ -12,6 +12,7 @@ namespace aggrelod::detail {
 struct EdgeLimits2D {
     double sameModel = 0;      ///< F for an edge with both ends on one model
     double unpaired = 0;       ///< F for an edge with a Steiner end
+    double delta = 0;          ///< the level threshold
     std::vector<double> pair;  ///< per FreeSpace2D::pairs entry
 };
 
