@@ -155,44 +155,47 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
         diagnostics.push_back({Diagnostic::Severity::Error, features[f].name, message + "; feature skipped"});
     };
     // 1. Per ring: finite, >= 3 distinct vertices, non-zero area; orientation normalised.
-    std::vector<uint32_t> firstPart(features.size() + 1, 0);
+    // A bad polygon of a multipolygon is dropped (warning); a feature left without polygons
+    // is skipped (error). A degenerate hole is dropped (warning).
+    std::vector<uint32_t> partIndexInFeature;
+    std::vector<std::string> droppedParts(features.size());  // first problem, for the error message
+    auto warn = [&](size_t f, const std::string& message) {
+        diagnostics.push_back({Diagnostic::Severity::Warning, features[f].name, message});
+    };
     for (size_t f = 0; f < features.size(); ++f) {
-        firstPart[f] = static_cast<uint32_t>(out.parts.size());
         const Feature2D& feature = features[f];
-        if (feature.polygons.empty()) {
-            reject(f, "empty geometry (no polygon)");
-            firstPart[f + 1] = firstPart[f];
-            continue;
-        }
-        std::vector<Polygon2D> parts;
-        bool ok = true;
-        for (size_t p = 0; p < feature.polygons.size() && ok; ++p) {
+        const size_t count = feature.polygons.size();
+        for (size_t p = 0; p < count; ++p) {
             Polygon2D clean;
             std::string problem;
             if (!cleanRing(feature.polygons[p].exterior, clean.exterior, problem)) {
-                reject(f, ringLabel(p, feature.polygons.size(), -1) + ": " + problem);
-                ok = false;
-                break;
+                const std::string message = ringLabel(p, count, -1) + ": " + problem;
+                if (count > 1) warn(f, message + "; polygon " + std::to_string(p + 1) + " dropped");
+                if (droppedParts[f].empty()) droppedParts[f] = message;
+                continue;
             }
             orientRing(clean.exterior, true);
+            bool ok = true;
             for (size_t h = 0; h < feature.polygons[p].holes.size(); ++h) {
                 std::vector<double> ring;
                 if (!cleanRing(feature.polygons[p].holes[h], ring, problem)) {
-                    reject(f, ringLabel(p, feature.polygons.size(), static_cast<int>(h)) + ": " + problem);
-                    ok = false;
-                    break;
+                    const std::string message = ringLabel(p, count, static_cast<int>(h)) + ": " + problem;
+                    if (problem.find("finite") != std::string::npos) {  // NaN: the polygon is unusable
+                        if (count > 1) warn(f, message + "; polygon " + std::to_string(p + 1) + " dropped");
+                        if (droppedParts[f].empty()) droppedParts[f] = message;
+                        ok = false;
+                        break;
+                    }
+                    warn(f, message + "; hole dropped");
+                    continue;
                 }
                 orientRing(ring, false);
                 clean.holes.push_back(std::move(ring));
             }
-            parts.push_back(std::move(clean));
-        }
-        if (ok) {
-            out.featureAccepted[f] = 1;
-            for (Polygon2D& part : parts) {
-                out.parts.push_back(std::move(part));
-                out.partFeature.push_back(static_cast<uint32_t>(f));
-            }
+            if (!ok) continue;
+            out.parts.push_back(std::move(clean));
+            out.partFeature.push_back(static_cast<uint32_t>(f));
+            partIndexInFeature.push_back(static_cast<uint32_t>(p));
         }
     }
 
@@ -245,7 +248,7 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
     std::sort(entries.begin(), entries.end());
 
     // 3. Test pairs. Problems per feature are collected, the first one reported.
-    std::vector<std::string> featureProblem(features.size());
+    std::vector<std::string> partProblem(out.parts.size());
     std::vector<std::pair<uint32_t, uint32_t>> touching;
     for (size_t b = 0; b < entries.size();) {
         size_t e = b;
@@ -264,7 +267,7 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
                 auto [cx, cy] = cellOf(ox, oy);
                 if (cy * nx + cx != key) continue;
                 const bool samePart = s.part == t.part;
-                if (samePart && !featureProblem[out.partFeature[s.part]].empty()) continue;
+                if (samePart && !partProblem[s.part].empty()) continue;
                 double wx = 0, wy = 0;
                 const Contact c = contact(s, t, wx, wy);
                 if (c == Contact::None) continue;
@@ -273,62 +276,63 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
                     continue;
                 }
                 const uint32_t feature = out.partFeature[s.part];
-                const Polygon2D& poly = out.parts[s.part];
-                (void)poly;
                 auto label = [&](const Segment& g) {
                     const auto [part, hole] = ringOwner[g.ring];
-                    return ringLabel(part - firstPart[feature], features[feature].polygons.size(), hole);
+                    return ringLabel(partIndexInFeature[part], features[feature].polygons.size(), hole);
                 };
                 if (s.ring == t.ring) {
                     const bool adjacent = (s.index + 1) % s.ringSize == t.index || (t.index + 1) % t.ringSize == s.index;
                     if (adjacent && c == Contact::Touch) continue;  // shared vertex
-                    featureProblem[feature] = label(s) + ": self-intersecting ring " +
+                    partProblem[s.part] = label(s) + ": self-intersecting ring " +
                                               (c == Contact::Overlap && adjacent ? "(the ring turns back on itself) " : "") +
                                               "at " + formatPoint(wx, wy);
                 } else if (c != Contact::Touch) {
-                    featureProblem[feature] = label(s) + " and " + label(t) + " cross at " + formatPoint(wx, wy);
+                    partProblem[s.part] = label(s) + " and " + label(t) + " cross at " + formatPoint(wx, wy);
                 }
             }
         }
         b = e;
     }
-    // Holes must lie inside their exterior (checked at a hole vertex; crossings are found above).
+    // Holes must lie inside their exterior (checked at a hole edge midpoint; crossings are found above).
     for (uint32_t p = 0; p < out.parts.size(); ++p) {
-        const uint32_t feature = out.partFeature[p];
-        if (!featureProblem[feature].empty()) continue;
+        if (!partProblem[p].empty()) continue;
         const Polygon2D& poly = out.parts[p];
         for (size_t h = 0; h < poly.holes.size(); ++h) {
             const std::vector<double>& hole = poly.holes[h];
             const double mx = 0.5 * (hole[0] + hole[2]), my = 0.5 * (hole[1] + hole[3]);
             if (!pointInRing(poly.exterior, mx, my)) {
-                featureProblem[feature] = ringLabel(p - firstPart[feature], features[feature].polygons.size(),
-                                                    static_cast<int>(h)) + " lies outside its exterior ring";
+                partProblem[p] = ringLabel(partIndexInFeature[p], features[out.partFeature[p]].polygons.size(),
+                                           static_cast<int>(h)) + " lies outside its exterior ring";
                 break;
             }
         }
     }
-    // Reject features with problems: rebuild parts without them.
-    bool anyRejected = false;
-    for (size_t f = 0; f < features.size(); ++f)
-        if (!featureProblem[f].empty()) {
-            reject(f, featureProblem[f]);
-            out.featureAccepted[f] = 0;
-            anyRejected = true;
-        }
+    // Drop bad polygons; skip features left with none.
     std::vector<uint32_t> newIndex(out.parts.size(), UINT32_MAX);
-    if (anyRejected) {
-        std::vector<Polygon2D> parts;
-        std::vector<uint32_t> partFeature;
-        for (uint32_t p = 0; p < out.parts.size(); ++p) {
-            if (!out.featureAccepted[out.partFeature[p]]) continue;
-            newIndex[p] = static_cast<uint32_t>(parts.size());
-            parts.push_back(std::move(out.parts[p]));
-            partFeature.push_back(out.partFeature[p]);
+    std::vector<Polygon2D> parts;
+    std::vector<uint32_t> partFeature;
+    std::vector<uint32_t> kept(features.size(), 0);
+    for (uint32_t p = 0; p < out.parts.size(); ++p) {
+        const uint32_t f = out.partFeature[p];
+        if (!partProblem[p].empty()) {
+            if (features[f].polygons.size() > 1)
+                warn(f, partProblem[p] + "; polygon " + std::to_string(partIndexInFeature[p] + 1) + " dropped");
+            if (droppedParts[f].empty()) droppedParts[f] = partProblem[p];
+            continue;
         }
-        out.parts = std::move(parts);
-        out.partFeature = std::move(partFeature);
-    } else {
-        for (uint32_t p = 0; p < newIndex.size(); ++p) newIndex[p] = p;
+        newIndex[p] = static_cast<uint32_t>(parts.size());
+        parts.push_back(std::move(out.parts[p]));
+        partFeature.push_back(f);
+        kept[f]++;
+    }
+    out.parts = std::move(parts);
+    out.partFeature = std::move(partFeature);
+    for (size_t f = 0; f < features.size(); ++f) {
+        out.featureAccepted[f] = kept[f] > 0;
+        if (kept[f] > 0) continue;
+        if (features[f].polygons.empty()) reject(f, "empty geometry (no polygon)");
+        else if (features[f].polygons.size() == 1) reject(f, droppedParts[f]);
+        else reject(f, "no usable polygon left (first problem: " + droppedParts[f] + ")");
     }
     for (auto [a, b] : touching)
         if (newIndex[a] != UINT32_MAX && newIndex[b] != UINT32_MAX) out.touchingParts.emplace_back(newIndex[a], newIndex[b]);
