@@ -215,7 +215,7 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
             }
         }
     }
-    if (segments.empty()) return;
+    if (segments.empty()) segments.push_back({0, 0, 0, 0, UINT32_MAX, 0, 0, 1});  // keeps the grid code simple; never tested (one entry)
     double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY, sumLen = 0;
     for (const Segment& s : segments) {
         minX = std::min({minX, s.ax, s.bx});
