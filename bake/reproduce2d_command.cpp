@@ -1,7 +1,7 @@
 // aggrelod reproduce2d: the paper's 2D evaluation (Section 4: Fig. 4, Fig. 6 b-d, Eq. 3)
 // rerun on seeded analogues of its five environments. For each environment, 4 thresholds
-// on a geometric series between the smallest and largest neighbour distance (the paper
-// picks them in that range); measures of constant (Eq. 1), adaptive (Eq. 2) and convex
+// between the smallest and largest neighbour distance (the paper picks them at random in
+// that range): just above the merges at 1/5, 2/5, 3/5 and 4/5 of the dendrogram; measures of constant (Eq. 1), adaptive (Eq. 2) and convex
 // hull at the same groups, normalised to the originals. Files are deterministic; run
 // times go to the terminal only.
 #include "commands_2d.h"
@@ -11,6 +11,7 @@
 #include <aggrelod/aggregate2d.h>
 #include <aggrelod/environments2d.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -63,9 +64,17 @@ int runReproduce2D(const Reproduce2DOptions& o) {
             std::fprintf(stderr, "aggrelod: error: environment %s: aggregation failed\n", name.c_str());
             return 3;
         }
-        const double lo = first.merges.front().height, hi = first.merges.back().height;
+        // Thresholds between neighbour distances: just above the merges at 1/5 .. 4/5 of the
+        // dendrogram (every level changes the grouping; the extremes would join almost nothing
+        // or everything).
         Settings2D settings;
-        for (int i = 1; i <= 4; ++i) settings.deltas.push_back(lo * std::pow(hi / lo, i / 4.0) * 1.0001);
+        const size_t mergeCount = first.merges.size();
+        for (int i = 1; i <= 4; ++i) {
+            const size_t k = std::min(mergeCount - 1, static_cast<size_t>(i * mergeCount / 5));
+            const double h = first.merges[k].height;
+            const double next = k + 1 < mergeCount ? first.merges[k + 1].height : h * 1.1;
+            settings.deltas.push_back(h + 0.5 * (next - h));
+        }
         const auto start = std::chrono::steady_clock::now();
         Hierarchy2D adaptive;
         if (!buildHierarchy2D(features, settings, adaptive)) return 3;

@@ -19,6 +19,7 @@ struct ModelPair2D {
     uint32_t a = 0, b = 0;             ///< models, a < b
     double minDistance = 0;            ///< shortest connection (graph weight), world units
     int bestFace[2] = {-1, -1};        ///< free faces holding the shortest connection
+    int connection[3] = {-1, -1, -1};  ///< its ends: vertices (c0, c1), or vertex c0 to the edge (c1, c2)
     std::vector<double> lengths;       ///< lengths of the free edges joining a and b, ascending
     std::vector<double> prefixSum, prefixSumSquares;  ///< size lengths.size() + 1
 };

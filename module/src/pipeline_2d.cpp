@@ -122,75 +122,20 @@ double pointSegmentDistance(const double* p, const double* a, const double* b) {
     return std::hypot(p[0] - (a[0] + t * dx), p[1] - (a[1] + t * dy));
 }
 
-}  // namespace
+/// Which model each part belongs to, and which parts touch others.
+struct FreeSpaceModels {
+    std::vector<int> partModel;
+    std::vector<char> partTouches;  // touches or overlaps a part of another feature
+};
 
-bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& settings, Hierarchy2D& out) {
-    out = Hierarchy2D{};
-    out.featureModel.assign(features.size(), -1);
-    auto progress = [&](const char* stage, double fraction) {
-        if (settings.progress) settings.progress(stage, fraction);
-    };
-    auto stageStart = Clock::now();
-    auto endStage = [&](const char* name) {
-        const auto now = Clock::now();
-        out.timings.emplace_back(name, std::chrono::duration<double>(now - stageStart).count());
-        stageStart = now;
-    };
-    auto fail = [&](const std::string& message) {
-        out.diagnostics.push_back({Diagnostic::Severity::Error, "", message});
-        return false;
-    };
-    for (double d : settings.deltas)
-        if (!std::isfinite(d) || d < 0) return fail("every threshold delta must be a finite number >= 0");
-
-    // 1. Input checks.
-    progress("checking input", 0);
-    CheckedPolygons checked;
-    checkPolygons(features, checked, out.diagnostics);
-    if (checked.parts.empty()) return fail("no usable polygon in the input");
-    InputVertices in;
-    for (uint32_t p = 0; p < checked.parts.size(); ++p) {
-        const Polygon2D& poly = checked.parts[p];
-        out.originals.area += ringSignedArea(poly.exterior);
-        out.originals.perimeter += ringLength(poly.exterior);
-        for (int h = -1; h < static_cast<int>(poly.holes.size()); ++h) {
-            const std::vector<double>& ring = h < 0 ? poly.exterior : poly.holes[h];
-            if (h >= 0) {
-                out.originals.area += ringSignedArea(ring);
-                out.originals.perimeter += ringLength(ring);
-            }
-            const uint32_t start = static_cast<uint32_t>(in.part.size()), n = static_cast<uint32_t>(ring.size() / 2);
-            for (uint32_t i = 0; i < n; ++i) {
-                in.points.push_back(ring[2 * i]);
-                in.points.push_back(ring[2 * i + 1]);
-                in.part.push_back(p);
-                in.ringStart.push_back(start);
-                in.ringSize.push_back(n);
-                in.segments.emplace_back(start + i, start + (i + 1) % n);
-            }
-        }
-    }
-    out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
-    in.sorted.resize(in.part.size());
-    std::iota(in.sorted.begin(), in.sorted.end(), size_t{0});
-    std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
-        return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
-    });
-    endStage("check input");
-
-    // 2. Triangulation.
-    progress("triangulating", 0);
-    FreeSpace2D space;
-    std::string error;
-    if (!triangulateConstrained(in.points, in.segments, space.tri, error)) return fail(error);
+/// Stages 2-5: triangulation, inside/outside, models, voids, model pairs.
+bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
+                    FreeSpaceModels& models, std::string& error) {
+    if (!triangulateConstrained(in.points, in.segments, space.tri, error)) return false;
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
-    out.vertexCount = vertexCount;
-    out.triangleCount = faceCount;
-    endStage("triangulate");
 
     // 3. Inside / outside by winding count, flooding from the outside of the hull.
-    progress("marking free space", 0);
     std::vector<int> winding(faceCount, INT32_MIN);
     std::deque<int> queue;
     for (size_t f = 0; f < faceCount; ++f)
@@ -243,7 +188,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     std::iota(parent.begin(), parent.end(), 0u);
     for (uint32_t p = 1; p < partCount; ++p)
         if (checked.partFeature[p] == checked.partFeature[p - 1]) unite(parent, p, p - 1);
-    std::vector<char> partTouches(partCount, 0);
+    std::vector<char>& partTouches = models.partTouches;
+    partTouches.assign(partCount, 0);
     for (auto [a, b] : checked.touchingParts) {
         if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
         unite(parent, a, b);
@@ -256,27 +202,13 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
             unite(parent, a, b);
         }
-    std::vector<int> modelOfRoot(partCount, -1), partModel(partCount);
+    std::vector<int>& partModel = models.partModel;
+    std::vector<int> modelOfRoot(partCount, -1);
+    partModel.assign(partCount, -1);
     for (uint32_t p = 0; p < partCount; ++p) {
         const uint32_t r = findRoot(parent, p);
         if (modelOfRoot[r] < 0) modelOfRoot[r] = static_cast<int>(space.modelCount++);
         partModel[p] = modelOfRoot[r];
-        out.featureModel[checked.partFeature[p]] = partModel[p];
-    }
-    out.modelCount = space.modelCount;
-    {
-        std::vector<std::vector<uint32_t>> modelFeatures(space.modelCount);
-        std::vector<char> modelTouches(space.modelCount, 0);
-        for (uint32_t p = 0; p < partCount; ++p) {
-            auto& list = modelFeatures[partModel[p]];
-            if (list.empty() || list.back() != checked.partFeature[p]) list.push_back(checked.partFeature[p]);
-            if (partTouches[p]) modelTouches[partModel[p]] = 1;
-        }
-        for (size_t m = 0; m < space.modelCount; ++m)
-            if (modelTouches[m] && modelFeatures[m].size() > 1)
-                out.diagnostics.push_back({Diagnostic::Severity::Note, joinNames(features, modelFeatures[m]),
-                                           "these " + std::to_string(modelFeatures[m].size()) +
-                                               " features touch or overlap; merged into one model"});
     }
     space.vertexModel.assign(vertexCount, -1);
     for (size_t v = 0; v < vertexCount; ++v)
@@ -328,11 +260,9 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             space.faceVoid[f] = single ? 1 : 0;
         }
     }
-    endStage("mark free space");
 
     // 5. Neighbourhood graph: per model pair the free edges joining them; weight = the
     // shortest connection seen in a free triangle (edge, or vertex to a model's boundary edge).
-    progress("building the neighbourhood graph", 0);
     space.faceArea.resize(faceCount);
     space.edgeLength.resize(3 * faceCount);
     space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
@@ -341,6 +271,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         double length;   // free edge length, or -1 for a distance-only entry
         double distance;
         int face;
+        int connection[3];  // see ModelPair2D::connection
     };
     std::vector<PairEntry> entries;
     auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
@@ -362,7 +293,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             const double len = space.edgeLength[3 * f + j];
             // Count each undirected edge once (from its smaller free face, or its only one).
             const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
-            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f)});
+            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}});
         }
         // Vertex to the opposite edge when that edge is another model's boundary.
         for (int k = 0; k < 3; ++k) {
@@ -371,7 +302,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
             const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
             entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
-                               static_cast<int>(f)});
+                               static_cast<int>(f), {v[k], v[j1], v[j2]}});
         }
     }
     std::sort(entries.begin(), entries.end(), [](const PairEntry& x, const PairEntry& y) {
@@ -384,6 +315,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         pair.b = entries[i].b;
         pair.minDistance = entries[i].distance;
         pair.bestFace[0] = entries[i].face;
+        std::copy(entries[i].connection, entries[i].connection + 3, pair.connection);
         for (; e < entries.size() && entries[e].a == pair.a && entries[e].b == pair.b; ++e) {
             if (entries[e].length >= 0) pair.lengths.push_back(entries[e].length);
             if (pair.bestFace[1] < 0 && entries[e].distance == pair.minDistance && entries[e].face != pair.bestFace[0])
@@ -406,11 +338,188 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             if (mu < 0 || mw < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
             else if (mu != mw) space.edgePair[3 * f + j] = space.pairIndex(mu, mw);
         }
+    return true;
+}
+
+std::vector<GraphEdge> graphEdges(const FreeSpace2D& space) {
     std::vector<GraphEdge> graph;
     graph.reserve(space.pairs.size());
     for (const ModelPair2D& p : space.pairs) graph.push_back(GraphEdge{p.a, p.b, p.minDistance});
-    out.merges = kruskalMerges(space.modelCount, std::move(graph));
-    endStage("neighbourhood graph");
+    return graph;
+}
+
+/// Input vertices of the checked polygons; splits[s] lists parameters in (0, 1) at which the
+/// ring segment starting at original vertex s gets an extra (collinear) vertex.
+InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<std::vector<double>>& splits) {
+    InputVertices in;
+    size_t original = 0;
+    for (uint32_t p = 0; p < checked.parts.size(); ++p) {
+        const Polygon2D& poly = checked.parts[p];
+        for (int h = -1; h < static_cast<int>(poly.holes.size()); ++h) {
+            const std::vector<double>& ring = h < 0 ? poly.exterior : poly.holes[h];
+            const uint32_t start = static_cast<uint32_t>(in.part.size()), n = static_cast<uint32_t>(ring.size() / 2);
+            for (uint32_t i = 0; i < n; ++i, ++original) {
+                const uint32_t j = (i + 1) % n;
+                in.points.push_back(ring[2 * i]);
+                in.points.push_back(ring[2 * i + 1]);
+                in.part.push_back(p);
+                if (original < splits.size())
+                    for (double t : splits[original]) {
+                        in.points.push_back(ring[2 * i] + t * (ring[2 * j] - ring[2 * i]));
+                        in.points.push_back(ring[2 * i + 1] + t * (ring[2 * j + 1] - ring[2 * i + 1]));
+                        in.part.push_back(p);
+                    }
+            }
+            const uint32_t size = static_cast<uint32_t>(in.part.size()) - start;
+            for (uint32_t i = 0; i < size; ++i) {
+                in.ringStart.push_back(start);
+                in.ringSize.push_back(size);
+                in.segments.emplace_back(start + i, start + (i + 1) % size);
+            }
+        }
+    }
+    in.sorted.resize(in.part.size());
+    std::iota(in.sorted.begin(), in.sorted.end(), size_t{0});
+    std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
+        return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
+    });
+    return in;
+}
+
+/// Steiner points for the shortest connection of every merge (DESIGN 2.4 step 4): where a
+/// connection ends at a vertex, its boundary edges longer than 3 d get a point at distance d
+/// (d = the connection's length); where it ends inside an edge, the edge gets the foot point
+/// and points d to either side. Returns, per original input vertex, the split parameters of
+/// the segment it starts (ascending). Only called on the unsplit input.
+std::vector<std::vector<double>> connectionSplits(const InputVertices& in, const FreeSpace2D& space,
+                                                  const std::vector<Merge>& merges) {
+    std::vector<std::vector<double>> splits(in.part.size());
+    const Triangulation2D& tri = space.tri;
+    auto addAt = [&](size_t segmentStart, double t) { splits[segmentStart].push_back(t); };
+    auto segmentLength = [&](size_t s) { return std::hypot(in.x(in.next(s)) - in.x(s), in.y(in.next(s)) - in.y(s)); };
+    // Split both boundary edges at vertex v (input vertex) at distance d from it.
+    auto splitAroundVertex = [&](size_t v, double d) {
+        const size_t prev = in.prev(v);
+        const double lOut = segmentLength(v), lIn = segmentLength(prev);
+        if (lOut > 3 * d) addAt(v, d / lOut);
+        if (lIn > 3 * d) addAt(prev, 1 - d / lIn);
+    };
+    for (const Merge& m : merges) {
+        const int pi = space.pairIndex(m.modelA, m.modelB);
+        if (pi < 0) continue;
+        const ModelPair2D& pair = space.pairs[pi];
+        const double d = pair.minDistance;
+        if (!(d > 0)) continue;
+        const int* c = pair.connection;
+        const int iv0 = tri.vertexInput[c[0]];
+        if (iv0 < 0) continue;
+        splitAroundVertex(static_cast<size_t>(iv0), d);
+        if (c[2] < 0) {  // vertex to vertex
+            const int iv1 = tri.vertexInput[c[1]];
+            if (iv1 >= 0) splitAroundVertex(static_cast<size_t>(iv1), d);
+            continue;
+        }
+        // Vertex to the edge (c[1], c[2]): find the input segment holding it.
+        const int e0 = tri.vertexInput[c[1]], e1 = tri.vertexInput[c[2]];
+        if (e0 < 0 || e1 < 0) continue;
+        size_t s;
+        if (in.next(static_cast<size_t>(e0)) == static_cast<size_t>(e1)) s = static_cast<size_t>(e0);
+        else if (in.next(static_cast<size_t>(e1)) == static_cast<size_t>(e0)) s = static_cast<size_t>(e1);
+        else continue;  // a part of a longer segment: leave it
+        const size_t e = in.next(s);
+        const double dx = in.x(e) - in.x(s), dy = in.y(e) - in.y(s);
+        const double len = std::hypot(dx, dy);
+        const double t = ((in.x(iv0) - in.x(s)) * dx + (in.y(iv0) - in.y(s)) * dy) / (len * len);
+        const double margin = 0.5 * d / len;
+        for (double u : {t - d / len, t, t + d / len})
+            if (u > margin && u < 1 - margin) addAt(s, u);
+    }
+    for (auto& list : splits) {
+        std::sort(list.begin(), list.end());
+        // Drop near-duplicates (two connections at one place).
+        std::vector<double> kept;
+        for (double t : list)
+            if (kept.empty() || t - kept.back() > 1e-6) kept.push_back(t);
+        list = std::move(kept);
+    }
+    return splits;
+}
+
+}  // namespace
+
+bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& settings, Hierarchy2D& out) {
+    out = Hierarchy2D{};
+    out.featureModel.assign(features.size(), -1);
+    auto progress = [&](const char* stage, double fraction) {
+        if (settings.progress) settings.progress(stage, fraction);
+    };
+    auto stageStart = Clock::now();
+    auto endStage = [&](const char* name) {
+        const auto now = Clock::now();
+        out.timings.emplace_back(name, std::chrono::duration<double>(now - stageStart).count());
+        stageStart = now;
+    };
+    auto fail = [&](const std::string& message) {
+        out.diagnostics.push_back({Diagnostic::Severity::Error, "", message});
+        return false;
+    };
+    for (double d : settings.deltas)
+        if (!std::isfinite(d) || d < 0) return fail("every threshold delta must be a finite number >= 0");
+
+    // 1. Input checks.
+    progress("checking input", 0);
+    CheckedPolygons checked;
+    checkPolygons(features, checked, out.diagnostics);
+    if (checked.parts.empty()) return fail("no usable polygon in the input");
+    for (const Polygon2D& poly : checked.parts) {
+        out.originals.area += ringSignedArea(poly.exterior);
+        out.originals.perimeter += ringLength(poly.exterior);
+        for (const auto& hole : poly.holes) {
+            out.originals.area += ringSignedArea(hole);
+            out.originals.perimeter += ringLength(hole);
+        }
+    }
+    out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
+    InputVertices in = inputVertices(checked, {});
+    endStage("check input");
+
+    // 2.-5. Triangulation, free space, models and graph; then once more with Steiner points
+    // on long boundary edges at the shortest connections of the dendrogram (DESIGN 2.4
+    // step 4), so that joined models get a narrow bridge of small triangles.
+    progress("triangulating", 0);
+    FreeSpace2D space;
+    FreeSpaceModels models;
+    std::string error;
+    if (!buildFreeSpace(in, checked, space, models, error)) return fail(error);
+    out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+    std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
+    size_t splitCount = 0;
+    for (const auto& list : splits) splitCount += list.size();
+    if (splitCount > 0) {
+        in = inputVertices(checked, splits);
+        space = FreeSpace2D{};
+        if (!buildFreeSpace(in, checked, space, models, error)) return fail(error);
+        out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+    }
+    out.vertexCount = space.tri.vertexCount();
+    out.triangleCount = space.tri.faceCount();
+    out.modelCount = space.modelCount;
+    for (uint32_t p = 0; p < checked.parts.size(); ++p) out.featureModel[checked.partFeature[p]] = models.partModel[p];
+    {
+        std::vector<std::vector<uint32_t>> modelFeatures(space.modelCount);
+        std::vector<char> modelTouches(space.modelCount, 0);
+        for (uint32_t p = 0; p < checked.parts.size(); ++p) {
+            auto& list = modelFeatures[models.partModel[p]];
+            if (list.empty() || list.back() != checked.partFeature[p]) list.push_back(checked.partFeature[p]);
+            if (models.partTouches[p]) modelTouches[models.partModel[p]] = 1;
+        }
+        for (size_t m = 0; m < space.modelCount; ++m)
+            if (modelTouches[m] && modelFeatures[m].size() > 1)
+                out.diagnostics.push_back({Diagnostic::Severity::Note, joinNames(features, modelFeatures[m]),
+                                           "these " + std::to_string(modelFeatures[m].size()) +
+                                               " features touch or overlap; merged into one model"});
+    }
+    endStage("triangulate and build the graph");
 
     // 6. Levels.
     std::vector<double> deltas = settings.deltas;
