@@ -262,11 +262,13 @@ std::vector<Feature2D> makeEnvironment2D(Environment2D env, uint32_t seed) {
     return {};
 }
 
-std::vector<Feature2D> makeSquareGrid(int count, double size, double gap) {
+std::vector<Feature2D> makeSquareGrid(int count, double size, double gap, double jitter, uint32_t seed) {
     std::vector<Feature2D> out;
+    Random rnd(seed);
     const int perRow = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(count, 1)))));
     for (int i = 0; i < count; ++i) {
-        const double x = (i % perRow) * (size + gap), y = (i / perRow) * (size + gap);
+        const double x = (i % perRow) * (size + gap) + (jitter > 0 ? rnd.uniform(-jitter, jitter) : 0.0);
+        const double y = (i / perRow) * (size + gap) + (jitter > 0 ? rnd.uniform(-jitter, jitter) : 0.0);
         out.push_back(feature("square", static_cast<size_t>(i), {x, y, x + size, y, x + size, y + size, x, y + size}));
     }
     return out;

@@ -24,80 +24,115 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_
 using Point = Kernel::Point_2;
 }  // namespace
 
-bool triangulateConstrained(const std::vector<double>& points,
-                            const std::vector<std::pair<size_t, size_t>>& segments,
-                            Triangulation2D& out, std::string& error) {
+struct ConstrainedTriangulation2D::Impl {
+    Cdt cdt;
+    std::vector<Cdt::Vertex_handle> inputHandle;  // per build() input point
+};
+
+ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
+ConstrainedTriangulation2D::~ConstrainedTriangulation2D() { delete impl_; }
+
+namespace {
+
+// Flat export. Vertices are numbered in the order of their input point (Steiner points
+// after, in CGAL's order, which is deterministic for a given input); faces by their sorted
+// vertex triple. Neither depends on CGAL's storage order.
+void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
+                         std::vector<Cdt::Vertex_handle>* inputHandle) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
+    std::vector<size_t> order(n);
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
+        if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
+        return a < b;
+    });
+    std::vector<std::pair<long long, Cdt::Vertex_handle>> keyed;
+    keyed.reserve(cdt.number_of_vertices());
+    long long steinerKey = static_cast<long long>(n);
+    for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
+        const double x = v->point().x(), y = v->point().y();
+        auto it = std::lower_bound(order.begin(), order.end(), size_t{0}, [&](size_t a, size_t) {
+            return points[2 * a] < x || (points[2 * a] == x && points[2 * a + 1] < y);
+        });
+        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y) {
+            keyed.emplace_back(static_cast<long long>(*it), v);
+            if (inputHandle)
+                for (auto same = it; same != order.end() && points[2 * *same] == x && points[2 * *same + 1] == y; ++same)
+                    (*inputHandle)[*same] = v;
+        } else {
+            keyed.emplace_back(steinerKey++, v);
+        }
+    }
+    std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    out.points.reserve(2 * keyed.size());
+    out.vertexInput.reserve(keyed.size());
+    for (size_t i = 0; i < keyed.size(); ++i) {
+        Cdt::Vertex_handle v = keyed[i].second;
+        v->info() = static_cast<int>(i);
+        out.points.push_back(v->point().x());
+        out.points.push_back(v->point().y());
+        out.vertexInput.push_back(keyed[i].first < static_cast<long long>(n) ? static_cast<int>(keyed[i].first) : -1);
+    }
+    std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> faces;
+    faces.reserve(cdt.number_of_faces());
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+        std::array<int, 3> key{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+        std::sort(key.begin(), key.end());
+        faces.emplace_back(key, f);
+    }
+    std::sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
+    for (size_t i = 0; i < faces.size(); ++i) faces[i].second->info() = static_cast<int>(i);
+    out.faces.resize(3 * faces.size());
+    out.neighbors.resize(3 * faces.size());
+    out.constrained.resize(3 * faces.size());
+    for (size_t i = 0; i < faces.size(); ++i) {
+        Cdt::Face_handle f = faces[i].second;
+        for (int k = 0; k < 3; ++k) {
+            out.faces[3 * i + k] = f->vertex(k)->info();
+            out.neighbors[3 * i + k] = f->neighbor(k)->info();
+            out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
+        }
+    }
+}
+
+}  // namespace
+
+bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
+                                       const std::vector<std::pair<size_t, size_t>>& segments, Triangulation2D& out,
+                                       std::string& error) {
+    const size_t n = points.size() / 2;
     try {
+        impl_->cdt.clear();
         std::vector<Point> pts;
         pts.reserve(n);
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
-        Cdt cdt;
-        cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
-        if (n > 0 && cdt.number_of_vertices() < n) {
-            // Points that are not endpoints of any segment are not inserted by insert_constraints.
-            cdt.insert(pts.begin(), pts.end());
-        }
-        // Map vertices back to input points by position (sorted index, binary search).
-        std::vector<size_t> order(n);
-        std::iota(order.begin(), order.end(), size_t{0});
-        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-            if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
-            if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
-            return a < b;
-        });
-        // Vertices numbered in the order of their input point (Steiner points after), so the
-        // numbering does not depend on CGAL's internal storage order.
-        std::vector<Cdt::Vertex_handle> handles;
-        std::vector<std::pair<long long, Cdt::Vertex_handle>> keyed;
-        keyed.reserve(cdt.number_of_vertices());
-        long long steinerKey = static_cast<long long>(n);
-        for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
-            const double x = v->point().x(), y = v->point().y();
-            auto it = std::lower_bound(order.begin(), order.end(), size_t{0}, [&](size_t a, size_t) {
-                return points[2 * a] < x || (points[2 * a] == x && points[2 * a + 1] < y);
-            });
-            if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y)
-                keyed.emplace_back(static_cast<long long>(*it), v);
-            else
-                keyed.emplace_back(steinerKey++, v);  // CGAL's order for Steiner points is deterministic for a given input
-        }
-        std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-        out.points.reserve(2 * keyed.size());
-        out.vertexInput.reserve(keyed.size());
-        for (size_t i = 0; i < keyed.size(); ++i) {
-            Cdt::Vertex_handle v = keyed[i].second;
-            v->info() = static_cast<int>(i);
-            out.points.push_back(v->point().x());
-            out.points.push_back(v->point().y());
-            out.vertexInput.push_back(keyed[i].first < static_cast<long long>(n) ? static_cast<int>(keyed[i].first) : -1);
-        }
-        // Faces numbered by their sorted vertex triple (again independent of storage order).
-        std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> faces;
-        faces.reserve(cdt.number_of_faces());
-        for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-            std::array<int, 3> key{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
-            std::sort(key.begin(), key.end());
-            faces.emplace_back(key, f);
-        }
-        std::sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-        for (size_t i = 0; i < faces.size(); ++i) faces[i].second->info() = static_cast<int>(i);
-        for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
-            if (cdt.is_infinite(f)) f->info() = -1;
-        out.faces.resize(3 * faces.size());
-        out.neighbors.resize(3 * faces.size());
-        out.constrained.resize(3 * faces.size());
-        for (size_t i = 0; i < faces.size(); ++i) {
-            Cdt::Face_handle f = faces[i].second;
-            for (int k = 0; k < 3; ++k) {
-                out.faces[3 * i + k] = f->vertex(k)->info();
-                out.neighbors[3 * i + k] = f->neighbor(k)->info();
-                out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
-            }
-        }
+        impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
+        impl_->inputHandle.assign(n, Cdt::Vertex_handle());
+        exportTriangulation(impl_->cdt, points, out, &impl_->inputHandle);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
+        return false;
+    }
+    return true;
+}
+
+bool ConstrainedTriangulation2D::insertPoints(const std::vector<double>& newPoints, const std::vector<size_t>& hintInput,
+                                              const std::vector<double>& allPoints, Triangulation2D& out,
+                                              std::string& error) {
+    try {
+        for (size_t i = 0; i < newPoints.size() / 2; ++i) {
+            Cdt::Vertex_handle hint = hintInput[i] < impl_->inputHandle.size() ? impl_->inputHandle[hintInput[i]]
+                                                                                : Cdt::Vertex_handle();
+            const Point p(newPoints[2 * i], newPoints[2 * i + 1]);
+            if (hint != Cdt::Vertex_handle()) impl_->cdt.insert(p, hint->face());
+            else impl_->cdt.insert(p);
+        }
+        exportTriangulation(impl_->cdt, allPoints, out, nullptr);
+    } catch (const std::exception& e) {
+        error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;
     }
     return true;

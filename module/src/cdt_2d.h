@@ -20,12 +20,31 @@ struct Triangulation2D {
     size_t faceCount() const { return faces.size() / 3; }
 };
 
-/// Triangulates `points` (2 * n, x y pairs) with the segments `segments` (pairs of point
-/// indices) as constraints, all inserted in one batch. Crossing constraints are split at
-/// their intersections (new Steiner vertices). Duplicate points become one vertex.
-/// Returns false with a message when the triangulator fails (never throws).
-bool triangulateConstrained(const std::vector<double>& points,
-                            const std::vector<std::pair<size_t, size_t>>& segments,
-                            Triangulation2D& out, std::string& error);
+/// A constrained Delaunay triangulation kept alive between steps, so points can be added
+/// later without triangulating again.
+class ConstrainedTriangulation2D {
+public:
+    ConstrainedTriangulation2D();
+    ~ConstrainedTriangulation2D();
+    ConstrainedTriangulation2D(const ConstrainedTriangulation2D&) = delete;
+    ConstrainedTriangulation2D& operator=(const ConstrainedTriangulation2D&) = delete;
+
+    /// Triangulates `points` (2 * n, x y pairs) with the segments `segments` (pairs of point
+    /// indices) as constraints, all inserted in one batch. Crossing constraints are split at
+    /// their intersections (new Steiner vertices). Duplicate points become one vertex.
+    /// Returns false with a message when the triangulator fails (never throws).
+    bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
+               Triangulation2D& out, std::string& error);
+
+    /// Inserts `newPoints` (x y pairs, each on a constraint, near the input point hintInput[i]
+    /// of the build() call), then exports again, numbering vertices by `allPoints` (the input
+    /// points including the new ones, in any order).
+    bool insertPoints(const std::vector<double>& newPoints, const std::vector<size_t>& hintInput,
+                      const std::vector<double>& allPoints, Triangulation2D& out, std::string& error);
+
+private:
+    struct Impl;
+    Impl* impl_;
+};
 
 }  // namespace aggrelod::detail

@@ -82,10 +82,11 @@ bool onInputSegment(const InputVertices& in, size_t a, size_t b, double qx, doub
 // Change of the winding count when crossing the triangulation edge u->v from its left side
 // (the face) to its right: -1 per input ring running u->v (its interior is on the left),
 // +1 per ring running v->u.
-int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, int v) {
+int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, int v,
+                  std::vector<std::tuple<size_t, int>>& found) {
     const double ux = tri.points[2 * u], uy = tri.points[2 * u + 1];
     const double vx = tri.points[2 * v], vy = tri.points[2 * v + 1];
-    std::vector<std::tuple<size_t, int>> found;  // (segment start vertex, sign)
+    found.clear();  // (segment start vertex, sign)
     auto scan = [&](double ax, double ay, double bx, double by, int signForward) {
         auto [lo, hi] = in.at(ax, ay);
         for (size_t i = lo; i < hi; ++i) {
@@ -128,21 +129,21 @@ struct FreeSpaceModels {
     std::vector<char> partTouches;  // touches or overlaps a part of another feature
 };
 
-/// Stages 2-5: triangulation, inside/outside, models, voids, model pairs.
-bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
-                    FreeSpaceModels& models, std::string& error) {
-    if (!triangulateConstrained(in.points, in.segments, space.tri, error)) return false;
+/// Stages 3-5 on the triangulation in space.tri: inside/outside, models, voids, model pairs.
+void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
+                    FreeSpaceModels& models) {
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
 
     // 3. Inside / outside by winding count, flooding from the outside of the hull.
     std::vector<int> winding(faceCount, INT32_MIN);
+    std::vector<std::tuple<size_t, int>> found;
     std::deque<int> queue;
     for (size_t f = 0; f < faceCount; ++f)
         for (int j = 0; j < 3; ++j)
             if (tri.neighbors[3 * f + j] < 0 && winding[f] == INT32_MIN) {
                 const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
-                winding[f] = tri.constrained[3 * f + j] ? -windingChange(in, tri, u, v) : 0;
+                winding[f] = tri.constrained[3 * f + j] ? -windingChange(in, tri, u, v, found) : 0;
                 queue.push_back(static_cast<int>(f));
             }
     while (!queue.empty()) {
@@ -153,7 +154,7 @@ bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
             if (n < 0 || winding[n] != INT32_MIN) continue;
             int w = winding[f];
             if (tri.constrained[3 * f + j])
-                w += windingChange(in, tri, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3]);
+                w += windingChange(in, tri, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3], found);
             winding[n] = w;
             queue.push_back(n);
         }
@@ -272,6 +273,7 @@ bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         double distance;
         int face;
         int connection[3];  // see ModelPair2D::connection
+        long long faceEdge; // 3 * face + edge for an edge entry, -1 for a distance-only entry
     };
     std::vector<PairEntry> entries;
     auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
@@ -293,7 +295,7 @@ bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
             const double len = space.edgeLength[3 * f + j];
             // Count each undirected edge once (from its smaller free face, or its only one).
             const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
-            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}});
+            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
         }
         // Vertex to the opposite edge when that edge is another model's boundary.
         for (int k = 0; k < 3; ++k) {
@@ -302,7 +304,7 @@ bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
             if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
             const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
             entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
-                               static_cast<int>(f), {v[k], v[j1], v[j2]}});
+                               static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
         }
     }
     std::sort(entries.begin(), entries.end(), [](const PairEntry& x, const PairEntry& y) {
@@ -328,17 +330,16 @@ bool buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
             pair.prefixSum[k + 1] = pair.prefixSum[k] + pair.lengths[k];
             pair.prefixSumSquares[k + 1] = pair.prefixSumSquares[k] + pair.lengths[k] * pair.lengths[k];
         }
+        for (size_t k = i; k < e; ++k)
+            if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
         space.pairs.push_back(std::move(pair));
         i = e;
     }
     for (size_t f = 0; f < faceCount; ++f)
         for (int j = 0; j < 3; ++j) {
             const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
-            const int mu = space.vertexModel[u], mw = space.vertexModel[w];
-            if (mu < 0 || mw < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
-            else if (mu != mw) space.edgePair[3 * f + j] = space.pairIndex(mu, mw);
+            if (space.vertexModel[u] < 0 || space.vertexModel[w] < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
         }
-    return true;
 }
 
 std::vector<GraphEdge> graphEdges(const FreeSpace2D& space) {
@@ -490,15 +491,35 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpace2D space;
     FreeSpaceModels models;
     std::string error;
-    if (!buildFreeSpace(in, checked, space, models, error)) return fail(error);
+    ConstrainedTriangulation2D triangulation;
+    if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    buildFreeSpace(in, checked, space, models);
+    // Free edges between two free triangles, before Steiner points (as GEOS measures them).
+    out.freeEdgeMin = INFINITY;
+    for (size_t f = 0; f < space.tri.faceCount(); ++f)
+        for (int j = 0; j < 3; ++j) {
+            const int n = space.tri.neighbors[3 * f + j];
+            if (space.faceModel[f] >= 0 || n < 0 || space.faceModel[n] >= 0) continue;
+            out.freeEdgeMin = std::min(out.freeEdgeMin, space.edgeLength[3 * f + j]);
+            out.freeEdgeMax = std::max(out.freeEdgeMax, space.edgeLength[3 * f + j]);
+        }
+    if (!std::isfinite(out.freeEdgeMin)) out.freeEdgeMin = 0;
     out.merges = kruskalMerges(space.modelCount, graphEdges(space));
-    std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
-    size_t splitCount = 0;
-    for (const auto& list : splits) splitCount += list.size();
-    if (splitCount > 0) {
+    const std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
+    std::vector<double> newPoints;
+    std::vector<size_t> hints;
+    for (size_t v = 0; v < splits.size(); ++v)
+        for (double t : splits[v]) {
+            const size_t e = in.next(v);
+            newPoints.push_back(in.x(v) + t * (in.x(e) - in.x(v)));  // as inputVertices() computes them
+            newPoints.push_back(in.y(v) + t * (in.y(e) - in.y(v)));
+            hints.push_back(v);
+        }
+    if (!hints.empty()) {
         in = inputVertices(checked, splits);
         space = FreeSpace2D{};
-        if (!buildFreeSpace(in, checked, space, models, error)) return fail(error);
+        if (!triangulation.insertPoints(newPoints, hints, in.points, space.tri, error)) return fail(error);
+        buildFreeSpace(in, checked, space, models);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
     }
     out.vertexCount = space.tri.vertexCount();

@@ -24,7 +24,9 @@ std::string environmentName(Environment2D env);
 std::vector<Feature2D> makeEnvironment2D(Environment2D env, uint32_t seed = 1);
 
 /// count squares of side `size` on a square grid with `gap` between neighbours (row-major,
-/// ceil(sqrt(count)) per row). Names "square i".
-std::vector<Feature2D> makeSquareGrid(int count, double size = 1.0, double gap = 0.5);
+/// ceil(sqrt(count)) per row), each moved by up to +-jitter in x and y (seeded; jitter
+/// < gap / 2 keeps them apart). Names "square i".
+std::vector<Feature2D> makeSquareGrid(int count, double size = 1.0, double gap = 0.5, double jitter = 0,
+                                      uint32_t seed = 1);
 
 }  // namespace aggrelod::samples
