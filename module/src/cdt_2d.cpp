@@ -26,7 +26,6 @@ using Point = Kernel::Point_2;
 
 struct ConstrainedTriangulation2D::Impl {
     Cdt cdt;
-    std::vector<Cdt::Vertex_handle> inputHandle;  // per build() input point
 };
 
 ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
@@ -37,8 +36,7 @@ namespace {
 // Flat export. Vertices are numbered in the order of their input point (Steiner points
 // after, in CGAL's order, which is deterministic for a given input); faces by their sorted
 // vertex triple. Neither depends on CGAL's storage order.
-void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
-                         std::vector<Cdt::Vertex_handle>* inputHandle) {
+void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
     std::vector<size_t> order(n);
@@ -56,14 +54,10 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
         auto it = std::lower_bound(order.begin(), order.end(), size_t{0}, [&](size_t a, size_t) {
             return points[2 * a] < x || (points[2 * a] == x && points[2 * a + 1] < y);
         });
-        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y) {
+        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y)
             keyed.emplace_back(static_cast<long long>(*it), v);
-            if (inputHandle)
-                for (auto same = it; same != order.end() && points[2 * *same] == x && points[2 * *same + 1] == y; ++same)
-                    (*inputHandle)[*same] = v;
-        } else {
+        else
             keyed.emplace_back(steinerKey++, v);
-        }
     }
     std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     out.points.reserve(2 * keyed.size());
@@ -110,29 +104,9 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         pts.reserve(n);
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
-        impl_->inputHandle.assign(n, Cdt::Vertex_handle());
-        exportTriangulation(impl_->cdt, points, out, &impl_->inputHandle);
+        exportTriangulation(impl_->cdt, points, out);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
-        return false;
-    }
-    return true;
-}
-
-bool ConstrainedTriangulation2D::insertPoints(const std::vector<double>& newPoints, const std::vector<size_t>& hintInput,
-                                              const std::vector<double>& allPoints, Triangulation2D& out,
-                                              std::string& error) {
-    try {
-        for (size_t i = 0; i < newPoints.size() / 2; ++i) {
-            Cdt::Vertex_handle hint = hintInput[i] < impl_->inputHandle.size() ? impl_->inputHandle[hintInput[i]]
-                                                                                : Cdt::Vertex_handle();
-            const Point p(newPoints[2 * i], newPoints[2 * i + 1]);
-            if (hint != Cdt::Vertex_handle()) impl_->cdt.insert(p, hint->face());
-            else impl_->cdt.insert(p);
-        }
-        exportTriangulation(impl_->cdt, allPoints, out, nullptr);
-    } catch (const std::exception& e) {
-        error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;
     }
     return true;

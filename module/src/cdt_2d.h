@@ -20,8 +20,7 @@ struct Triangulation2D {
     size_t faceCount() const { return faces.size() / 3; }
 };
 
-/// A constrained Delaunay triangulation kept alive between steps, so points can be added
-/// later without triangulating again.
+/// A constrained Delaunay triangulation (CGAL's, hidden behind this class).
 class ConstrainedTriangulation2D {
 public:
     ConstrainedTriangulation2D();
@@ -35,12 +34,6 @@ public:
     /// Returns false with a message when the triangulator fails (never throws).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
                Triangulation2D& out, std::string& error);
-
-    /// Inserts `newPoints` (x y pairs, each on a constraint, near the input point hintInput[i]
-    /// of the build() call), then exports again, numbering vertices by `allPoints` (the input
-    /// points including the new ones, in any order).
-    bool insertPoints(const std::vector<double>& newPoints, const std::vector<size_t>& hintInput,
-                      const std::vector<double>& allPoints, Triangulation2D& out, std::string& error);
 
 private:
     struct Impl;

@@ -506,19 +506,15 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     if (!std::isfinite(out.freeEdgeMin)) out.freeEdgeMin = 0;
     out.merges = kruskalMerges(space.modelCount, graphEdges(space));
     const std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
-    std::vector<double> newPoints;
-    std::vector<size_t> hints;
-    for (size_t v = 0; v < splits.size(); ++v)
-        for (double t : splits[v]) {
-            const size_t e = in.next(v);
-            newPoints.push_back(in.x(v) + t * (in.x(e) - in.x(v)));  // as inputVertices() computes them
-            newPoints.push_back(in.y(v) + t * (in.y(e) - in.y(v)));
-            hints.push_back(v);
-        }
-    if (!hints.empty()) {
+    bool anySplit = false;
+    for (const auto& list : splits) anySplit |= !list.empty();
+    if (anySplit) {
+        // Triangulate again with the split rings: the new points are then exact constraint
+        // vertices (inserting them into the live triangulation left points a rounding error
+        // off their constraint, which broke the inside/outside marking).
         in = inputVertices(checked, splits);
         space = FreeSpace2D{};
-        if (!triangulation.insertPoints(newPoints, hints, in.points, space.tri, error)) return fail(error);
+        if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
         buildFreeSpace(in, checked, space, models);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
     }
