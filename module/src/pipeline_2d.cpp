@@ -52,6 +52,7 @@ struct InputVertices {
     std::vector<uint32_t> ringStart, ringSize;  // per vertex: its ring's first vertex and size
     std::vector<std::pair<size_t, size_t>> segments;
     std::vector<size_t> sorted;            // by (x, y, index)
+    std::vector<char> shared;              // per vertex: another input vertex lies at the same place
 
     size_t next(size_t v) const { return ringStart[v] + (v - ringStart[v] + 1) % ringSize[v]; }
     size_t prev(size_t v) const { return ringStart[v] + (v - ringStart[v] + ringSize[v] - 1) % ringSize[v]; }
@@ -87,6 +88,13 @@ int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, in
     const double ux = tri.points[2 * u], uy = tri.points[2 * u + 1];
     const double vx = tri.points[2 * v], vy = tri.points[2 * v + 1];
     found.clear();  // (segment start vertex, sign)
+    // Fast path: both ends are input vertices that no other ring passes through, and the
+    // edge is a whole input segment.
+    const int iu = tri.vertexInput[u], iv = tri.vertexInput[v];
+    if (iu >= 0 && iv >= 0 && !in.shared[iu] && !in.shared[iv]) {
+        if (in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return -1;
+        if (in.prev(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return +1;
+    }
     auto scan = [&](double ax, double ay, double bx, double by, int signForward) {
         auto [lo, hi] = in.at(ax, ay);
         for (size_t i = lo; i < hi; ++i) {
@@ -384,6 +392,11 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
     std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
         return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
     });
+    in.shared.assign(in.part.size(), 0);
+    for (size_t k = 1; k < in.sorted.size(); ++k) {
+        const size_t a = in.sorted[k - 1], b = in.sorted[k];
+        if (in.x(a) == in.x(b) && in.y(a) == in.y(b)) in.shared[a] = in.shared[b] = 1;
+    }
     return in;
 }
 
@@ -493,6 +506,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     std::string error;
     ConstrainedTriangulation2D triangulation;
     if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    endStage("triangulate");
     buildFreeSpace(in, checked, space, models);
     // Free edges between two free triangles, before Steiner points (as GEOS measures them).
     out.freeEdgeMin = INFINITY;
@@ -505,6 +519,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         }
     if (!std::isfinite(out.freeEdgeMin)) out.freeEdgeMin = 0;
     out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+    endStage("free space and graph");
     const std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
     bool anySplit = false;
     for (const auto& list : splits) anySplit |= !list.empty();
@@ -515,8 +530,10 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         in = inputVertices(checked, splits);
         space = FreeSpace2D{};
         if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+        endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+        endStage("free space and graph again");
     }
     out.vertexCount = space.tri.vertexCount();
     out.triangleCount = space.tri.faceCount();
@@ -536,7 +553,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
                                            "these " + std::to_string(modelFeatures[m].size()) +
                                                " features touch or overlap; merged into one model"});
     }
-    endStage("triangulate and build the graph");
+    endStage("models");
 
     // 6. Levels.
     std::vector<double> deltas = settings.deltas;
