@@ -136,7 +136,7 @@ TEST(Aggregate2D, GroupsFollowTheDendrogram) {
 TEST(Aggregate2D, HolesTouchingPartsAndDeterminism) {
     // A ring-shaped building (square with a square hole) with a small block inside the hole,
     // and two blocks that touch the ring at a vertex.
-    std::vector<Feature2D> features(4);
+    std::vector<Feature2D> features(5);
     features[0].name = "ring";
     features[0].polygons = {Polygon2D{{0, 0, 10, 0, 10, 10, 0, 10}, {{3, 3, 3, 7, 7, 7, 7, 3}}}};
     features[1].name = "inner";
@@ -145,24 +145,30 @@ TEST(Aggregate2D, HolesTouchingPartsAndDeterminism) {
     features[2].polygons = {Polygon2D{{10, 10, 12, 10, 12, 12, 10, 12}, {}}};
     features[3].name = "far";
     features[3].polygons = {Polygon2D{{20, 0, 22, 0, 22, 2, 20, 2}, {}}};
-    for (uint32_t i = 0; i < 4; ++i) features[i].id = i;
+    features[4].name = "notched";  // a hole touching its exterior at one vertex (OGC-valid)
+    features[4].polygons = {Polygon2D{{30, 0, 34, 0, 34, 4, 30, 4}, {{32, 0, 31, 1, 33, 1}}}};
+    for (uint32_t i = 0; i < 5; ++i) features[i].id = i;
     Settings2D settings;
     settings.deltas = {0, 1, 2, 9};
     Hierarchy2D h;
     ASSERT_TRUE(buildHierarchy2D(features, settings, h));
-    EXPECT_EQ(h.modelCount, 3u) << "ring and corner touch: one model";
+    EXPECT_EQ(h.modelCount, 4u) << "ring and corner touch: one model";
     bool noted = false;
     for (const Diagnostic& d : h.diagnostics) noted |= d.message.find("touch or overlap") != std::string::npos;
     EXPECT_TRUE(noted);
     expectValidAndContaining(features, h, "holes");
     // Delta 0: the hole stays a hole (with the inner block as its own aggregate).
-    ASSERT_EQ(h.levels[0].aggregates.size(), 3u);
+    ASSERT_EQ(h.levels[0].aggregates.size(), 4u);
     const Aggregate2D& ring = h.levels[0].aggregates[0];
     size_t holes = 0;
     for (const Polygon2D& p : ring.polygons) holes += p.holes.size();
     EXPECT_EQ(holes, 1u);
     // Delta 2 joins the inner block (1.5 away) with the ring: still valid (checked above).
-    EXPECT_EQ(h.levels[2].aggregates.size(), 2u);
+    EXPECT_EQ(h.levels[2].aggregates.size(), 3u);
+    // The touching hole is kept at delta 0.
+    size_t notchHoles = 0;
+    for (const Polygon2D& p : h.levels[0].aggregates[3].polygons) notchHoles += p.holes.size();
+    EXPECT_EQ(notchHoles, 1u);
     // Same input, same output, byte for byte.
     Hierarchy2D again;
     ASSERT_TRUE(buildHierarchy2D(features, settings, again));
