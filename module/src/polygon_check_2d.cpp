@@ -215,84 +215,86 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
             }
         }
     }
-    if (segments.empty()) segments.push_back({0, 0, 0, 0, UINT32_MAX, 0, 0, 1});  // keeps the grid code simple; never tested (one entry)
-    double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY, sumLen = 0;
-    for (const Segment& s : segments) {
-        minX = std::min({minX, s.ax, s.bx});
-        maxX = std::max({maxX, s.ax, s.bx});
-        minY = std::min({minY, s.ay, s.by});
-        maxY = std::max({maxY, s.ay, s.by});
-        sumLen += std::hypot(s.bx - s.ax, s.by - s.ay);
-    }
-    // Cell about twice the mean segment length, at most ~4 cells per segment overall.
-    double cell = 2 * sumLen / static_cast<double>(segments.size());
-    const double spanX = maxX - minX, spanY = maxY - minY;
-    const double minCell = std::sqrt(std::max(spanX * spanY, 1e-300) / (4.0 * static_cast<double>(segments.size())));
-    cell = std::max({cell, minCell, 1e-300});
-    const long long nx = std::min<long long>(static_cast<long long>(spanX / cell) + 1, 1 << 20);
-    const long long ny = std::min<long long>(static_cast<long long>(spanY / cell) + 1, 1 << 20);
-    auto cellOf = [&](double x, double y) {
-        long long cx = std::clamp<long long>(static_cast<long long>((x - minX) / cell), 0, nx - 1);
-        long long cy = std::clamp<long long>(static_cast<long long>((y - minY) / cell), 0, ny - 1);
-        return std::pair<long long, long long>(cx, cy);
-    };
-    std::vector<std::pair<long long, uint32_t>> entries;  // (cell key, segment)
-    entries.reserve(segments.size() * 2);
-    for (uint32_t i = 0; i < segments.size(); ++i) {
-        const Segment& s = segments[i];
-        auto [x0, y0] = cellOf(std::min(s.ax, s.bx), std::min(s.ay, s.by));
-        auto [x1, y1] = cellOf(std::max(s.ax, s.bx), std::max(s.ay, s.by));
-        for (long long cy = y0; cy <= y1; ++cy)
-            for (long long cx = x0; cx <= x1; ++cx) entries.emplace_back(cy * nx + cx, i);
-    }
-    std::sort(entries.begin(), entries.end());
-
-    // 3. Test pairs. Problems per feature are collected, the first one reported.
+    // 3. Contacts between segments. Problems per polygon are collected, the first one reported.
     std::vector<std::string> partProblem(out.parts.size());
     std::vector<std::pair<uint32_t, uint32_t>> touching;
-    for (size_t b = 0; b < entries.size();) {
-        size_t e = b;
-        while (e < entries.size() && entries[e].first == entries[b].first) ++e;
-        const long long key = entries[b].first;
-        for (size_t i = b; i < e; ++i) {
-            for (size_t j = i + 1; j < e; ++j) {
-                const Segment& s = segments[entries[i].second];
-                const Segment& t = segments[entries[j].second];
-                // Test the pair only in the cell of the lower-left corner of the boxes' overlap.
-                const double ox = std::max(std::min(s.ax, s.bx), std::min(t.ax, t.bx));
-                const double oy = std::max(std::min(s.ay, s.by), std::min(t.ay, t.by));
-                if (ox > std::min(std::max(s.ax, s.bx), std::max(t.ax, t.bx)) ||
-                    oy > std::min(std::max(s.ay, s.by), std::max(t.ay, t.by)))
-                    continue;
-                auto [cx, cy] = cellOf(ox, oy);
-                if (cy * nx + cx != key) continue;
-                const bool samePart = s.part == t.part;
-                if (samePart && !partProblem[s.part].empty()) continue;
-                double wx = 0, wy = 0;
-                const Contact c = contact(s, t, wx, wy);
-                if (c == Contact::None) continue;
-                if (!samePart) {
-                    touching.emplace_back(std::min(s.part, t.part), std::max(s.part, t.part));
-                    continue;
-                }
-                const uint32_t feature = out.partFeature[s.part];
-                auto label = [&](const Segment& g) {
-                    const auto [part, hole] = ringOwner[g.ring];
-                    return ringLabel(partIndexInFeature[part], features[feature].polygons.size(), hole);
-                };
-                if (s.ring == t.ring) {
-                    const bool adjacent = (s.index + 1) % s.ringSize == t.index || (t.index + 1) % t.ringSize == s.index;
-                    if (adjacent && c == Contact::Touch) continue;  // shared vertex
-                    partProblem[s.part] = label(s) + ": self-intersecting ring " +
-                                              (c == Contact::Overlap && adjacent ? "(the ring turns back on itself) " : "") +
-                                              "at " + formatPoint(wx, wy);
-                } else if (c != Contact::Touch) {
-                    partProblem[s.part] = label(s) + " and " + label(t) + " cross at " + formatPoint(wx, wy);
+    if (!segments.empty()) {
+        double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY, sumLen = 0;
+        for (const Segment& s : segments) {
+            minX = std::min({minX, s.ax, s.bx});
+            maxX = std::max({maxX, s.ax, s.bx});
+            minY = std::min({minY, s.ay, s.by});
+            maxY = std::max({maxY, s.ay, s.by});
+            sumLen += std::hypot(s.bx - s.ax, s.by - s.ay);
+        }
+        // Cell about twice the mean segment length, at most ~4 cells per segment overall.
+        double cell = 2 * sumLen / static_cast<double>(segments.size());
+        const double spanX = maxX - minX, spanY = maxY - minY;
+        const double minCell = std::sqrt(std::max(spanX * spanY, 1e-300) / (4.0 * static_cast<double>(segments.size())));
+        cell = std::max({cell, minCell, 1e-300});
+        const long long nx = std::min<long long>(static_cast<long long>(spanX / cell) + 1, 1 << 20);
+        const long long ny = std::min<long long>(static_cast<long long>(spanY / cell) + 1, 1 << 20);
+        auto cellOf = [&](double x, double y) {
+            long long cx = std::clamp<long long>(static_cast<long long>((x - minX) / cell), 0, nx - 1);
+            long long cy = std::clamp<long long>(static_cast<long long>((y - minY) / cell), 0, ny - 1);
+            return std::pair<long long, long long>(cx, cy);
+        };
+        std::vector<std::pair<long long, uint32_t>> entries;  // (cell key, segment)
+        entries.reserve(segments.size() * 2);
+        for (uint32_t i = 0; i < segments.size(); ++i) {
+            const Segment& s = segments[i];
+            auto [x0, y0] = cellOf(std::min(s.ax, s.bx), std::min(s.ay, s.by));
+            auto [x1, y1] = cellOf(std::max(s.ax, s.bx), std::max(s.ay, s.by));
+            for (long long cy = y0; cy <= y1; ++cy)
+                for (long long cx = x0; cx <= x1; ++cx) entries.emplace_back(cy * nx + cx, i);
+        }
+        std::sort(entries.begin(), entries.end());
+
+        for (size_t b = 0; b < entries.size();) {
+            size_t e = b;
+            while (e < entries.size() && entries[e].first == entries[b].first) ++e;
+            const long long key = entries[b].first;
+            for (size_t i = b; i < e; ++i) {
+                for (size_t j = i + 1; j < e; ++j) {
+                    const Segment& s = segments[entries[i].second];
+                    const Segment& t = segments[entries[j].second];
+                    // Test the pair only in the cell of the lower-left corner of the boxes' overlap.
+                    const double ox = std::max(std::min(s.ax, s.bx), std::min(t.ax, t.bx));
+                    const double oy = std::max(std::min(s.ay, s.by), std::min(t.ay, t.by));
+                    if (ox > std::min(std::max(s.ax, s.bx), std::max(t.ax, t.bx)) ||
+                        oy > std::min(std::max(s.ay, s.by), std::max(t.ay, t.by)))
+                        continue;
+                    auto [cx, cy] = cellOf(ox, oy);
+                    if (cy * nx + cx != key) continue;
+                    const bool samePart = s.part == t.part;
+                    if (samePart && !partProblem[s.part].empty()) continue;
+                    double wx = 0, wy = 0;
+                    const Contact c = contact(s, t, wx, wy);
+                    if (c == Contact::None) continue;
+                    if (!samePart) {
+                        touching.emplace_back(std::min(s.part, t.part), std::max(s.part, t.part));
+                        continue;
+                    }
+                    const uint32_t feature = out.partFeature[s.part];
+                    auto label = [&](const Segment& g) {
+                        const auto [part, hole] = ringOwner[g.ring];
+                        return ringLabel(partIndexInFeature[part], features[feature].polygons.size(), hole);
+                    };
+                    if (s.ring == t.ring) {
+                        const bool adjacent = (s.index + 1) % s.ringSize == t.index || (t.index + 1) % t.ringSize == s.index;
+                        if (adjacent && c == Contact::Touch) continue;  // shared vertex
+                        partProblem[s.part] = label(s) + ": self-intersecting ring " +
+                                                  (c == Contact::Overlap && adjacent ? "(the ring turns back on itself) " : "") +
+                                                  "at " + formatPoint(wx, wy);
+                    } else if (c != Contact::Touch) {
+                        partProblem[s.part] = label(s) + " and " + label(t) + " cross at " + formatPoint(wx, wy);
+                    }
                 }
             }
+            b = e;
         }
-        b = e;
     }
+
     // Holes must lie inside their exterior (checked at a hole edge midpoint; crossings are found above).
     for (uint32_t p = 0; p < out.parts.size(); ++p) {
         if (!partProblem[p].empty()) continue;
