@@ -565,6 +565,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
                                                               : makeAggregateFunction(settings.function);
     const AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
+    std::vector<int> mergePair;  // per merge: its index in space.pairs
+    for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
     std::vector<int> label;
     for (size_t li = 0; li < deltas.size(); ++li) {
         progress("sculpting levels", static_cast<double>(li) / deltas.size());
@@ -573,10 +575,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         size_t groupCount = 0;
         const std::vector<uint32_t> modelGroup = groupsAtThreshold(space.modelCount, out.merges, level.delta, &groupCount);
         std::vector<int> joined;
-        for (const Merge& m : out.merges) {
-            if (!(m.height < level.delta)) break;
-            joined.push_back(space.pairIndex(m.modelA, m.modelB));
-        }
+        for (size_t k = 0; k < out.merges.size() && out.merges[k].height < level.delta; ++k)
+            joined.push_back(mergePair[k]);
         level.aggregates.resize(groupCount);
         // Sources and hulls of every group.
         for (size_t f = 0; f < features.size(); ++f)

@@ -123,3 +123,35 @@ TEST(Aggregate2DCli, WritesLevelsLinksPicturesAndStatsDeterministically) {
         EXPECT_EQ(r.exitCode, 0) << fn << "\n" << r.describe();
     }
 }
+
+TEST(Aggregate2DCli, Reproduce2DWritesTablesAndFiguresDeterministically) {
+    const fs::path dir = freshTestDir(currentTestName());
+    RunResult r = runProgram({AGGRELOD_CLI, "reproduce2d", "-o", (dir / "a").string(), "-q"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.describe();
+    const std::string csv = readFile(dir / "a" / "table.csv");
+    // Header + 5 environments x 4 levels.
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 21) << csv;
+    for (const std::string env : {"tree", "scatter", "room", "colony", "forest"}) {
+        EXPECT_NE(csv.find(env + ","), std::string::npos) << env;
+        EXPECT_GT(fs::file_size(dir / "a" / ("fig4-" + env + ".png")), 5000u) << env;
+    }
+    EXPECT_GT(fs::file_size(dir / "a" / "fig6.png"), 5000u);
+    // Every row: area adaptive <= constant <= hull (columns 7, 8, 9 of the CSV).
+    std::istringstream lines(csv);
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) {
+        std::vector<double> v;
+        std::istringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ',')) v.push_back(std::atof(cell.c_str()));
+        ASSERT_GE(v.size(), 15u) << line;
+        EXPECT_LE(v[7], v[6] + 1e-4) << line;
+        EXPECT_LE(v[6], v[8] + 1e-4) << line;
+    }
+    r = runProgram({AGGRELOD_CLI, "reproduce2d", "-o", (dir / "b").string(), "-q"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.describe();
+    EXPECT_EQ(readFile(dir / "b" / "table.csv"), csv);
+    EXPECT_EQ(readFile(dir / "b" / "table.md"), readFile(dir / "a" / "table.md"));
+    EXPECT_EQ(readFile(dir / "b" / "fig6.png"), readFile(dir / "a" / "fig6.png"));
+}
