@@ -508,12 +508,12 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models);
-    // Free edges between two free triangles, before Steiner points (as GEOS measures them).
+    // Unconstrained edges of free triangles (hull edges included), before Steiner points:
+    // the edges GEOS's ConcaveHullOfPolygons takes for its length ratio.
     out.freeEdgeMin = INFINITY;
     for (size_t f = 0; f < space.tri.faceCount(); ++f)
         for (int j = 0; j < 3; ++j) {
-            const int n = space.tri.neighbors[3 * f + j];
-            if (space.faceModel[f] >= 0 || n < 0 || space.faceModel[n] >= 0) continue;
+            if (space.faceModel[f] >= 0 || space.tri.constrained[3 * f + j]) continue;
             out.freeEdgeMin = std::min(out.freeEdgeMin, space.edgeLength[3 * f + j]);
             out.freeEdgeMax = std::max(out.freeEdgeMax, space.edgeLength[3 * f + j]);
         }

@@ -1,10 +1,10 @@
 // Benchmark: aggrelod 2D (constant function, paper Eq. 1) against GEOS 3.11
 // ConcaveHullOfPolygons, the strongest open peer, at the same edge-length threshold.
 //
-// GEOS takes a length ratio r, not a length: L = r * (max - min) + min over the free edges
-// of its triangulation (NOTES-deps). We use the min / max free-edge lengths of our own
-// constrained triangulation of the same vertices, so both remove exposed edges longer than
-// delta. aggrelod builds ALL its levels (8 thresholds); GEOS builds one. Figures: seconds,
+// GEOS takes a length ratio r, not a length: L = r * (max - min) + min over the
+// unconstrained edges of the triangles between the polygons (GEOS computeTargetEdgeLength;
+// NOTES-deps). Our own constrained triangulation of the same vertices gives the same min /
+// max, so both remove exposed edges longer than delta. aggrelod builds ALL its levels (8 thresholds); GEOS builds one. Figures: seconds,
 // added area (relative to the originals), validity (GEOSisValid), and the longest boundary
 // edge of the output that does not lie on an input boundary versus delta.
 // GEOS time grows about with the square of the polygon count: it is skipped above 10k.

@@ -84,7 +84,7 @@ struct Hierarchy2D {
     std::vector<std::pair<std::string, double>> timings;  ///< stage -> seconds, run order
     size_t vertexCount = 0;                  ///< triangulation vertices
     size_t triangleCount = 0;                ///< triangulation faces
-    double freeEdgeMin = 0, freeEdgeMax = 0; ///< shortest / longest edge between two free-space triangles (before Steiner points)
+    double freeEdgeMin = 0, freeEdgeMax = 0; ///< shortest / longest unconstrained edge of a free-space triangle (before Steiner points)
 };
 
 /// Measures divided by the originals' (area, perimeter, circularity each normalised).
