@@ -39,6 +39,7 @@ int runAggregate2D(Aggregate2DOptions o) {
     settings.automaticLevelCount = o.levels;
     settings.function = o.function == "constant" ? AggregateFunctionKind::Constant : AggregateFunctionKind::Adaptive;
     settings.shape = o.function == "hull" ? Shape2D::ConvexHull : Shape2D::Sculpted;
+    settings.threadCount = o.threads;
     settings.progress = [&progress](const char* stage, double fraction) { progress.update(stage, fraction); };
     Hierarchy2D hierarchy;
     const bool ok = buildHierarchy2D(input.features, settings, hierarchy);

@@ -14,6 +14,7 @@ struct Aggregate2DOptions {
     int levels = 8;
     std::string function = "adaptive";  ///< adaptive | constant | hull
     std::string linksPath, svgPath, pngPath, statsPath;
+    int threads = 0;                    ///< threads for sculpting levels (0: all cores)
     bool quiet = false;
 };
 /// Returns the process exit code (0 ok, 1 usage, 2 file problem, 3 aggregation failed).

@@ -3,6 +3,7 @@
 // models (touching / overlapping polygons merged) -> neighbourhood graph -> Kruskal
 // dendrogram (shared with 3D) -> per level: sculpt, polygons, measures and baselines.
 #include "free_space_2d.h"
+#include "parallel_for.h"
 #include "polygon_check_2d.h"
 #include "sculpt_2d.h"
 
@@ -567,10 +568,21 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
     std::vector<int> mergePair;  // per merge: its index in space.pairs
     for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
-    std::vector<int> label;
-    for (size_t li = 0; li < deltas.size(); ++li) {
-        progress("sculpting levels", static_cast<double>(li) / deltas.size());
-        Level2D level;
+    // F of every pair at every level, on the calling thread (a custom function is user code).
+    const size_t levelCount = deltas.size();
+    std::vector<EdgeLimits2D> primaryLimits(levelCount), constantLimits(levelCount), adaptiveLimits(levelCount);
+    for (size_t li = 0; li < levelCount; ++li) {
+        if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
+        if (settings.computeBaselines) {
+            constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
+            adaptiveLimits[li] = computeEdgeLimits2D(space, deltas[li], adaptive);
+        }
+    }
+    // Levels are independent: sculpted in parallel, each writing only its own slot.
+    out.levels.resize(levelCount);
+    auto buildLevel = [&](size_t li) {
+        Level2D& level = out.levels[li];
+        std::vector<int> label;
         level.delta = deltas[li];
         size_t groupCount = 0;
         const std::vector<uint32_t> modelGroup = groupsAtThreshold(space.modelCount, out.merges, level.delta, &groupCount);
@@ -606,7 +618,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
                 agg.measures.circularity = circularity(agg.measures.area, agg.measures.perimeter);
             }
         } else {
-            sculptLevel2D(space, modelGroup, computeEdgeLimits2D(space, level.delta, primary), joined, label);
+            sculptLevel2D(space, modelGroup, primaryLimits[li], joined, label);
             extractPolygons2D(space, label, groupCount, level.aggregates);
         }
         for (const Aggregate2D& agg : level.aggregates) {
@@ -615,13 +627,16 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         }
         level.measures.circularity = circularity(level.measures.area, level.measures.perimeter);
         if (settings.computeBaselines) {
-            sculptLevel2D(space, modelGroup, computeEdgeLimits2D(space, level.delta, constant), joined, label);
+            sculptLevel2D(space, modelGroup, constantLimits[li], joined, label);
             level.constant = measureLabels2D(space, label);
-            sculptLevel2D(space, modelGroup, computeEdgeLimits2D(space, level.delta, adaptive), joined, label);
+            sculptLevel2D(space, modelGroup, adaptiveLimits[li], joined, label);
             level.adaptive = measureLabels2D(space, label);
         }
-        out.levels.push_back(std::move(level));
-    }
+    };
+    progress("sculpting levels", 0);
+    parallelFor(levelCount, settings.threadCount, buildLevel, [&](size_t done) {
+        progress("sculpting levels", static_cast<double>(done) / static_cast<double>(levelCount));
+    });
     progress("sculpting levels", 1);
     endStage("sculpt levels");
     return true;

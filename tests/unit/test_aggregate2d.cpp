@@ -216,3 +216,23 @@ TEST(Aggregate2D, SharedBordersMergeAtDeltaZero) {
     EXPECT_NEAR(h.levels[0].measures.area, unionArea, 1e-9 * unionArea);
     EXPECT_LT(h.levels[0].measures.perimeter, 0.5 * h.originals.perimeter) << "inner borders are gone";
 }
+
+TEST(Aggregate2D, SameResultForAnyThreadCount) {
+    const std::vector<Feature2D> features = samples::makeEnvironment2D(samples::Environment2D::Forest, 2);
+    std::string first;
+    for (int threads : {1, 2, 5}) {
+        Settings2D settings;
+        settings.automaticLevelCount = 6;
+        settings.threadCount = threads;
+        Hierarchy2D h;
+        ASSERT_TRUE(buildHierarchy2D(features, settings, h));
+        std::string text = io::formatLevelsGeoJson(h, features);
+        for (const Level2D& l : h.levels) {
+            char buf[128];
+            std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g\n", l.constant.area, l.adaptive.area, l.hull.area);
+            text += buf;
+        }
+        if (first.empty()) first = text;
+        else EXPECT_EQ(text, first) << threads << " threads";
+    }
+}
