@@ -26,6 +26,7 @@ using Point = Kernel::Point_2;
 
 struct ConstrainedTriangulation2D::Impl {
     Cdt cdt;
+    std::vector<Cdt::Vertex_handle> inputHandle;  // per build() input point
 };
 
 ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
@@ -36,7 +37,8 @@ namespace {
 // Flat export. Vertices are numbered in the order of their input point (Steiner points
 // after, in CGAL's order, which is deterministic for a given input); faces by their sorted
 // vertex triple. Neither depends on CGAL's storage order.
-void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out) {
+void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
+                         std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
     std::vector<size_t> order(n);
@@ -54,10 +56,14 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
         auto it = std::lower_bound(order.begin(), order.end(), size_t{0}, [&](size_t a, size_t) {
             return points[2 * a] < x || (points[2 * a] == x && points[2 * a + 1] < y);
         });
-        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y)
+        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y) {
             keyed.emplace_back(static_cast<long long>(*it), v);
-        else
+            if (inputHandle)
+                for (auto same = it; same != order.end() && points[2 * *same] == x && points[2 * *same + 1] == y; ++same)
+                    (*inputHandle)[*same] = v;
+        } else {
             keyed.emplace_back(steinerKey++, v);
+        }
     }
     std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     out.points.reserve(2 * keyed.size());
@@ -104,9 +110,45 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         pts.reserve(n);
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
-        exportTriangulation(impl_->cdt, points, out);
+        impl_->inputHandle.assign(n, Cdt::Vertex_handle());
+        exportTriangulation(impl_->cdt, points, out, &impl_->inputHandle);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
+        return false;
+    }
+    return true;
+}
+
+bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSplit>& splits,
+                                                  std::vector<char>& applied, const std::vector<double>& allPoints,
+                                                  Triangulation2D& out, std::string& error) {
+    applied.assign(splits.size(), 0);
+    try {
+        Cdt& cdt = impl_->cdt;
+        for (size_t k = 0; k < splits.size(); ++k) {
+            const ConstraintSplit& split = splits[k];
+            if (split.from >= impl_->inputHandle.size() || split.to >= impl_->inputHandle.size()) continue;
+            const Cdt::Vertex_handle va = impl_->inputHandle[split.from], vb = impl_->inputHandle[split.to];
+            Cdt::Face_handle face;
+            int index = 0;
+            // Only a segment that is still one constrained edge (not already split by another
+            // ring's vertex on it) is split here; the caller leaves the others as they are.
+            if (va == Cdt::Vertex_handle() || vb == Cdt::Vertex_handle() || !cdt.is_edge(va, vb, face, index) ||
+                !face->is_constrained(index))
+                continue;
+            cdt.remove_constrained_edge(face, index);
+            Cdt::Vertex_handle previous = va;
+            for (size_t i = 0; i + 1 < split.points.size(); i += 2) {
+                const Cdt::Vertex_handle v = cdt.insert(Point(split.points[i], split.points[i + 1]), va->face());
+                cdt.insert_constraint(previous, v);
+                previous = v;
+            }
+            cdt.insert_constraint(previous, vb);
+            applied[k] = 1;
+        }
+        exportTriangulation(cdt, allPoints, out);
+    } catch (const std::exception& e) {
+        error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;
     }
     return true;

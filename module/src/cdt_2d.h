@@ -20,6 +20,12 @@ struct Triangulation2D {
     size_t faceCount() const { return faces.size() / 3; }
 };
 
+/// New vertices on one constraint segment of the build() input, from point `from` to `to`.
+struct ConstraintSplit {
+    size_t from = 0, to = 0;     ///< indices of build() input points
+    std::vector<double> points;  ///< x y pairs, in order from `from` to `to`
+};
+
 /// A constrained Delaunay triangulation (CGAL's, hidden behind this class).
 class ConstrainedTriangulation2D {
 public:
@@ -34,6 +40,15 @@ public:
     /// Returns false with a message when the triangulator fails (never throws).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
                Triangulation2D& out, std::string& error);
+
+    /// Splits constraint segments (DESIGN 2.4 step 4, Steiner points): each segment that is
+    /// still one constrained edge loses its constraint, gets its points inserted, and the
+    /// chain from -> points -> to becomes constrained, so the new vertices lie exactly on
+    /// constraints whatever the rounding of their coordinates. applied[k] says whether
+    /// splits[k] was done. Then exports again, numbering vertices by `allPoints` (the input
+    /// points including the new ones).
+    bool splitConstraints(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
+                          const std::vector<double>& allPoints, Triangulation2D& out, std::string& error);
 
 private:
     struct Impl;

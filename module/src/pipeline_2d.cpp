@@ -521,16 +521,39 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     if (!std::isfinite(out.freeEdgeMin)) out.freeEdgeMin = 0;
     out.merges = kruskalMerges(space.modelCount, graphEdges(space));
     endStage("free space and graph");
-    const std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
-    bool anySplit = false;
-    for (const auto& list : splits) anySplit |= !list.empty();
-    if (anySplit) {
-        // Triangulate again with the split rings: the new points are then exact constraint
-        // vertices (inserting them into the live triangulation left points a rounding error
-        // off their constraint, which broke the inside/outside marking).
-        in = inputVertices(checked, splits);
+    std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
+    std::vector<ConstraintSplit> requests;
+    std::vector<size_t> requestSegment;
+    for (size_t v = 0; v < splits.size(); ++v) {
+        if (splits[v].empty()) continue;
+        ConstraintSplit r;
+        r.from = v;
+        r.to = in.next(v);
+        for (double t : splits[v]) {  // the same arithmetic as inputVertices()
+            r.points.push_back(in.x(v) + t * (in.x(r.to) - in.x(v)));
+            r.points.push_back(in.y(v) + t * (in.y(r.to) - in.y(v)));
+        }
+        requests.push_back(std::move(r));
+        requestSegment.push_back(v);
+    }
+    if (!requests.empty()) {
+        // The new vertices go into the live triangulation with their constraints split
+        // exactly; segments that cannot be split that way keep no new vertex.
+        const std::vector<double> allPoints = inputVertices(checked, splits).points;
+        std::vector<char> applied;
         space = FreeSpace2D{};
-        if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+        if (!triangulation.splitConstraints(requests, applied, allPoints, space.tri, error)) return fail(error);
+        bool allApplied = true;
+        for (size_t k = 0; k < requests.size(); ++k)
+            if (!applied[k]) {
+                splits[requestSegment[k]].clear();
+                allApplied = false;
+            }
+        in = inputVertices(checked, splits);
+        if (!allApplied) {
+            // Numbering must follow the final input points: export again without the skipped ones.
+            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error)) return fail(error);
+        }
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
