@@ -54,31 +54,58 @@ struct InputVertices {
     std::vector<std::pair<size_t, size_t>> segments;
     std::vector<size_t> sorted;            // by (x, y, index)
     std::vector<char> shared;              // per vertex: another input vertex lies at the same place
+    // Uniform grid of the ring segments (segment i starts at vertex i), for finding the input
+    // segments under a triangulation edge; segments spanning many cells go to `longSegments`.
+    double gridX0 = 0, gridY0 = 0, gridCell = 1;
+    long long gridNx = 1, gridNy = 1;
+    std::vector<std::pair<long long, uint32_t>> gridEntries;  // (cell, segment), sorted
+    std::vector<uint32_t> longSegments;
 
     size_t next(size_t v) const { return ringStart[v] + (v - ringStart[v] + 1) % ringSize[v]; }
+    long long cellX(double px) const {
+        return std::clamp<long long>(static_cast<long long>((px - gridX0) / gridCell), 0, gridNx - 1);
+    }
+    long long cellY(double py) const {
+        return std::clamp<long long>(static_cast<long long>((py - gridY0) / gridCell), 0, gridNy - 1);
+    }
     size_t prev(size_t v) const { return ringStart[v] + (v - ringStart[v] + ringSize[v] - 1) % ringSize[v]; }
     double x(size_t v) const { return points[2 * v]; }
     double y(size_t v) const { return points[2 * v + 1]; }
-
-    // Input vertices at (px, py): a range of `sorted`.
-    std::pair<size_t, size_t> at(double px, double py) const {
-        auto less = [&](size_t a, std::pair<double, double> k) { return x(a) < k.first || (x(a) == k.first && y(a) < k.second); };
-        auto lo = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(px, py), less);
-        auto hi = lo;
-        while (hi != sorted.end() && x(*hi) == px && y(*hi) == py) ++hi;
-        return {static_cast<size_t>(lo - sorted.begin()), static_cast<size_t>(hi - sorted.begin())};
-    }
 };
 
-// True when point (qx, qy) lies on the segment from vertex a to b, beyond a.
-bool onInputSegment(const InputVertices& in, size_t a, size_t b, double qx, double qy) {
-    const double dx = in.x(b) - in.x(a), dy = in.y(b) - in.y(a);
-    const double ex = qx - in.x(a), ey = qy - in.y(a);
-    const double len2 = dx * dx + dy * dy;
-    const double dot = dx * ex + dy * ey;
-    if (dot <= 0 || dot > len2 * (1 + 1e-12)) return false;
-    const double cross = dx * ey - dy * ex;
-    return std::fabs(cross) <= 1e-9 * len2;
+void buildSegmentGrid(InputVertices& in) {
+    const size_t n = in.part.size();
+    if (n == 0) return;
+    double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY, sumLen = 0;
+    for (size_t i = 0; i < n; ++i) {
+        minX = std::min(minX, in.x(i));
+        maxX = std::max(maxX, in.x(i));
+        minY = std::min(minY, in.y(i));
+        maxY = std::max(maxY, in.y(i));
+        sumLen += std::hypot(in.x(in.next(i)) - in.x(i), in.y(in.next(i)) - in.y(i));
+    }
+    const double span = std::max(maxX - minX, maxY - minY);
+    double cell = std::max(2 * sumLen / static_cast<double>(n), span / 4096);
+    if (!(cell > 0) || !std::isfinite(cell)) cell = 1;
+    in.gridX0 = minX;
+    in.gridY0 = minY;
+    in.gridCell = cell;
+    in.gridNx = std::max<long long>(1, std::min<long long>(static_cast<long long>((maxX - minX) / cell) + 1, 1 << 20));
+    in.gridNy = std::max<long long>(1, std::min<long long>(static_cast<long long>((maxY - minY) / cell) + 1, 1 << 20));
+    in.gridEntries.clear();
+    in.longSegments.clear();
+    for (size_t i = 0; i < n; ++i) {
+        const size_t j = in.next(i);
+        const long long x0 = in.cellX(std::min(in.x(i), in.x(j))), x1 = in.cellX(std::max(in.x(i), in.x(j)));
+        const long long y0 = in.cellY(std::min(in.y(i), in.y(j))), y1 = in.cellY(std::max(in.y(i), in.y(j)));
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) > 64) {
+            in.longSegments.push_back(static_cast<uint32_t>(i));
+            continue;
+        }
+        for (long long cy = y0; cy <= y1; ++cy)
+            for (long long cx = x0; cx <= x1; ++cx) in.gridEntries.emplace_back(cy * in.gridNx + cx, static_cast<uint32_t>(i));
+    }
+    std::sort(in.gridEntries.begin(), in.gridEntries.end());
 }
 
 // Change of the winding count when crossing the triangulation edge u->v from its left side
@@ -96,21 +123,24 @@ int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, in
         if (in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return -1;
         if (in.prev(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return +1;
     }
-    auto scan = [&](double ax, double ay, double bx, double by, int signForward) {
-        auto [lo, hi] = in.at(ax, ay);
-        for (size_t i = lo; i < hi; ++i) {
-            const size_t a = in.sorted[i];
-            const size_t n = in.next(a), p = in.prev(a);
-            if (onInputSegment(in, a, n, bx, by)) found.emplace_back(a, signForward);
-            if (onInputSegment(in, a, p, bx, by)) found.emplace_back(p, -signForward);
-        }
+    // Every input segment under the edge's midpoint, collinear with it: -1 for a ring running
+    // u->v (its interior is on the left, where the face is), +1 for one running v->u.
+    const double mx = 0.5 * (ux + vx), my = 0.5 * (uy + vy);
+    const double ex = vx - ux, ey = vy - uy;
+    auto test = [&](uint32_t s) {
+        const size_t a = s, b = in.next(s);
+        const double dx = in.x(b) - in.x(a), dy = in.y(b) - in.y(a);
+        const double len2 = dx * dx + dy * dy;
+        const double px = mx - in.x(a), py = my - in.y(a);
+        const double along = px * dx + py * dy;
+        if (!(along > 0 && along < len2)) return;
+        if (std::fabs(dx * py - dy * px) > 1e-9 * len2) return;  // midpoint off the segment
+        found.emplace_back(s, dx * ex + dy * ey > 0 ? -1 : +1);
     };
-    scan(ux, uy, vx, vy, -1);  // ring a->n along u->v: leaving (-1)
-    scan(vx, vy, ux, uy, +1);  // ring a->n along v->u: entering (+1)
-    std::sort(found.begin(), found.end());
-    found.erase(std::unique(found.begin(), found.end(),
-                            [](const auto& a, const auto& b) { return std::get<0>(a) == std::get<0>(b); }),
-                found.end());
+    const long long key = in.cellY(my) * in.gridNx + in.cellX(mx);
+    auto it = std::lower_bound(in.gridEntries.begin(), in.gridEntries.end(), std::make_pair(key, uint32_t{0}));
+    for (; it != in.gridEntries.end() && it->first == key; ++it) test(it->second);
+    for (uint32_t s : in.longSegments) test(s);
     int change = 0;
     for (auto& f : found) change += std::get<1>(f);
     return change;
@@ -398,6 +428,7 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
         const size_t a = in.sorted[k - 1], b = in.sorted[k];
         if (in.x(a) == in.x(b) && in.y(a) == in.y(b)) in.shared[a] = in.shared[b] = 1;
     }
+    buildSegmentGrid(in);
     return in;
 }
 
