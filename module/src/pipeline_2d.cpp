@@ -54,6 +54,7 @@ struct InputVertices {
     std::vector<std::pair<size_t, size_t>> segments;
     std::vector<size_t> sorted;            // by (x, y, index)
     std::vector<char> shared;              // per vertex: another input vertex lies at the same place
+    std::vector<char> partTouches;         // per part: its boundary meets another part's
     // Uniform grid of the ring segments (segment i starts at vertex i), for finding the input
     // segments under a triangulation edge; segments spanning many cells go to `longSegments`.
     double gridX0 = 0, gridY0 = 0, gridCell = 1;
@@ -108,6 +109,21 @@ void buildSegmentGrid(InputVertices& in) {
     std::sort(in.gridEntries.begin(), in.gridEntries.end());
 }
 
+// Winding number of all input rings around (px, py) (exteriors counter-clockwise, holes
+// clockwise): the number of polygons containing the point. Linear in the vertex count; only
+// for the rare faces the flood cannot reach.
+int windingNumberAt(const InputVertices& in, double px, double py) {
+    int w = 0;
+    for (size_t a = 0; a < in.part.size(); ++a) {
+        const size_t b = in.next(a);
+        const double ay = in.y(a), by = in.y(b);
+        const double side = (in.x(b) - in.x(a)) * (py - ay) - (px - in.x(a)) * (by - ay);
+        if (ay <= py && by > py && side > 0) ++w;
+        else if (ay > py && by <= py && side < 0) --w;
+    }
+    return w;
+}
+
 // Change of the winding count when crossing the triangulation edge u->v from its left side
 // (the face) to its right: -1 per input ring running u->v (its interior is on the left),
 // +1 per ring running v->u.
@@ -116,10 +132,10 @@ int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, in
     const double ux = tri.points[2 * u], uy = tri.points[2 * u + 1];
     const double vx = tri.points[2 * v], vy = tri.points[2 * v + 1];
     found.clear();  // (segment start vertex, sign)
-    // Fast path: both ends are input vertices that no other ring passes through, and the
-    // edge is a whole input segment.
+    // Fast path: the edge is a whole input segment of a polygon whose boundary meets no other
+    // (else another ring may run along the same edge, e.g. a shared border).
     const int iu = tri.vertexInput[u], iv = tri.vertexInput[v];
-    if (iu >= 0 && iv >= 0 && !in.shared[iu] && !in.shared[iv]) {
+    if (iu >= 0 && iv >= 0 && !in.shared[iu] && !in.shared[iv] && !in.partTouches[in.part[iu]]) {
         if (in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return -1;
         if (in.prev(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return +1;
     }
@@ -135,6 +151,7 @@ int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, in
         const double along = px * dx + py * dy;
         if (!(along > 0 && along < len2)) return;
         if (std::fabs(dx * py - dy * px) > 1e-9 * len2) return;  // midpoint off the segment
+        if (std::fabs(dx * ey - dy * ex) > 1e-9 * std::sqrt(len2 * (ex * ex + ey * ey))) return;  // not along it
         found.emplace_back(s, dx * ex + dy * ey > 0 ? -1 : +1);
     };
     const long long key = in.cellY(my) * in.gridNx + in.cellX(mx);
@@ -185,18 +202,52 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                 winding[f] = tri.constrained[3 * f + j] ? -windingChange(in, tri, u, v, found) : 0;
                 queue.push_back(static_cast<int>(f));
             }
+    // A constrained edge between two Steiner points a rounding error apart (crossings of
+    // nearly coincident rings) has no reliable direction: the flood does not cross it, and a
+    // face reached only that way is counted directly (rings around its centroid).
+    const double tiny = 1e-7 * in.gridCell;
+    // Likewise a sliver face (area a rounding error) between two copies of one constraint
+    // (coincident rings crossed by another ring give two nearly equal Steiner points): the
+    // flood neither enters nor leaves it, since each copy would count the rings again.
+    std::vector<char> sliver(faceCount, 0);
+    for (size_t f = 0; f < faceCount; ++f) {
+        const int* v = &tri.faces[3 * f];
+        auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
+        const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
+        double longest = 0;
+        for (int k = 0; k < 3; ++k)
+            longest = std::max(longest, std::hypot(P((k + 1) % 3)[0] - P(k)[0], P((k + 1) % 3)[1] - P(k)[1]));
+        sliver[f] = area2 <= 1e-12 * longest * longest;
+    }
+    auto unreliable = [&](int f, int j) {
+        const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
+        const int n = tri.neighbors[3 * f + j];
+        if (!tri.constrained[3 * f + j]) return false;
+        if (sliver[f] || (n >= 0 && sliver[n])) return true;
+        return tri.vertexInput[u] < 0 && tri.vertexInput[v] < 0 &&
+               std::hypot(tri.points[2 * v] - tri.points[2 * u], tri.points[2 * v + 1] - tri.points[2 * u + 1]) <= tiny;
+    };
     while (!queue.empty()) {
         const int f = queue.front();
         queue.pop_front();
         for (int j = 0; j < 3; ++j) {
             const int n = tri.neighbors[3 * f + j];
-            if (n < 0 || winding[n] != INT32_MIN) continue;
+            if (n < 0 || winding[n] != INT32_MIN || unreliable(f, j)) continue;
             int w = winding[f];
             if (tri.constrained[3 * f + j])
                 w += windingChange(in, tri, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3], found);
             winding[n] = w;
             queue.push_back(n);
         }
+    }
+    for (size_t f = 0; f < faceCount; ++f) {
+        if (winding[f] != INT32_MIN) continue;
+        double cx = 0, cy = 0;
+        for (int k = 0; k < 3; ++k) {
+            cx += tri.points[2 * tri.faces[3 * f + k]] / 3;
+            cy += tri.points[2 * tri.faces[3 * f + k] + 1] / 3;
+        }
+        winding[f] = windingNumberAt(in, cx, cy);
     }
     // Part of each vertex and of each interior face.
     std::vector<int> vertexPart(vertexCount, -1);
@@ -428,6 +479,8 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
         const size_t a = in.sorted[k - 1], b = in.sorted[k];
         if (in.x(a) == in.x(b) && in.y(a) == in.y(b)) in.shared[a] = in.shared[b] = 1;
     }
+    in.partTouches.assign(checked.parts.size(), 0);
+    for (auto [a, b] : checked.touchingParts) in.partTouches[a] = in.partTouches[b] = 1;
     buildSegmentGrid(in);
     return in;
 }
