@@ -6,6 +6,7 @@
 // Each subcommand has an options struct, an add<Name>Command() that declares its
 // options, and a run<Name>() that does the work; add new subcommands the same way.
 #include "runtime_export.h"
+#include "commands_2d.h"
 #include "scene_io.h"
 #include "terminal.h"
 
@@ -395,6 +396,45 @@ int runInspect(const InspectOptions& o) {
 }
 
 // ---------------------------------------------------------------------------
+// aggregate2d, reproduce2d (work in aggregate2d_command.cpp / reproduce2d_command.cpp)
+
+CLI::App* addAggregate2DCommand(CLI::App& app, cli::Aggregate2DOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "aggregate2d", "Aggregate 2D polygons (WKT or GeoJSON) into levels; writes GeoJSON (coordinates are taken as "
+                       "plain planar numbers, degrees included)");
+    cmd->add_option("input", o.input, "Input polygons: .wkt (one POLYGON/MULTIPOLYGON per line) or .geojson")
+        ->required();
+    cmd->add_option("-o,--output", o.output, "Output GeoJSON: one feature per aggregate per level")->required();
+    CLI::Option* delta = cmd->add_option("--delta", o.deltas, "Explicit thresholds, comma-separated, in input units")
+                             ->delimiter(',')
+                             ->allow_extra_args(false);
+    CLI::Option* levels =
+        cmd->add_option("--levels", o.levels, "Number of automatic levels (default 8)")->check(CLI::Range(1, 1000));
+    delta->excludes(levels);
+    cmd->add_option("--function", o.function,
+                    "Aggregate shape: adaptive (default, paper Eq. 2), constant (Eq. 1) or hull (convex hull per group)")
+        ->transform(CLI::IsMember({"adaptive", "constant", "hull"}, CLI::ignore_case));
+    cmd->add_option("--links", o.linksPath, "Write the input id -> output id table per level (CSV)");
+    cmd->add_option("--svg", o.svgPath, "Write an SVG picture (originals filled, aggregates outlined)");
+    cmd->add_option("--png", o.pngPath, "Write a PNG picture (originals filled, aggregates outlined)");
+    cmd->add_option("--stats", o.statsPath, "Write the measures of every level to this JSON file");
+    cmd->add_option("--threads", o.threads, "Threads for sculpting levels (default 0: all cores); output is identical for any count")
+        ->check(CLI::Range(0, 1024));
+    cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
+    return cmd;
+}
+
+CLI::App* addReproduce2DCommand(CLI::App& app, cli::Reproduce2DOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "reproduce2d", "Rerun the paper's 2D evaluation on its five environments: table.md, table.csv, "
+                       "fig4-<env>.png, fig6.png");
+    cmd->add_option("-o,--output", o.outDir, "Output directory (created if missing)")->required();
+    cmd->add_option("--seed", o.seed, "Seed of the environment generators (default 1)");
+    cmd->add_flag("-q,--quiet", o.quiet, "No progress or table (errors only)");
+    return cmd;
+}
+
+// ---------------------------------------------------------------------------
 
 int run(int argc, char** argv) {
     CLI::App app{"aggrelod: aggregate separate objects into a level-of-detail hierarchy"};
@@ -405,6 +445,10 @@ int run(int argc, char** argv) {
     CLI::App* bakeCommand = addBakeCommand(app, bake);
     InspectOptions inspect;
     CLI::App* inspectCommand = addInspectCommand(app, inspect);
+    cli::Aggregate2DOptions aggregate2d;
+    CLI::App* aggregate2dCommand = addAggregate2DCommand(app, aggregate2d);
+    cli::Reproduce2DOptions reproduce2d;
+    CLI::App* reproduce2dCommand = addReproduce2DCommand(app, reproduce2d);
 
     if (argc <= 1) {
         std::fputs(app.help().c_str(), stderr);
@@ -418,6 +462,8 @@ int run(int argc, char** argv) {
     }
     if (bakeCommand->parsed()) return runBake(bake);
     if (inspectCommand->parsed()) return runInspect(inspect);
+    if (aggregate2dCommand->parsed()) return cli::runAggregate2D(aggregate2d);
+    if (reproduce2dCommand->parsed()) return cli::runReproduce2D(reproduce2d);
     return kUsage;
 }
 

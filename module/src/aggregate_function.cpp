@@ -8,7 +8,7 @@
 // With this choice sigma <= (delta - min) / 2, so F <= delta.
 // For an edge with both ends on one model, min = 0 and sigma = 0, so F = delta / 2:
 // concavities of a single model are filled only when their mouth is under delta / 2.
-#include <aggrelod/aggregate3d.h>
+#include <aggrelod/aggregate_common.h>
 
 namespace aggrelod {
 

@@ -2,7 +2,7 @@
 // Shared by 2D and 3D: models are plain indices, weights are distances in world units.
 #pragma once
 
-#include <aggrelod/aggregate3d.h>
+#include <aggrelod/aggregate_common.h>
 
 #include <cstdint>
 #include <vector>

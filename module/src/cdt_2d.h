@@ -1,0 +1,58 @@
+// Constrained Delaunay triangulation of a planar point set with constraint segments
+// (DESIGN 2.1, 2D; paper Section 3.1). The only place that knows CGAL's 2D triangulation.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace aggrelod::detail {
+
+/// Flat triangulation of the convex hull of the input points.
+struct Triangulation2D {
+    std::vector<double> points;     ///< 2 * vertexCount, x y pairs
+    std::vector<int> vertexInput;   ///< per vertex: index of an input point at the same place, -1 for a Steiner point
+    std::vector<int> faces;         ///< 3 * faceCount vertex indices, counter-clockwise
+    std::vector<int> neighbors;     ///< 3 * faceCount: face across the edge opposite corner i, -1 outside the hull
+    std::vector<char> constrained;  ///< 3 * faceCount: edge opposite corner i lies on a constraint
+    size_t vertexCount() const { return points.size() / 2; }
+    size_t faceCount() const { return faces.size() / 3; }
+};
+
+/// New vertices on one constraint segment of the build() input, from point `from` to `to`.
+struct ConstraintSplit {
+    size_t from = 0, to = 0;     ///< indices of build() input points
+    std::vector<double> points;  ///< x y pairs, in order from `from` to `to`
+};
+
+/// A constrained Delaunay triangulation (CGAL's, hidden behind this class).
+class ConstrainedTriangulation2D {
+public:
+    ConstrainedTriangulation2D();
+    ~ConstrainedTriangulation2D();
+    ConstrainedTriangulation2D(const ConstrainedTriangulation2D&) = delete;
+    ConstrainedTriangulation2D& operator=(const ConstrainedTriangulation2D&) = delete;
+
+    /// Triangulates `points` (2 * n, x y pairs) with the segments `segments` (pairs of point
+    /// indices) as constraints, all inserted in one batch. Crossing constraints are split at
+    /// their intersections (new Steiner vertices). Duplicate points become one vertex.
+    /// Returns false with a message when the triangulator fails (never throws).
+    bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
+               Triangulation2D& out, std::string& error);
+
+    /// Splits constraint segments (DESIGN 2.4 step 4, Steiner points): each segment that is
+    /// still one constrained edge loses its constraint, gets its points inserted, and the
+    /// chain from -> points -> to becomes constrained, so the new vertices lie exactly on
+    /// constraints whatever the rounding of their coordinates. applied[k] says whether
+    /// splits[k] was done. Then exports again, numbering vertices by `allPoints` (the input
+    /// points including the new ones).
+    bool splitConstraints(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
+                          const std::vector<double>& allPoints, Triangulation2D& out, std::string& error);
+
+private:
+    struct Impl;
+    Impl* impl_;
+};
+
+}  // namespace aggrelod::detail

@@ -1,0 +1,43 @@
+// The triangulated free space of a 2D scene, shared by the graph, hierarchy and sculpting
+// stages (DESIGN 2.1-2.4, 2D). Built once; every level only reads it.
+#pragma once
+
+#include "cdt_2d.h"
+
+#include <aggrelod/aggregate2d.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace aggrelod::detail {
+
+constexpr int kSameModelEdge2D = -1;  ///< edgePair: both ends on one model
+constexpr int kUnpairedEdge2D = -2;   ///< edgePair: an end is a Steiner point
+
+/// Statistics of one model pair joined by free-space triangulation edges.
+struct ModelPair2D {
+    uint32_t a = 0, b = 0;             ///< models, a < b
+    double minDistance = 0;            ///< shortest connection (graph weight), world units
+    int bestFace[2] = {-1, -1};        ///< free faces holding the shortest connection
+    int connection[3] = {-1, -1, -1};  ///< its ends: vertices (c0, c1), or vertex c0 to the edge (c1, c2)
+    std::vector<double> lengths;       ///< lengths of the free edges joining a and b, ascending
+    std::vector<double> prefixSum, prefixSumSquares;  ///< size lengths.size() + 1
+};
+
+struct FreeSpace2D {
+    Triangulation2D tri;
+    size_t modelCount = 0;
+    std::vector<int> vertexModel;    ///< per vertex: owning model, -1 for Steiner points
+    std::vector<int> faceModel;      ///< per face: model whose interior it is, -1 for free space
+    std::vector<char> faceVoid;      ///< per face: free, enclosed by one model (an input hole): never filled
+    std::vector<double> faceArea;    ///< per face
+    std::vector<double> edgeLength;  ///< 3 * faceCount: edge opposite corner i
+    std::vector<int> edgePair;       ///< 3 * faceCount: index into pairs, or kSameModelEdge2D / kUnpairedEdge2D
+    std::vector<ModelPair2D> pairs;  ///< sorted by (a, b)
+    std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs)
+
+    /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.
+    int pairIndex(uint32_t a, uint32_t b) const;
+};
+
+}  // namespace aggrelod::detail

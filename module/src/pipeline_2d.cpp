@@ -1,0 +1,752 @@
+// The 2D pipeline (paper Sections 3.1-3.3 and 4.2; DESIGN 2.1-2.5 in 2D):
+// check input -> one constrained Delaunay triangulation -> inside/outside by winding ->
+// models (touching / overlapping polygons merged) -> neighbourhood graph -> Kruskal
+// dendrogram (shared with 3D) -> per level: sculpt, polygons, measures and baselines.
+#include "free_space_2d.h"
+#include "parallel_for.h"
+#include "polygon_check_2d.h"
+#include "sculpt_2d.h"
+
+#include <aggrelod/aggregate2d.h>
+#include <aggrelod/dendrogram.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <numeric>
+#include <string>
+#include <tuple>
+
+namespace aggrelod {
+
+double circularity(double area, double perimeter) {
+    return perimeter > 0 ? 4 * M_PI * area / (perimeter * perimeter) : 0;
+}
+
+Measures2D normalizedMeasures(const Measures2D& m, const Measures2D& o) {
+    Measures2D r;
+    r.area = o.area > 0 ? m.area / o.area : 0;
+    r.perimeter = o.perimeter > 0 ? m.perimeter / o.perimeter : 0;
+    r.circularity = o.circularity > 0 ? m.circularity / o.circularity : 0;
+    return r;
+}
+
+namespace {
+using namespace detail;
+using Clock = std::chrono::steady_clock;
+
+uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+}
+void unite(std::vector<uint32_t>& parent, uint32_t a, uint32_t b) {
+    a = findRoot(parent, a);
+    b = findRoot(parent, b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+}
+
+/// Input vertices as one array, with the ring structure needed to orient constraints.
+struct InputVertices {
+    std::vector<double> points;            // 2 * n
+    std::vector<uint32_t> part;            // per vertex
+    std::vector<uint32_t> ringStart, ringSize;  // per vertex: its ring's first vertex and size
+    std::vector<std::pair<size_t, size_t>> segments;
+    std::vector<size_t> sorted;            // by (x, y, index)
+    std::vector<char> shared;              // per vertex: another input vertex lies at the same place
+    std::vector<char> partTouches;         // per part: its boundary meets another part's
+    // Uniform grid of the ring segments (segment i starts at vertex i), for finding the input
+    // segments under a triangulation edge; segments spanning many cells go to `longSegments`.
+    double gridX0 = 0, gridY0 = 0, gridCell = 1;
+    long long gridNx = 1, gridNy = 1;
+    std::vector<std::pair<long long, uint32_t>> gridEntries;  // (cell, segment), sorted
+    std::vector<uint32_t> longSegments;
+
+    size_t next(size_t v) const { return ringStart[v] + (v - ringStart[v] + 1) % ringSize[v]; }
+    long long cellX(double px) const {
+        return std::clamp<long long>(static_cast<long long>((px - gridX0) / gridCell), 0, gridNx - 1);
+    }
+    long long cellY(double py) const {
+        return std::clamp<long long>(static_cast<long long>((py - gridY0) / gridCell), 0, gridNy - 1);
+    }
+    size_t prev(size_t v) const { return ringStart[v] + (v - ringStart[v] + ringSize[v] - 1) % ringSize[v]; }
+    double x(size_t v) const { return points[2 * v]; }
+    double y(size_t v) const { return points[2 * v + 1]; }
+};
+
+void buildSegmentGrid(InputVertices& in) {
+    const size_t n = in.part.size();
+    if (n == 0) return;
+    double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY, sumLen = 0;
+    for (size_t i = 0; i < n; ++i) {
+        minX = std::min(minX, in.x(i));
+        maxX = std::max(maxX, in.x(i));
+        minY = std::min(minY, in.y(i));
+        maxY = std::max(maxY, in.y(i));
+        sumLen += std::hypot(in.x(in.next(i)) - in.x(i), in.y(in.next(i)) - in.y(i));
+    }
+    const double span = std::max(maxX - minX, maxY - minY);
+    double cell = std::max(2 * sumLen / static_cast<double>(n), span / 4096);
+    if (!(cell > 0) || !std::isfinite(cell)) cell = 1;
+    in.gridX0 = minX;
+    in.gridY0 = minY;
+    in.gridCell = cell;
+    in.gridNx = std::max<long long>(1, std::min<long long>(static_cast<long long>((maxX - minX) / cell) + 1, 1 << 20));
+    in.gridNy = std::max<long long>(1, std::min<long long>(static_cast<long long>((maxY - minY) / cell) + 1, 1 << 20));
+    in.gridEntries.clear();
+    in.longSegments.clear();
+    for (size_t i = 0; i < n; ++i) {
+        const size_t j = in.next(i);
+        const long long x0 = in.cellX(std::min(in.x(i), in.x(j))), x1 = in.cellX(std::max(in.x(i), in.x(j)));
+        const long long y0 = in.cellY(std::min(in.y(i), in.y(j))), y1 = in.cellY(std::max(in.y(i), in.y(j)));
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) > 64) {
+            in.longSegments.push_back(static_cast<uint32_t>(i));
+            continue;
+        }
+        for (long long cy = y0; cy <= y1; ++cy)
+            for (long long cx = x0; cx <= x1; ++cx) in.gridEntries.emplace_back(cy * in.gridNx + cx, static_cast<uint32_t>(i));
+    }
+    std::sort(in.gridEntries.begin(), in.gridEntries.end());
+}
+
+// Winding number of all input rings around (px, py) (exteriors counter-clockwise, holes
+// clockwise): the number of polygons containing the point. Linear in the vertex count; only
+// for the rare faces the flood cannot reach.
+int windingNumberAt(const InputVertices& in, double px, double py) {
+    int w = 0;
+    for (size_t a = 0; a < in.part.size(); ++a) {
+        const size_t b = in.next(a);
+        const double ay = in.y(a), by = in.y(b);
+        const double side = (in.x(b) - in.x(a)) * (py - ay) - (px - in.x(a)) * (by - ay);
+        if (ay <= py && by > py && side > 0) ++w;
+        else if (ay > py && by <= py && side < 0) --w;
+    }
+    return w;
+}
+
+// Change of the winding count when crossing the triangulation edge u->v from its left side
+// (the face) to its right: -1 per input ring running u->v (its interior is on the left),
+// +1 per ring running v->u.
+int windingChange(const InputVertices& in, const Triangulation2D& tri, int u, int v,
+                  std::vector<std::tuple<size_t, int>>& found) {
+    const double ux = tri.points[2 * u], uy = tri.points[2 * u + 1];
+    const double vx = tri.points[2 * v], vy = tri.points[2 * v + 1];
+    found.clear();  // (segment start vertex, sign)
+    // Fast path: the edge is a whole input segment of a polygon whose boundary meets no other
+    // (else another ring may run along the same edge, e.g. a shared border).
+    const int iu = tri.vertexInput[u], iv = tri.vertexInput[v];
+    if (iu >= 0 && iv >= 0 && !in.shared[iu] && !in.shared[iv] && !in.partTouches[in.part[iu]]) {
+        if (in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return -1;
+        if (in.prev(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) return +1;
+    }
+    // Every input segment under the edge's midpoint, collinear with it: -1 for a ring running
+    // u->v (its interior is on the left, where the face is), +1 for one running v->u.
+    const double mx = 0.5 * (ux + vx), my = 0.5 * (uy + vy);
+    const double ex = vx - ux, ey = vy - uy;
+    auto test = [&](uint32_t s) {
+        const size_t a = s, b = in.next(s);
+        const double dx = in.x(b) - in.x(a), dy = in.y(b) - in.y(a);
+        const double len2 = dx * dx + dy * dy;
+        const double px = mx - in.x(a), py = my - in.y(a);
+        const double along = px * dx + py * dy;
+        if (!(along > 0 && along < len2)) return;
+        if (std::fabs(dx * py - dy * px) > 1e-9 * len2) return;  // midpoint off the segment
+        if (std::fabs(dx * ey - dy * ex) > 1e-9 * std::sqrt(len2 * (ex * ex + ey * ey))) return;  // not along it
+        found.emplace_back(s, dx * ex + dy * ey > 0 ? -1 : +1);
+    };
+    const long long key = in.cellY(my) * in.gridNx + in.cellX(mx);
+    auto it = std::lower_bound(in.gridEntries.begin(), in.gridEntries.end(), std::make_pair(key, uint32_t{0}));
+    for (; it != in.gridEntries.end() && it->first == key; ++it) test(it->second);
+    for (uint32_t s : in.longSegments) test(s);
+    int change = 0;
+    for (auto& f : found) change += std::get<1>(f);
+    return change;
+}
+
+std::string joinNames(const std::vector<Feature2D>& features, const std::vector<uint32_t>& ids) {
+    std::string s;
+    const size_t shown = std::min<size_t>(ids.size(), 6);
+    for (size_t i = 0; i < shown; ++i) s += (i ? ", " : "") + features[ids[i]].name;
+    if (ids.size() > shown) s += " and " + std::to_string(ids.size() - shown) + " more";
+    return s;
+}
+
+double pointSegmentDistance(const double* p, const double* a, const double* b) {
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double len2 = dx * dx + dy * dy;
+    double t = len2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2 : 0;
+    t = std::clamp(t, 0.0, 1.0);
+    return std::hypot(p[0] - (a[0] + t * dx), p[1] - (a[1] + t * dy));
+}
+
+/// Which model each part belongs to, and which parts touch others.
+struct FreeSpaceModels {
+    std::vector<int> partModel;
+    std::vector<char> partTouches;  // touches or overlaps a part of another feature
+};
+
+/// Stages 3-5 on the triangulation in space.tri: inside/outside, models, voids, model pairs.
+void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
+                    FreeSpaceModels& models) {
+    const Triangulation2D& tri = space.tri;
+    const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
+
+    // 3. Inside / outside by winding count, flooding from the outside of the hull.
+    std::vector<int> winding(faceCount, INT32_MIN);
+    std::vector<std::tuple<size_t, int>> found;
+    std::deque<int> queue;
+    for (size_t f = 0; f < faceCount; ++f)
+        for (int j = 0; j < 3; ++j)
+            if (tri.neighbors[3 * f + j] < 0 && winding[f] == INT32_MIN) {
+                const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
+                winding[f] = tri.constrained[3 * f + j] ? -windingChange(in, tri, u, v, found) : 0;
+                queue.push_back(static_cast<int>(f));
+            }
+    // A constrained edge between two Steiner points a rounding error apart (crossings of
+    // nearly coincident rings) has no reliable direction: the flood does not cross it, and a
+    // face reached only that way is counted directly (rings around its centroid).
+    const double tiny = 1e-7 * in.gridCell;
+    // Likewise a sliver face (area a rounding error) between two copies of one constraint
+    // (coincident rings crossed by another ring give two nearly equal Steiner points): the
+    // flood neither enters nor leaves it, since each copy would count the rings again.
+    std::vector<char> sliver(faceCount, 0);
+    for (size_t f = 0; f < faceCount; ++f) {
+        const int* v = &tri.faces[3 * f];
+        auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
+        const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
+        double longest = 0;
+        for (int k = 0; k < 3; ++k)
+            longest = std::max(longest, std::hypot(P((k + 1) % 3)[0] - P(k)[0], P((k + 1) % 3)[1] - P(k)[1]));
+        sliver[f] = area2 <= 1e-12 * longest * longest;
+    }
+    auto unreliable = [&](int f, int j) {
+        const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
+        const int n = tri.neighbors[3 * f + j];
+        if (!tri.constrained[3 * f + j]) return false;
+        if (sliver[f] || (n >= 0 && sliver[n])) return true;
+        return tri.vertexInput[u] < 0 && tri.vertexInput[v] < 0 &&
+               std::hypot(tri.points[2 * v] - tri.points[2 * u], tri.points[2 * v + 1] - tri.points[2 * u + 1]) <= tiny;
+    };
+    while (!queue.empty()) {
+        const int f = queue.front();
+        queue.pop_front();
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || winding[n] != INT32_MIN || unreliable(f, j)) continue;
+            int w = winding[f];
+            if (tri.constrained[3 * f + j])
+                w += windingChange(in, tri, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3], found);
+            winding[n] = w;
+            queue.push_back(n);
+        }
+    }
+    for (size_t f = 0; f < faceCount; ++f) {
+        if (winding[f] != INT32_MIN) continue;
+        double cx = 0, cy = 0;
+        for (int k = 0; k < 3; ++k) {
+            cx += tri.points[2 * tri.faces[3 * f + k]] / 3;
+            cy += tri.points[2 * tri.faces[3 * f + k] + 1] / 3;
+        }
+        winding[f] = windingNumberAt(in, cx, cy);
+    }
+    // Part of each vertex and of each interior face.
+    std::vector<int> vertexPart(vertexCount, -1);
+    for (size_t v = 0; v < vertexCount; ++v)
+        if (tri.vertexInput[v] >= 0) vertexPart[v] = static_cast<int>(in.part[tri.vertexInput[v]]);
+    std::vector<int> facePart(faceCount, -1);
+    for (size_t f = 0; f < faceCount; ++f) {
+        if (winding[f] < 1) continue;
+        for (int k = 0; k < 3 && facePart[f] < 0; ++k) facePart[f] = vertexPart[tri.faces[3 * f + k]];
+    }
+    for (bool changed = true; changed;) {  // interior faces with only Steiner vertices
+        changed = false;
+        for (size_t f = 0; f < faceCount; ++f) {
+            if (winding[f] < 1 || facePart[f] >= 0) continue;
+            for (int j = 0; j < 3; ++j) {
+                const int n = tri.neighbors[3 * f + j];
+                if (n >= 0 && winding[n] >= 1 && facePart[n] >= 0) {
+                    facePart[f] = facePart[n];
+                    changed = true;
+                    break;
+                }
+            }
+        }
+    }
+
+    // 4. Models: parts of one feature, touching or overlapping parts, parts nested in others.
+    const uint32_t partCount = static_cast<uint32_t>(checked.parts.size());
+    std::vector<uint32_t> parent(partCount);
+    std::iota(parent.begin(), parent.end(), 0u);
+    for (uint32_t p = 1; p < partCount; ++p)
+        if (checked.partFeature[p] == checked.partFeature[p - 1]) unite(parent, p, p - 1);
+    std::vector<char>& partTouches = models.partTouches;
+    partTouches.assign(partCount, 0);
+    for (auto [a, b] : checked.touchingParts) {
+        if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
+        unite(parent, a, b);
+    }
+    for (size_t f = 0; f < faceCount; ++f)
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || facePart[f] < 0 || facePart[n] < 0 || facePart[f] == facePart[n]) continue;
+            const uint32_t a = facePart[f], b = facePart[n];
+            if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
+            unite(parent, a, b);
+        }
+    std::vector<int>& partModel = models.partModel;
+    std::vector<int> modelOfRoot(partCount, -1);
+    partModel.assign(partCount, -1);
+    for (uint32_t p = 0; p < partCount; ++p) {
+        const uint32_t r = findRoot(parent, p);
+        if (modelOfRoot[r] < 0) modelOfRoot[r] = static_cast<int>(space.modelCount++);
+        partModel[p] = modelOfRoot[r];
+    }
+    space.vertexModel.assign(vertexCount, -1);
+    for (size_t v = 0; v < vertexCount; ++v)
+        if (vertexPart[v] >= 0) space.vertexModel[v] = partModel[vertexPart[v]];
+    space.faceModel.assign(faceCount, -1);
+    for (size_t f = 0; f < faceCount; ++f)
+        if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;
+    space.modelPoints.resize(space.modelCount);
+    for (size_t v = 0; v < in.part.size(); ++v) {
+        auto& pts = space.modelPoints[partModel[in.part[v]]];
+        pts.push_back(in.x(v));
+        pts.push_back(in.y(v));
+    }
+
+    // Voids: free faces not reachable from the hull through free faces (input holes, or
+    // gaps enclosed by touching polygons) and owned by one model only: never filled.
+    space.faceVoid.assign(faceCount, 0);
+    {
+        std::vector<char> reached(faceCount, 0);
+        std::vector<int> stack;
+        for (size_t f = 0; f < faceCount; ++f)
+            if (space.faceModel[f] < 0)
+                for (int j = 0; j < 3; ++j)
+                    if (tri.neighbors[3 * f + j] < 0 && !reached[f]) {
+                        reached[f] = 1;
+                        stack.push_back(static_cast<int>(f));
+                    }
+        while (!stack.empty()) {
+            const int f = stack.back();
+            stack.pop_back();
+            for (int j = 0; j < 3; ++j) {
+                const int n = tri.neighbors[3 * f + j];
+                if (n >= 0 && !reached[n] && space.faceModel[n] < 0) {
+                    reached[n] = 1;
+                    stack.push_back(n);
+                }
+            }
+        }
+        for (size_t f = 0; f < faceCount; ++f) {
+            if (space.faceModel[f] >= 0 || reached[f]) continue;
+            int model = -1;
+            bool single = true;
+            for (int k = 0; k < 3; ++k) {
+                const int m = space.vertexModel[tri.faces[3 * f + k]];
+                if (m < 0) continue;
+                if (model < 0) model = m;
+                else if (m != model) single = false;
+            }
+            space.faceVoid[f] = single ? 1 : 0;
+        }
+    }
+
+    // 5. Neighbourhood graph: per model pair the free edges joining them; weight = the
+    // shortest connection seen in a free triangle (edge, or vertex to a model's boundary edge).
+    space.faceArea.resize(faceCount);
+    space.edgeLength.resize(3 * faceCount);
+    space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
+    struct PairEntry {
+        uint32_t a, b;
+        double length;   // free edge length, or -1 for a distance-only entry
+        double distance;
+        int face;
+        int connection[3];  // see ModelPair2D::connection
+        long long faceEdge; // 3 * face + edge for an edge entry, -1 for a distance-only entry
+    };
+    std::vector<PairEntry> entries;
+    auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
+    for (size_t f = 0; f < faceCount; ++f) {
+        const int* v = &tri.faces[3 * f];
+        space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
+                                   (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
+        for (int j = 0; j < 3; ++j) {
+            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+            space.edgeLength[3 * f + j] = std::hypot(P(w)[0] - P(u)[0], P(w)[1] - P(u)[1]);
+        }
+        if (space.faceModel[f] >= 0) continue;
+        for (int j = 0; j < 3; ++j) {
+            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+            const int mu = space.vertexModel[u], mw = space.vertexModel[w];
+            if (mu < 0 || mw < 0 || mu == mw) continue;
+            const int n = tri.neighbors[3 * f + j];
+            const uint32_t a = std::min(mu, mw), b = std::max(mu, mw);
+            const double len = space.edgeLength[3 * f + j];
+            // Count each undirected edge once (from its smaller free face, or its only one).
+            const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
+            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
+        }
+        // Vertex to the opposite edge when that edge is another model's boundary.
+        for (int k = 0; k < 3; ++k) {
+            const int j1 = (k + 1) % 3, j2 = (k + 2) % 3;
+            const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
+            if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
+            const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
+            entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
+                               static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
+        }
+    }
+    std::sort(entries.begin(), entries.end(), [](const PairEntry& x, const PairEntry& y) {
+        return std::tie(x.a, x.b, x.distance, x.face) < std::tie(y.a, y.b, y.distance, y.face);
+    });
+    for (size_t i = 0; i < entries.size();) {
+        size_t e = i;
+        ModelPair2D pair;
+        pair.a = entries[i].a;
+        pair.b = entries[i].b;
+        pair.minDistance = entries[i].distance;
+        pair.bestFace[0] = entries[i].face;
+        std::copy(entries[i].connection, entries[i].connection + 3, pair.connection);
+        for (; e < entries.size() && entries[e].a == pair.a && entries[e].b == pair.b; ++e) {
+            if (entries[e].length >= 0) pair.lengths.push_back(entries[e].length);
+            if (pair.bestFace[1] < 0 && entries[e].distance == pair.minDistance && entries[e].face != pair.bestFace[0])
+                pair.bestFace[1] = entries[e].face;
+        }
+        std::sort(pair.lengths.begin(), pair.lengths.end());
+        pair.prefixSum.assign(pair.lengths.size() + 1, 0);
+        pair.prefixSumSquares.assign(pair.lengths.size() + 1, 0);
+        for (size_t k = 0; k < pair.lengths.size(); ++k) {
+            pair.prefixSum[k + 1] = pair.prefixSum[k] + pair.lengths[k];
+            pair.prefixSumSquares[k + 1] = pair.prefixSumSquares[k] + pair.lengths[k] * pair.lengths[k];
+        }
+        for (size_t k = i; k < e; ++k)
+            if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
+        space.pairs.push_back(std::move(pair));
+        i = e;
+    }
+    for (size_t f = 0; f < faceCount; ++f)
+        for (int j = 0; j < 3; ++j) {
+            const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
+            if (space.vertexModel[u] < 0 || space.vertexModel[w] < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
+        }
+}
+
+std::vector<GraphEdge> graphEdges(const FreeSpace2D& space) {
+    std::vector<GraphEdge> graph;
+    graph.reserve(space.pairs.size());
+    for (const ModelPair2D& p : space.pairs) graph.push_back(GraphEdge{p.a, p.b, p.minDistance});
+    return graph;
+}
+
+/// Input vertices of the checked polygons; splits[s] lists parameters in (0, 1) at which the
+/// ring segment starting at original vertex s gets an extra (collinear) vertex.
+InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<std::vector<double>>& splits) {
+    InputVertices in;
+    size_t original = 0;
+    for (uint32_t p = 0; p < checked.parts.size(); ++p) {
+        const Polygon2D& poly = checked.parts[p];
+        for (int h = -1; h < static_cast<int>(poly.holes.size()); ++h) {
+            const std::vector<double>& ring = h < 0 ? poly.exterior : poly.holes[h];
+            const uint32_t start = static_cast<uint32_t>(in.part.size()), n = static_cast<uint32_t>(ring.size() / 2);
+            for (uint32_t i = 0; i < n; ++i, ++original) {
+                const uint32_t j = (i + 1) % n;
+                in.points.push_back(ring[2 * i]);
+                in.points.push_back(ring[2 * i + 1]);
+                in.part.push_back(p);
+                if (original < splits.size())
+                    for (double t : splits[original]) {
+                        in.points.push_back(ring[2 * i] + t * (ring[2 * j] - ring[2 * i]));
+                        in.points.push_back(ring[2 * i + 1] + t * (ring[2 * j + 1] - ring[2 * i + 1]));
+                        in.part.push_back(p);
+                    }
+            }
+            const uint32_t size = static_cast<uint32_t>(in.part.size()) - start;
+            for (uint32_t i = 0; i < size; ++i) {
+                in.ringStart.push_back(start);
+                in.ringSize.push_back(size);
+                in.segments.emplace_back(start + i, start + (i + 1) % size);
+            }
+        }
+    }
+    in.sorted.resize(in.part.size());
+    std::iota(in.sorted.begin(), in.sorted.end(), size_t{0});
+    std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
+        return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
+    });
+    in.shared.assign(in.part.size(), 0);
+    for (size_t k = 1; k < in.sorted.size(); ++k) {
+        const size_t a = in.sorted[k - 1], b = in.sorted[k];
+        if (in.x(a) == in.x(b) && in.y(a) == in.y(b)) in.shared[a] = in.shared[b] = 1;
+    }
+    in.partTouches.assign(checked.parts.size(), 0);
+    for (auto [a, b] : checked.touchingParts) in.partTouches[a] = in.partTouches[b] = 1;
+    buildSegmentGrid(in);
+    return in;
+}
+
+/// Steiner points for the shortest connection of every merge (DESIGN 2.4 step 4): where a
+/// connection ends at a vertex, its boundary edges longer than 3 d get a point at distance d
+/// (d = the connection's length); where it ends inside an edge, the edge gets the foot point
+/// and points d to either side. Returns, per original input vertex, the split parameters of
+/// the segment it starts (ascending). Only called on the unsplit input.
+std::vector<std::vector<double>> connectionSplits(const InputVertices& in, const FreeSpace2D& space,
+                                                  const std::vector<Merge>& merges) {
+    std::vector<std::vector<double>> splits(in.part.size());
+    const Triangulation2D& tri = space.tri;
+    auto addAt = [&](size_t segmentStart, double t) { splits[segmentStart].push_back(t); };
+    auto segmentLength = [&](size_t s) { return std::hypot(in.x(in.next(s)) - in.x(s), in.y(in.next(s)) - in.y(s)); };
+    // Split both boundary edges at vertex v (input vertex) at distance d from it.
+    auto splitAroundVertex = [&](size_t v, double d) {
+        const size_t prev = in.prev(v);
+        const double lOut = segmentLength(v), lIn = segmentLength(prev);
+        if (lOut > 3 * d) addAt(v, d / lOut);
+        if (lIn > 3 * d) addAt(prev, 1 - d / lIn);
+    };
+    for (const Merge& m : merges) {
+        const int pi = space.pairIndex(m.modelA, m.modelB);
+        if (pi < 0) continue;
+        const ModelPair2D& pair = space.pairs[pi];
+        const double d = pair.minDistance;
+        if (!(d > 0)) continue;
+        const int* c = pair.connection;
+        const int iv0 = tri.vertexInput[c[0]];
+        if (iv0 < 0) continue;
+        splitAroundVertex(static_cast<size_t>(iv0), d);
+        if (c[2] < 0) {  // vertex to vertex
+            const int iv1 = tri.vertexInput[c[1]];
+            if (iv1 >= 0) splitAroundVertex(static_cast<size_t>(iv1), d);
+            continue;
+        }
+        // Vertex to the edge (c[1], c[2]): find the input segment holding it.
+        const int e0 = tri.vertexInput[c[1]], e1 = tri.vertexInput[c[2]];
+        if (e0 < 0 || e1 < 0) continue;
+        size_t s;
+        if (in.next(static_cast<size_t>(e0)) == static_cast<size_t>(e1)) s = static_cast<size_t>(e0);
+        else if (in.next(static_cast<size_t>(e1)) == static_cast<size_t>(e0)) s = static_cast<size_t>(e1);
+        else continue;  // a part of a longer segment: leave it
+        const size_t e = in.next(s);
+        const double dx = in.x(e) - in.x(s), dy = in.y(e) - in.y(s);
+        const double len = std::hypot(dx, dy);
+        const double t = ((in.x(iv0) - in.x(s)) * dx + (in.y(iv0) - in.y(s)) * dy) / (len * len);
+        const double margin = 0.5 * d / len;
+        for (double u : {t - d / len, t, t + d / len})
+            if (u > margin && u < 1 - margin) addAt(s, u);
+    }
+    for (auto& list : splits) {
+        std::sort(list.begin(), list.end());
+        // Drop near-duplicates (two connections at one place).
+        std::vector<double> kept;
+        for (double t : list)
+            if (kept.empty() || t - kept.back() > 1e-6) kept.push_back(t);
+        list = std::move(kept);
+    }
+    return splits;
+}
+
+}  // namespace
+
+bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& settings, Hierarchy2D& out) {
+    out = Hierarchy2D{};
+    out.featureModel.assign(features.size(), -1);
+    auto progress = [&](const char* stage, double fraction) {
+        if (settings.progress) settings.progress(stage, fraction);
+    };
+    auto stageStart = Clock::now();
+    auto endStage = [&](const char* name) {
+        const auto now = Clock::now();
+        out.timings.emplace_back(name, std::chrono::duration<double>(now - stageStart).count());
+        stageStart = now;
+    };
+    auto fail = [&](const std::string& message) {
+        out.diagnostics.push_back({Diagnostic::Severity::Error, "", message});
+        return false;
+    };
+    for (double d : settings.deltas)
+        if (!std::isfinite(d) || d < 0) return fail("every threshold delta must be a finite number >= 0");
+
+    // 1. Input checks.
+    progress("checking input", 0);
+    CheckedPolygons checked;
+    checkPolygons(features, checked, out.diagnostics);
+    if (checked.parts.empty()) return fail("no usable polygon in the input");
+    for (const Polygon2D& poly : checked.parts) {
+        out.originals.area += ringSignedArea(poly.exterior);
+        out.originals.perimeter += ringLength(poly.exterior);
+        for (const auto& hole : poly.holes) {
+            out.originals.area += ringSignedArea(hole);
+            out.originals.perimeter += ringLength(hole);
+        }
+    }
+    out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
+    InputVertices in = inputVertices(checked, {});
+    endStage("check input");
+
+    // 2.-5. Triangulation, free space, models and graph; then once more with Steiner points
+    // on long boundary edges at the shortest connections of the dendrogram (DESIGN 2.4
+    // step 4), so that joined models get a narrow bridge of small triangles.
+    progress("triangulating", 0);
+    FreeSpace2D space;
+    FreeSpaceModels models;
+    std::string error;
+    ConstrainedTriangulation2D triangulation;
+    if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    endStage("triangulate");
+    buildFreeSpace(in, checked, space, models);
+    // Unconstrained edges of free triangles (hull edges included), before Steiner points:
+    // the edges GEOS's ConcaveHullOfPolygons takes for its length ratio.
+    out.freeEdgeMin = INFINITY;
+    for (size_t f = 0; f < space.tri.faceCount(); ++f)
+        for (int j = 0; j < 3; ++j) {
+            if (space.faceModel[f] >= 0 || space.tri.constrained[3 * f + j]) continue;
+            out.freeEdgeMin = std::min(out.freeEdgeMin, space.edgeLength[3 * f + j]);
+            out.freeEdgeMax = std::max(out.freeEdgeMax, space.edgeLength[3 * f + j]);
+        }
+    if (!std::isfinite(out.freeEdgeMin)) out.freeEdgeMin = 0;
+    out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+    endStage("free space and graph");
+    std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
+    std::vector<ConstraintSplit> requests;
+    std::vector<size_t> requestSegment;
+    for (size_t v = 0; v < splits.size(); ++v) {
+        if (splits[v].empty()) continue;
+        ConstraintSplit r;
+        r.from = v;
+        r.to = in.next(v);
+        for (double t : splits[v]) {  // the same arithmetic as inputVertices()
+            r.points.push_back(in.x(v) + t * (in.x(r.to) - in.x(v)));
+            r.points.push_back(in.y(v) + t * (in.y(r.to) - in.y(v)));
+        }
+        requests.push_back(std::move(r));
+        requestSegment.push_back(v);
+    }
+    if (!requests.empty()) {
+        // The new vertices go into the live triangulation with their constraints split
+        // exactly; segments that cannot be split that way keep no new vertex.
+        const std::vector<double> allPoints = inputVertices(checked, splits).points;
+        std::vector<char> applied;
+        space = FreeSpace2D{};
+        if (!triangulation.splitConstraints(requests, applied, allPoints, space.tri, error)) return fail(error);
+        bool allApplied = true;
+        for (size_t k = 0; k < requests.size(); ++k)
+            if (!applied[k]) {
+                splits[requestSegment[k]].clear();
+                allApplied = false;
+            }
+        in = inputVertices(checked, splits);
+        if (!allApplied) {
+            // Numbering must follow the final input points: export again without the skipped ones.
+            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error)) return fail(error);
+        }
+        endStage("triangulate with Steiner points");
+        buildFreeSpace(in, checked, space, models);
+        out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+        endStage("free space and graph again");
+    }
+    out.vertexCount = space.tri.vertexCount();
+    out.triangleCount = space.tri.faceCount();
+    out.modelCount = space.modelCount;
+    for (uint32_t p = 0; p < checked.parts.size(); ++p) out.featureModel[checked.partFeature[p]] = models.partModel[p];
+    {
+        std::vector<std::vector<uint32_t>> modelFeatures(space.modelCount);
+        std::vector<char> modelTouches(space.modelCount, 0);
+        for (uint32_t p = 0; p < checked.parts.size(); ++p) {
+            auto& list = modelFeatures[models.partModel[p]];
+            if (list.empty() || list.back() != checked.partFeature[p]) list.push_back(checked.partFeature[p]);
+            if (models.partTouches[p]) modelTouches[models.partModel[p]] = 1;
+        }
+        for (size_t m = 0; m < space.modelCount; ++m)
+            if (modelTouches[m] && modelFeatures[m].size() > 1)
+                out.diagnostics.push_back({Diagnostic::Severity::Note, joinNames(features, modelFeatures[m]),
+                                           "these " + std::to_string(modelFeatures[m].size()) +
+                                               " features touch or overlap; merged into one model"});
+    }
+    endStage("models");
+
+    // 6. Levels.
+    std::vector<double> deltas = settings.deltas;
+    std::sort(deltas.begin(), deltas.end());
+    deltas.erase(std::unique(deltas.begin(), deltas.end()), deltas.end());
+    if (deltas.empty()) deltas = automaticDeltas(out.merges, settings.automaticLevelCount);
+    if (deltas.empty()) deltas.push_back(0);  // a single model: one level, the originals
+    const AggregateFunction primary = settings.customFunction ? settings.customFunction
+                                                              : makeAggregateFunction(settings.function);
+    const AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
+    const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
+    std::vector<int> mergePair;  // per merge: its index in space.pairs
+    for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
+    // F of every pair at every level, on the calling thread (a custom function is user code).
+    const size_t levelCount = deltas.size();
+    std::vector<EdgeLimits2D> primaryLimits(levelCount), constantLimits(levelCount), adaptiveLimits(levelCount);
+    for (size_t li = 0; li < levelCount; ++li) {
+        if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
+        if (settings.computeBaselines) {
+            constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
+            adaptiveLimits[li] = computeEdgeLimits2D(space, deltas[li], adaptive);
+        }
+    }
+    // Levels are independent: sculpted in parallel, each writing only its own slot.
+    out.levels.resize(levelCount);
+    auto buildLevel = [&](size_t li) {
+        Level2D& level = out.levels[li];
+        std::vector<int> label;
+        level.delta = deltas[li];
+        size_t groupCount = 0;
+        const std::vector<uint32_t> modelGroup = groupsAtThreshold(space.modelCount, out.merges, level.delta, &groupCount);
+        std::vector<int> joined;
+        for (size_t k = 0; k < out.merges.size() && out.merges[k].height < level.delta; ++k)
+            joined.push_back(mergePair[k]);
+        level.aggregates.resize(groupCount);
+        // Sources and hulls of every group.
+        for (size_t f = 0; f < features.size(); ++f)
+            if (out.featureModel[f] >= 0)
+                level.aggregates[modelGroup[out.featureModel[f]]].sourceFeatures.push_back(static_cast<uint32_t>(f));
+        std::vector<std::vector<double>> hulls;
+        if (settings.computeBaselines || settings.shape == Shape2D::ConvexHull) {
+            std::vector<std::vector<double>> groupPoints(groupCount);
+            for (size_t m = 0; m < space.modelCount; ++m) {
+                auto& gp = groupPoints[modelGroup[m]];
+                gp.insert(gp.end(), space.modelPoints[m].begin(), space.modelPoints[m].end());
+            }
+            hulls.resize(groupCount);
+            for (size_t g = 0; g < groupCount; ++g) {
+                hulls[g] = convexHull2D(std::move(groupPoints[g]));
+                level.hull.area += ringSignedArea(hulls[g]);
+                level.hull.perimeter += ringLength(hulls[g]);
+            }
+            level.hull.circularity = circularity(level.hull.area, level.hull.perimeter);
+        }
+        if (settings.shape == Shape2D::ConvexHull) {
+            for (size_t g = 0; g < groupCount; ++g) {
+                Aggregate2D& agg = level.aggregates[g];
+                agg.polygons.push_back(Polygon2D{hulls[g], {}});
+                agg.measures.area = ringSignedArea(hulls[g]);
+                agg.measures.perimeter = ringLength(hulls[g]);
+                agg.measures.circularity = circularity(agg.measures.area, agg.measures.perimeter);
+            }
+        } else {
+            sculptLevel2D(space, modelGroup, primaryLimits[li], joined, label);
+            extractPolygons2D(space, label, groupCount, level.aggregates);
+        }
+        for (const Aggregate2D& agg : level.aggregates) {
+            level.measures.area += agg.measures.area;
+            level.measures.perimeter += agg.measures.perimeter;
+        }
+        level.measures.circularity = circularity(level.measures.area, level.measures.perimeter);
+        if (settings.computeBaselines) {
+            sculptLevel2D(space, modelGroup, constantLimits[li], joined, label);
+            level.constant = measureLabels2D(space, label);
+            sculptLevel2D(space, modelGroup, adaptiveLimits[li], joined, label);
+            level.adaptive = measureLabels2D(space, label);
+        }
+    };
+    progress("sculpting levels", 0);
+    parallelFor(levelCount, settings.threadCount, buildLevel, [&](size_t done) {
+        progress("sculpting levels", static_cast<double>(done) / static_cast<double>(levelCount));
+    });
+    progress("sculpting levels", 1);
+    endStage("sculpt levels");
+    return true;
+}
+
+}  // namespace aggrelod

@@ -1,0 +1,30 @@
+// Input checks for 2D polygons (DESIGN 2.1 input rules): finite coordinates, rings of at
+// least 3 distinct vertices with non-zero area, no self-intersecting ring, no crossing rings
+// within a polygon; and which polygons touch or overlap each other (merged into one model).
+#pragma once
+
+#include <aggrelod/aggregate2d.h>
+
+#include <utility>
+#include <vector>
+
+namespace aggrelod::detail {
+
+struct CheckedPolygons {
+    std::vector<Polygon2D> parts;            ///< accepted polygons, repeated vertices removed, exterior CCW, holes CW
+    std::vector<uint32_t> partFeature;       ///< per part: index of its feature
+    std::vector<std::pair<uint32_t, uint32_t>> touchingParts;  ///< part pairs (a < b) whose boundaries meet
+    std::vector<char> featureAccepted;       ///< per feature
+};
+
+/// Checks every feature; a feature with any bad ring is rejected as a whole (Error diagnostic
+/// naming the feature, polygon, ring and place). Deterministic.
+void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
+                   std::vector<Diagnostic>& diagnostics);
+
+/// Signed area of an open ring (2 * n doubles), positive when counter-clockwise.
+double ringSignedArea(const std::vector<double>& ring);
+/// Length of a closed ring.
+double ringLength(const std::vector<double>& ring);
+
+}  // namespace aggrelod::detail

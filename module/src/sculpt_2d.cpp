@@ -1,0 +1,424 @@
+// Sculpting in 2D (DESIGN 2.4; paper Section 3.3 "Aggregated Approximation") and the
+// extraction of polygons with holes from the kept triangles.
+//
+// Step 1: a free triangle takes the single group of its owned vertices; triangles of two or
+// more groups, of none, and input holes (faceVoid) are removed.
+// Step 2: a kept free triangle with an exposed edge (on the hull or facing a triangle outside
+// its group) is removed when such an edge is longer than F(m1, m2). Removal is monotone, so
+// a stack gives the same result as any order (linear time).
+// Step 4: for every pair joined at this level, the triangle holding their shortest connection
+// and a fan of triangles to an edge of each model are never removed, so joined models come
+// out as one polygon (edge-connected) where the fan's faces are no longer than delta;
+// otherwise they touch at a point and come out as two polygons of one MultiPolygon.
+#include "sculpt_2d.h"
+
+#include "polygon_check_2d.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace aggrelod::detail {
+namespace {
+
+uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+}
+
+}  // namespace
+
+int FreeSpace2D::pairIndex(uint32_t a, uint32_t b) const {
+    if (a > b) std::swap(a, b);
+    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(a, b),
+                               [](const ModelPair2D& p, const std::pair<uint32_t, uint32_t>& k) {
+                                   return p.a < k.first || (p.a == k.first && p.b < k.second);
+                               });
+    if (it == pairs.end() || it->a != a || it->b != b) return -1;
+    return static_cast<int>(it - pairs.begin());
+}
+
+EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function) {
+    EdgeLimits2D limits;
+    AggregateFunctionInput same;
+    same.delta = delta;
+    same.sameModel = true;
+    limits.sameModel = function(same);
+    limits.unpaired = limits.sameModel;
+    limits.delta = delta;
+    limits.pair.resize(space.pairs.size());
+    for (size_t p = 0; p < space.pairs.size(); ++p) {
+        const ModelPair2D& pair = space.pairs[p];
+        AggregateFunctionInput in;
+        in.delta = delta;
+        in.minDistance = pair.minDistance;
+        // sigma over the joining edges shorter than delta (see aggregate_function.cpp).
+        const size_t k = static_cast<size_t>(std::lower_bound(pair.lengths.begin(), pair.lengths.end(), delta) -
+                                             pair.lengths.begin());
+        auto stats = [&](size_t count, double& mean, double& sigma) {
+            if (count == 0) { mean = sigma = 0; return; }
+            mean = pair.prefixSum[count] / static_cast<double>(count);
+            sigma = std::sqrt(std::max(0.0, pair.prefixSumSquares[count] / static_cast<double>(count) - mean * mean));
+        };
+        double meanAll = 0;
+        stats(k, in.meanEdgeLength, in.sigma);
+        stats(pair.lengths.size(), meanAll, in.sigmaAllEdges);
+        limits.pair[p] = function(in);
+    }
+    return limits;
+}
+
+namespace {
+
+struct Sculptor2D {
+    const FreeSpace2D& space;
+    const std::vector<uint32_t>& modelGroup;
+    const EdgeLimits2D& limits;
+    std::vector<int>& label;
+    std::vector<char> isProtected;
+
+    const Triangulation2D& tri() const { return space.tri; }
+    int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>(modelGroup[m]); }
+
+    void initialLabels() {
+        const size_t faceCount = tri().faceCount();
+        label.assign(faceCount, -1);
+        isProtected.assign(faceCount, 0);
+        for (size_t f = 0; f < faceCount; ++f) {
+            if (space.faceModel[f] >= 0) {
+                label[f] = groupOfModel(space.faceModel[f]);
+                continue;
+            }
+            if (space.faceVoid[f]) continue;
+            int group = -1;
+            bool mixed = false;
+            for (int k = 0; k < 3; ++k) {
+                const int g = groupOfModel(space.vertexModel[tri().faces[3 * f + k]]);
+                if (g < 0) continue;
+                if (group < 0) group = g;
+                else if (g != group) mixed = true;
+            }
+            label[f] = mixed ? -1 : group;
+        }
+    }
+
+    bool isKeptFree(int f, int group) const { return f >= 0 && space.faceModel[f] < 0 && label[f] == group; }
+
+    double limitOf(int pairIndex) const {
+        if (pairIndex >= 0) return limits.pair[pairIndex];
+        return pairIndex == kSameModelEdge2D ? limits.sameModel : limits.unpaired;
+    }
+
+    // A fan of kept free faces around a vertex of `model`, from face f to a face sharing an
+    // edge with the model's interior; protects the smallest one found.
+    void protectFanTo(int f, int model, int group) {
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri().neighbors[3 * f + j];
+            if (n >= 0 && space.faceModel[n] == model) return;  // already shares an edge
+        }
+        // The fan of least total area: the one hugging the corner, not a sliver along a side.
+        std::vector<int> best, path;
+        bool found = false;
+        double bestArea = INFINITY;
+        for (int k = 0; k < 3; ++k) {
+            const int v = tri().faces[3 * f + k];
+            if (space.vertexModel[v] != model) continue;
+            for (int side = 1; side <= 2; ++side) {
+                path.clear();
+                int cur = f;
+                for (int steps = 0; steps < 256; ++steps) {
+                    int kv = 0;
+                    while (tri().faces[3 * cur + kv] != v) ++kv;
+                    const int n = tri().neighbors[3 * cur + (kv + side) % 3];
+                    if (n < 0) break;
+                    if (space.faceModel[n] == model) {
+                        double area = 0;
+                        for (int p : path) area += space.faceArea[p];
+                        if (!found || area < bestArea) {
+                            best = path;
+                            bestArea = area;
+                        }
+                        found = true;
+                        break;
+                    }
+                    if (!isKeptFree(n, group) || n == f) break;
+                    // Only small faces: a fan through a sliver spanning the gap would fill far
+                    // more than the connection (the models then touch at a point instead).
+                    double longest = 0;
+                    for (int e = 0; e < 3; ++e) longest = std::max(longest, space.edgeLength[3 * static_cast<size_t>(n) + e]);
+                    if (longest > limits.delta) break;
+                    path.push_back(n);
+                    cur = n;
+                }
+            }
+        }
+        for (int p : best) isProtected[p] = 1;
+    }
+
+    void protectConnection(int pairIndex) {
+        const ModelPair2D& pair = space.pairs[pairIndex];
+        const int group = groupOfModel(static_cast<int>(pair.a));
+        if (group < 0 || group != groupOfModel(static_cast<int>(pair.b))) return;
+        for (int f : pair.bestFace) {
+            if (!isKeptFree(f, group)) continue;
+            isProtected[f] = 1;
+            protectFanTo(f, static_cast<int>(pair.a), group);
+            protectFanTo(f, static_cast<int>(pair.b), group);
+            return;
+        }
+    }
+
+    // True when face f (kept) has an exposed edge longer than its limit.
+    bool mustCarve(int f) const {
+        const int group = label[f];
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri().neighbors[3 * f + j];
+            if (n >= 0 && label[n] == group) continue;
+            const size_t e = 3 * static_cast<size_t>(f) + j;
+            if (space.edgeLength[e] > limitOf(space.edgePair[e])) return true;
+        }
+        return false;
+    }
+
+    void carve() {
+        const size_t faceCount = tri().faceCount();
+        std::vector<int> stack;
+        for (size_t f = 0; f < faceCount; ++f)
+            if (space.faceModel[f] < 0 && label[f] >= 0) stack.push_back(static_cast<int>(f));
+        while (!stack.empty()) {
+            const int f = stack.back();
+            stack.pop_back();
+            if (label[f] < 0 || isProtected[f] || !mustCarve(f)) continue;
+            const int group = label[f];
+            label[f] = -1;
+            for (int j = 0; j < 3; ++j) {
+                const int n = tri().neighbors[3 * f + j];
+                if (isKeptFree(n, group)) stack.push_back(n);
+            }
+        }
+    }
+};
+
+struct HalfEdge {
+    int group, from, to, face;
+};
+
+}  // namespace
+
+void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
+                   const std::vector<int>& joinedPairs, std::vector<int>& faceLabel) {
+    Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
+    s.initialLabels();
+    for (int p : joinedPairs)
+        if (p >= 0) s.protectConnection(p);
+    s.carve();
+}
+
+Measures2D measureLabels2D(const FreeSpace2D& space, const std::vector<int>& faceLabel) {
+    Measures2D m;
+    const Triangulation2D& tri = space.tri;
+    for (size_t f = 0; f < tri.faceCount(); ++f) {
+        if (faceLabel[f] < 0) continue;
+        m.area += space.faceArea[f];
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || faceLabel[n] != faceLabel[f]) m.perimeter += space.edgeLength[3 * f + j];
+        }
+    }
+    m.circularity = circularity(m.area, m.perimeter);
+    return m;
+}
+
+void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLabel, size_t groupCount,
+                       std::vector<Aggregate2D>& aggregates) {
+    const Triangulation2D& tri = space.tri;
+    const size_t faceCount = tri.faceCount();
+    aggregates.resize(groupCount);
+    // Boundary half-edges, the kept face on their left.
+    std::vector<HalfEdge> edges;
+    for (size_t f = 0; f < faceCount; ++f) {
+        const int g = faceLabel[f];
+        if (g < 0) continue;
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n >= 0 && faceLabel[n] == g) continue;
+            edges.push_back({g, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3], static_cast<int>(f)});
+        }
+    }
+    std::sort(edges.begin(), edges.end(), [](const HalfEdge& a, const HalfEdge& b) {
+        if (a.group != b.group) return a.group < b.group;
+        if (a.from != b.from) return a.from < b.from;
+        return a.to < b.to;
+    });
+    // Face components (edge-connected kept faces of one group): holes join the exterior of theirs.
+    std::vector<uint32_t> parent(faceCount);
+    std::iota(parent.begin(), parent.end(), 0u);
+    for (size_t f = 0; f < faceCount; ++f) {
+        if (faceLabel[f] < 0) continue;
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || faceLabel[n] != faceLabel[f]) continue;
+            uint32_t a = findRoot(parent, static_cast<uint32_t>(f)), b = findRoot(parent, static_cast<uint32_t>(n));
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    }
+    auto px = [&](int v) { return tri.points[2 * static_cast<size_t>(v)]; };
+    auto py = [&](int v) { return tri.points[2 * static_cast<size_t>(v) + 1]; };
+    std::vector<char> used(edges.size(), 0);
+    struct Loop {
+        std::vector<double> ring;
+        double area;
+        uint32_t component;
+    };
+    std::vector<Loop> loops;
+    size_t groupBegin = 0;
+    std::vector<size_t> trace, stack;
+    std::unordered_map<int, size_t> stackPos;  // lookup only, never iterated
+    while (groupBegin < edges.size()) {
+        const int g = edges[groupBegin].group;
+        size_t groupEnd = groupBegin;
+        while (groupEnd < edges.size() && edges[groupEnd].group == g) ++groupEnd;
+        loops.clear();
+        auto outgoing = [&](int v) {
+            auto lo = std::lower_bound(edges.begin() + groupBegin, edges.begin() + groupEnd, v,
+                                       [](const HalfEdge& e, int x) { return e.from < x; });
+            auto hi = lo;
+            while (hi != edges.begin() + groupEnd && hi->from == v) ++hi;
+            return std::make_pair(static_cast<size_t>(lo - edges.begin()), static_cast<size_t>(hi - edges.begin()));
+        };
+        for (size_t start = groupBegin; start < groupEnd; ++start) {
+            if (used[start]) continue;
+            // Trace: at each vertex take the first outgoing edge clockwise from the way back.
+            trace.clear();
+            size_t cur = start;
+            for (size_t guard = 0; guard <= groupEnd - groupBegin; ++guard) {
+                used[cur] = 1;
+                trace.push_back(cur);
+                const HalfEdge& e = edges[cur];
+                auto [lo, hi] = outgoing(e.to);
+                const double backAngle = std::atan2(py(e.from) - py(e.to), px(e.from) - px(e.to));
+                size_t next = SIZE_MAX;
+                double bestTurn = INFINITY;
+                for (size_t c = lo; c < hi; ++c) {
+                    if (used[c] && c != start) continue;
+                    const double a = std::atan2(py(edges[c].to) - py(e.to), px(edges[c].to) - px(e.to));
+                    double turn = backAngle - a;  // clockwise angle from the way back
+                    while (turn <= 0) turn += 2 * M_PI;
+                    while (turn > 2 * M_PI) turn -= 2 * M_PI;
+                    if (turn < bestTurn) {
+                        bestTurn = turn;
+                        next = c;
+                    }
+                }
+                if (next == SIZE_MAX || next == start) break;
+                cur = next;
+            }
+            // Split at repeated vertices so every ring is simple.
+            stack.clear();
+            stackPos.clear();
+            auto emit = [&](size_t fromIndex) {
+                Loop loop;
+                for (size_t i = fromIndex; i < stack.size(); ++i) {
+                    loop.ring.push_back(px(edges[stack[i]].from));
+                    loop.ring.push_back(py(edges[stack[i]].from));
+                }
+                loop.area = ringSignedArea(loop.ring);
+                loop.component = findRoot(parent, static_cast<uint32_t>(edges[stack[fromIndex]].face));
+                for (size_t i = fromIndex; i < stack.size(); ++i) stackPos.erase(edges[stack[i]].from);
+                stack.resize(fromIndex);
+                if (loop.ring.size() >= 6 && loop.area != 0) loops.push_back(std::move(loop));
+            };
+            for (size_t h : trace) {
+                auto it = stackPos.find(edges[h].from);
+                if (it != stackPos.end()) emit(it->second);
+                stackPos[edges[h].from] = stack.size();
+                stack.push_back(h);
+            }
+            if (!stack.empty()) emit(0);
+        }
+        // Exteriors (counter-clockwise) and holes (clockwise), holes to the exterior of their component.
+        Aggregate2D& agg = aggregates[g];
+        std::vector<size_t> exteriorOfLoop(loops.size(), SIZE_MAX);
+        std::vector<uint32_t> polygonComponent;
+        for (size_t i = 0; i < loops.size(); ++i) {
+            if (loops[i].area <= 0) continue;
+            exteriorOfLoop[i] = agg.polygons.size();
+            agg.polygons.push_back(Polygon2D{loops[i].ring, {}});
+            polygonComponent.push_back(loops[i].component);
+        }
+        for (size_t i = 0; i < loops.size(); ++i) {
+            if (loops[i].area > 0) continue;
+            size_t best = SIZE_MAX;
+            double bestArea = INFINITY;
+            const double mx = 0.5 * (loops[i].ring[0] + loops[i].ring[2]);
+            const double my = 0.5 * (loops[i].ring[1] + loops[i].ring[3]);
+            for (size_t p = 0; p < agg.polygons.size(); ++p) {
+                if (polygonComponent[p] != loops[i].component) continue;
+                const std::vector<double>& ring = agg.polygons[p].exterior;
+                const double a = ringSignedArea(ring);
+                if (a >= bestArea) continue;
+                // Point in ring (the hole edge midpoint is never on another ring's edge).
+                bool inside = false;
+                const size_t n = ring.size() / 2;
+                for (size_t s = 0, t = n - 1; s < n; t = s++) {
+                    const double xi = ring[2 * s], yi = ring[2 * s + 1], xj = ring[2 * t], yj = ring[2 * t + 1];
+                    if ((yi > my) != (yj > my) && mx < (xj - xi) * (my - yi) / (yj - yi) + xi) inside = !inside;
+                }
+                if (inside) {
+                    best = p;
+                    bestArea = a;
+                }
+            }
+            if (best != SIZE_MAX) agg.polygons[best].holes.push_back(std::move(loops[i].ring));
+        }
+        groupBegin = groupEnd;
+    }
+    for (Aggregate2D& agg : aggregates) {
+        Measures2D m;
+        for (const Polygon2D& p : agg.polygons) {
+            m.area += ringSignedArea(p.exterior);
+            m.perimeter += ringLength(p.exterior);
+            for (const auto& h : p.holes) {
+                m.area += ringSignedArea(h);
+                m.perimeter += ringLength(h);
+            }
+        }
+        m.circularity = circularity(m.area, m.perimeter);
+        agg.measures = m;
+    }
+}
+
+std::vector<double> convexHull2D(std::vector<double> points) {
+    const size_t n = points.size() / 2;
+    std::vector<std::pair<double, double>> p(n);
+    for (size_t i = 0; i < n; ++i) p[i] = {points[2 * i], points[2 * i + 1]};
+    std::sort(p.begin(), p.end());
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+    if (p.size() < 3) {
+        std::vector<double> out;
+        for (auto& q : p) { out.push_back(q.first); out.push_back(q.second); }
+        return out;
+    }
+    auto cross = [](const std::pair<double, double>& o, const std::pair<double, double>& a,
+                    const std::pair<double, double>& b) {
+        return (a.first - o.first) * (b.second - o.second) - (a.second - o.second) * (b.first - o.first);
+    };
+    std::vector<std::pair<double, double>> h(2 * p.size());
+    size_t k = 0;
+    for (size_t i = 0; i < p.size(); ++i) {
+        while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+        while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    h.resize(k - 1);
+    std::vector<double> out;
+    out.reserve(2 * h.size());
+    for (auto& q : h) { out.push_back(q.first); out.push_back(q.second); }
+    return out;
+}
+
+}  // namespace aggrelod::detail
