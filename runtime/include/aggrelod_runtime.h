@@ -66,6 +66,12 @@ uint32_t aglod_node_level(const aglod_file* file, uint32_t node);
 float aglod_node_error(const aglod_file* file, uint32_t node);
 /* Axis-aligned box of a node, world units; 0 when out of range, 1 otherwise. */
 int aglod_node_bounds(const aglod_file* file, uint32_t node, float min[3], float max[3]);
+/* Mesh of a node, as views into the file (valid until aglod_close): positions are 3 floats per
+ * vertex in world units (vertex_count vertices), indices 3 per triangle (index_count
+ * indices) relative to this node's first vertex. Proxies for inner nodes, the original
+ * meshes for leaves. 0 when out of range (outputs then empty), 1 otherwise. */
+int aglod_node_mesh(const aglod_file* file, uint32_t node, const float** positions, uint32_t* vertex_count,
+                    const uint32_t** indices, uint32_t* index_count);
 /* Box of the whole scene (union of the roots' boxes), world units. 0 when file is NULL. */
 int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]);
 /* Name of an original object, NUL-terminated copy into buffer (capacity bytes); returns the

@@ -105,6 +105,22 @@ int aglod_node_bounds(const aglod_file* file, uint32_t node, float min[3], float
     return 1;
 }
 
+int aglod_node_mesh(const aglod_file* file, uint32_t node, const float** positions, uint32_t* vertex_count,
+                    const uint32_t** indices, uint32_t* index_count) {
+    if (positions) *positions = nullptr;
+    if (vertex_count) *vertex_count = 0;
+    if (indices) *indices = nullptr;
+    if (index_count) *index_count = 0;
+    if (!file || node >= file->file.nodeCount()) return 0;
+    const aggrelod::runtime::Span<float> v = file->file.vertices(node);
+    const aggrelod::runtime::Span<uint32_t> t = file->file.triangles(node);
+    if (positions) *positions = v.data;
+    if (vertex_count) *vertex_count = static_cast<uint32_t>(v.size / 3);
+    if (indices) *indices = t.data;
+    if (index_count) *index_count = static_cast<uint32_t>(t.size);
+    return 1;
+}
+
 int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]) {
     if (!file || !min || !max) return 0;
     for (int k = 0; k < 3; ++k) {

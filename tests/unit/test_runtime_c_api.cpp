@@ -133,3 +133,38 @@ TEST(RuntimeCApi, RaycastReportsNodeAndObjects) {
     aglod_close(file);
 }
 #endif
+
+TEST(RuntimeCApi, NodeMeshIsAViewOfTheFile) {
+    const std::vector<uint8_t> bytes = syntheticBytes(50);
+    aglod_file* file = nullptr;
+    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
+    aggrelod::runtime::RuntimeFile cpp;
+    std::string message;
+    ASSERT_EQ(aggrelod::runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), cpp, message),
+              aggrelod::runtime::FileStatus::Ok);
+    size_t withTriangles = 0;
+    for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
+        const float* positions = nullptr;
+        const uint32_t* indices = nullptr;
+        uint32_t vertexCount = 0, indexCount = 0;
+        ASSERT_EQ(aglod_node_mesh(file, n, &positions, &vertexCount, &indices, &indexCount), 1);
+        const auto v = cpp.vertices(n);
+        const auto t = cpp.triangles(n);
+        ASSERT_EQ(vertexCount, v.size / 3);
+        ASSERT_EQ(indexCount, t.size);
+        EXPECT_EQ(indexCount % 3, 0u);
+        for (uint32_t i = 0; i < indexCount; ++i) EXPECT_LT(indices[i], vertexCount);
+        if (vertexCount) {
+            EXPECT_EQ(std::memcmp(positions, v.data, 3 * sizeof(float) * vertexCount), 0);
+        }
+        if (indexCount) ++withTriangles;
+    }
+    EXPECT_GT(withTriangles, 0u);
+    const float* positions = reinterpret_cast<const float*>(&bytes);
+    uint32_t vertexCount = 7;
+    EXPECT_EQ(aglod_node_mesh(file, aglod_node_count(file), &positions, &vertexCount, nullptr, nullptr), 0);
+    EXPECT_EQ(positions, nullptr);
+    EXPECT_EQ(vertexCount, 0u);
+    EXPECT_EQ(aglod_node_mesh(nullptr, 0, nullptr, nullptr, nullptr, nullptr), 0);
+    aglod_close(file);
+}
