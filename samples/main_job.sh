@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # aggrelod main job: install the dependencies, build (Release) into build/, generate the
 # 15-spheres sample scene (paper Fig. 9) into out/ and bake its LOD hierarchy, printing the
-# level table. Works from any directory.
+# level table; then run the runtime example on the baked file and the paper's 2D
+# evaluation. Works from any directory.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -15,5 +16,16 @@ build/samples/aggrelod_make_sample spheres15 --seed 1 -o out/spheres15.glb
 mkdir -p out/spheres15
 build/bake/aggrelod bake out/spheres15.glb -o out/spheres15 --stats out/spheres15/stats.json
 
+
+# What an engine does with the baked file: open it, fly a camera, print the cut, cast a ray.
 echo
-echo "Wrote out/spheres15/levels.glb (one node per aggregate per level) and out/spheres15/stats.json."
+build/samples/hello_runtime out/spheres15/scene.aglod
+
+# The paper's 2D evaluation: five environments, tables and figures.
+echo
+build/bake/aggrelod reproduce2d -o out/reproduce2d --quiet
+echo "2D evaluation (paper Fig. 4 and 6): out/reproduce2d/table.md, fig4-<environment>.png, fig6.png"
+
+echo
+echo "Wrote out/spheres15/levels.glb (one node per aggregate per level), proxies.glb (the runtime"
+echo "tree as glTF), scene.aglod (the runtime file) and stats.json."
