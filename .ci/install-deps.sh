@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what aggrelod needs to build and test, on Debian bookworm. Idempotent: apt runs
-# only when a package is missing, npm only when tests/validator/node_modules is missing or
-# older than its package-lock.json. Runs as root, or through sudo otherwise.
+# only when a package is missing, npm only when tests/validator/node_modules or
+# samples/web/node_modules is missing or older than its package-lock.json. Runs as root, or
+# through sudo otherwise.
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -17,7 +18,9 @@ packages=(
   libglm-dev libtinygltf-dev libembree-dev libtet1.5-dev
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev
   libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
+  chromium
 )
+# chromium: the web viewer test (tests/web) loads samples/web in headless Chromium.
 # node and npm run the glTF validator in the tests. Take them from Debian only when they are
 # missing: a node installed otherwise (e.g. a vendor repack) conflicts with Debian's npm.
 if ! command -v node >/dev/null 2>&1; then packages+=(nodejs); fi
@@ -39,13 +42,17 @@ else
   echo "install-deps: all Debian packages present"
 fi
 
-# glTF validator for the tests (pinned by tests/validator/package-lock.json).
-validator_dir="$repo_root/tests/validator"
-stamp="$validator_dir/node_modules/.package-lock.json"
-if [ ! -d "$validator_dir/node_modules/gltf-validator" ] || [ ! -f "$stamp" ] ||
-   [ "$validator_dir/package-lock.json" -nt "$stamp" ]; then
-  echo "install-deps: npm ci in tests/validator"
-  (cd "$validator_dir" && npm ci --no-audit --no-fund)
-else
-  echo "install-deps: gltf-validator present"
-fi
+# npm packages, pinned by each folder's package-lock.json: the glTF validator for the tests
+# and three.js + 3DTilesRendererJS for the web viewer (samples/web).
+npm_ci() {
+  local dir="$repo_root/$1" probe="$2"
+  local stamp="$dir/node_modules/.package-lock.json"
+  if [ ! -d "$dir/node_modules/$probe" ] || [ ! -f "$stamp" ] || [ "$dir/package-lock.json" -nt "$stamp" ]; then
+    echo "install-deps: npm ci in $1"
+    (cd "$dir" && npm ci --no-audit --no-fund)
+  else
+    echo "install-deps: $1/node_modules present"
+  fi
+}
+npm_ci tests/validator gltf-validator
+npm_ci samples/web 3d-tiles-renderer

@@ -1308,4 +1308,49 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
     }
 }
 
+std::vector<double> levelBaseColour(size_t level, size_t levelCount) { return levelColour(level, levelCount); }
+
+bool writeTileGlb(const TileMesh& tile, const std::string& path, std::string& error) {
+    if (tile.positions.size() % 3 != 0 || tile.indices.size() % 3 != 0) {
+        error = path + ": " + tile.name + ": positions or indices size is not a multiple of 3";
+        return false;
+    }
+    const size_t vertexCount = tile.positions.size() / 3;
+    for (uint32_t i : tile.indices) {
+        if (i >= vertexCount) {
+            error = path + ": " + tile.name + ": index " + std::to_string(i) + " out of range (" +
+                    std::to_string(vertexCount) + " vertices)";
+            return false;
+        }
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        tinygltf::Material material;
+        material.name = tile.name;
+        material.pbrMetallicRoughness.baseColorFactor.assign(tile.baseColor, tile.baseColor + 4);
+        material.pbrMetallicRoughness.metallicFactor = 0.0;
+        material.pbrMetallicRoughness.roughnessFactor = 0.8;
+        model.materials.push_back(std::move(material));
+
+        tinygltf::Node node;
+        node.name = tile.name;
+        const std::vector<double> positions(tile.positions.begin(), tile.positions.end());
+        node.mesh = glb.addMesh(tile.name, positions, tile.indices, 0);
+        tinygltf::Value::Object extras;
+        extras["node"] = intValue(tile.node);
+        extras["geometric_error"] = tinygltf::Value(tile.geometricError);
+        tinygltf::Value::Array sourceIds;
+        for (uint64_t id : tile.sourceIds) sourceIds.push_back(intValue(id));
+        extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+        node.extras = tinygltf::Value(std::move(extras));
+        const int root = glb.addNode(std::move(node));
+        if (model.meshes.empty()) model.materials.clear();  // nothing drawn: no unused material
+        return glb.write(path, {root}, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
 }  // namespace aggrelod::io

@@ -9,6 +9,7 @@
 #include "commands_2d.h"
 #include "scene_io.h"
 #include "terminal.h"
+#include "tiles_export.h"
 
 #include <aggrelod/runtime_file.h>
 
@@ -73,6 +74,7 @@ struct BakeOptions {
     double touchTolerance = -1;
     int threads = 0;
     double proxyError = 0.25;
+    bool tiles = false;
     bool quiet = false;
 };
 
@@ -129,8 +131,45 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "Simplification target of each level's proxies, as a fraction of the level's delta "
                     "(default 0.25; 0 keeps the exact aggregates)")
         ->check(CLI::Range(0.0, 10.0));
+    cmd->add_flag("--tiles", o.tiles,
+                  "Also write OUTDIR/tiles/: a 3D Tiles 1.1 tileset (tileset.json, one GLB per hierarchy node) "
+                  "for CesiumJS or 3DTilesRendererJS");
     cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
     return cmd;
+}
+
+/// Writes the 3D Tiles tileset into a fresh `outDir`/tiles.tmp, then puts it in place of
+/// `outDir`/tiles. On failure nothing of an older tileset is lost and tiles.tmp is removed.
+bool writeTilesDirectory(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, const fs::path& outDir,
+                         io::TilesetSummary& summary, std::string& error) {
+    const fs::path tilesDir = outDir / "tiles", tilesTmp = outDir / "tiles.tmp", tilesOld = outDir / "tiles.old";
+    std::error_code ec;
+    fs::remove_all(tilesTmp, ec);
+    fs::create_directories(tilesTmp, ec);
+    if (ec) {
+        error = tilesTmp.string() + ": cannot create: " + ec.message();
+        return false;
+    }
+    if (!io::writeTileset(nodes, objects, tilesTmp.string(), summary, error)) {
+        fs::remove_all(tilesTmp, ec);
+        return false;
+    }
+    fs::remove_all(tilesOld, ec);
+    if (fs::exists(tilesDir)) {
+        fs::rename(tilesDir, tilesOld, ec);
+        if (ec) {
+            error = tilesDir.string() + ": cannot replace: " + ec.message();
+            fs::remove_all(tilesTmp, ec);
+            return false;
+        }
+    }
+    fs::rename(tilesTmp, tilesDir, ec);
+    if (ec) {
+        error = tilesDir.string() + ": cannot replace: " + ec.message();
+        return false;
+    }
+    fs::remove_all(tilesOld, ec);
+    return true;
 }
 
 int runBake(BakeOptions o) {
@@ -286,6 +325,11 @@ int runBake(BakeOptions o) {
         printError(error);
         return kFileError;
     }
+    io::TilesetSummary tiles;
+    if (o.tiles && !writeTilesDirectory(nodes, scene.objects, outDir, tiles, error)) {
+        printError(error);
+        return kFileError;
+    }
 
     if (!o.quiet) {
         std::printf("%zu objects, %zu models, %zu triangles; originals: volume %s, sphericity %s\n",
@@ -305,6 +349,11 @@ int runBake(BakeOptions o) {
         std::printf("wrote %s, %s, %s%s%s\n", levelsPath.string().c_str(), proxiesPath.string().c_str(),
                     runtimePath.string().c_str(),
                     statsPath.empty() ? "" : " and ", statsPath.string().c_str());
+        if (o.tiles) {
+            std::printf("wrote %s: %zu tiles (%zu GLB contents), tileset geometric error %s\n",
+                        (outDir / "tiles" / "tileset.json").string().c_str(), tiles.tileCount, tiles.contentCount,
+                        cli::formatNumber(tiles.geometricError).c_str());
+        }
         std::fflush(stdout);
     }
     return kOk;

@@ -56,6 +56,27 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
 bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                      const std::string& path, std::string& error);
 
+/// The base colour (linear RGBA, 4 values) of level `level` of `levelCount` in levels.glb and
+/// proxies.glb: warm for fine levels, cool for coarse ones.
+std::vector<double> levelBaseColour(size_t level, size_t levelCount);
+
+/// The content of one 3D Tiles tile (see tiles_export.h): one mesh in glTF (y-up) world
+/// coordinates, world units.
+struct TileMesh {
+    std::string name;                 ///< glTF node, mesh and material name
+    std::vector<float> positions;     ///< 3 * vertexCount
+    std::vector<uint32_t> indices;    ///< 3 * triangleCount, outward
+    double baseColor[4] = {0.7, 0.7, 0.7, 1.0};  ///< linear RGBA of the one material
+    uint32_t node = 0;                ///< hierarchy node index (extras.node)
+    double geometricError = 0;        ///< extras.geometric_error, world units
+    std::vector<uint64_t> sourceIds;  ///< extras.source_ids: ids of the original objects
+};
+
+/// Writes one tile's GLB: one node with one triangle mesh (or none when `tile` has no
+/// triangles) and one material. Deterministic bytes. Returns false with a message naming
+/// `path` on a bad mesh (index out of range) or a write error.
+bool writeTileGlb(const TileMesh& tile, const std::string& path, std::string& error);
+
 /// Writes the stats JSON (see README "Stats file"). Timings are written last, in their
 /// own object, so determinism checks can drop them.
 bool writeStatsJson(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,

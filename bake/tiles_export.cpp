@@ -1,0 +1,266 @@
+// aggrelod bake: 3D Tiles export (DESIGN section 4; runtime selection as in section 3).
+// See tiles_export.h for the mapping and the axis convention. The GLB contents are written
+// by writeTileGlb (gltf_io.cpp, the only tinygltf user); this file writes the JSON.
+#include "tiles_export.h"
+
+#include "scene_io.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
+namespace aggrelod::io {
+namespace {
+
+/// Shortest text that reads back as the same double (locale-independent, deterministic).
+std::string number(double v) {
+    if (v == 0) return "0";  // also turns -0 into 0
+    char buffer[32];
+    const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
+    return std::string(buffer, r.ptr);
+}
+
+std::string jsonString(const std::string& s) {
+    std::string out = "\"";
+    for (unsigned char c : s) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += char(c);
+        } else if (c < 0x20) {
+            char buffer[8];
+            std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+            out += buffer;
+        } else {
+            out += char(c);
+        }
+    }
+    return out + "\"";
+}
+
+/// Axis-aligned box in glTF (y-up) world coordinates.
+struct Box {
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+};
+
+/// The 3D Tiles "box" (12 numbers: centre, x half axis, y half axis, z half axis) of `b`
+/// grown by `pad` on every side, taken from glTF y-up to 3D Tiles z-up: (x, y, z) -> (x, -z, y).
+std::string tilesBox(const Box& b, double pad) {
+    double c[3], h[3];
+    for (int k = 0; k < 3; ++k) {
+        c[k] = 0.5 * (b.lo[k] + b.hi[k]);
+        h[k] = 0.5 * (b.hi[k] - b.lo[k]) + pad;
+    }
+    const double values[12] = {c[0], -c[2], c[1],  //
+                               h[0], 0,     0,     // glTF x stays x
+                               0,    h[2],  0,     // glTF z becomes -y (a half axis: sign irrelevant)
+                               0,    0,     h[1]};  // glTF y becomes z
+    std::string s = "[";
+    for (int i = 0; i < 12; ++i) s += (i ? ", " : "") + number(values[i]);
+    return s + "]";
+}
+
+class TilesetWriter {
+public:
+    TilesetWriter(const HierarchyNodes& nodes, const std::vector<InputObject>& objects)
+        : nodes_(nodes), objects_(objects) {}
+
+    bool run(std::string& json, TilesetSummary& summary, std::string& error) {
+        if (nodes_.objectCount != objects_.size() || nodes_.nodes.size() < objects_.size()) {
+            error = "the hierarchy nodes do not belong to these objects";
+            return false;
+        }
+        for (size_t i = 0; i < nodes_.nodes.size(); ++i) {
+            for (uint32_t c : nodes_.nodes[i].children) {
+                if (c >= i) {  // children come before their parent: also rules out cycles
+                    error = "hierarchy node " + std::to_string(i) + " has child " + std::to_string(c) +
+                            " that does not come before it";
+                    return false;
+                }
+            }
+        }
+        std::vector<uint32_t> roots;
+        for (uint32_t r : nodes_.roots) {
+            if (r >= nodes_.nodes.size()) {
+                error = "hierarchy root " + std::to_string(r) + " does not exist";
+                return false;
+            }
+            if (hasGeometry(r)) roots.push_back(r);  // objects left out of the bake get no tile
+        }
+        if (roots.empty()) {
+            error = "the hierarchy has nothing to draw";
+            return false;
+        }
+        Box scene = box(roots[0]);
+        for (uint32_t r : roots) scene = unite(scene, box(r));
+        double diagonal = 0;
+        for (int k = 0; k < 3; ++k) diagonal += (scene.hi[k] - scene.lo[k]) * (scene.hi[k] - scene.lo[k]);
+        diagonal = std::sqrt(diagonal);
+        pad_ = diagonal > 0 ? 1e-6 * diagonal : 1e-6;
+        double rootError = 0;
+        for (uint32_t r : roots) rootError = std::max(rootError, nodes_.nodes[r].geometricError);
+        // Without any tile drawn, the error is about the whole scene: its diagonal.
+        summary.geometricError = std::max(diagonal, rootError);
+
+        out_ = "{\n  \"asset\": {\"version\": \"1.1\", \"generator\": \"aggrelod\"},\n";
+        out_ += "  \"geometricError\": " + number(summary.geometricError) + ",\n";
+        out_ += "  \"root\": ";
+        if (roots.size() == 1) {
+            writeTile(roots[0], 2);
+        } else {
+            // Several roots: a root without content standing for "nothing drawn".
+            ++tileCount_;
+            out_ += "{\n    \"boundingVolume\": {\"box\": " + tilesBox(scene, pad_) + "},\n";
+            out_ += "    \"geometricError\": " + number(summary.geometricError) + ",\n";
+            out_ += "    \"refine\": \"REPLACE\",\n";
+            out_ += "    \"children\": [\n";
+            for (size_t i = 0; i < roots.size(); ++i) {
+                out_ += "      ";
+                writeTile(roots[i], 6);
+                out_ += i + 1 < roots.size() ? ",\n" : "\n";
+            }
+            out_ += "    ]\n  }";
+        }
+        out_ += "\n}\n";
+        json = std::move(out_);
+        summary.tileCount = tileCount_;
+        summary.contentCount = contentCount_;
+        return true;
+    }
+
+    /// Nodes that have a tile with content, in the order of tileset.json.
+    const std::vector<uint32_t>& contentNodes() const { return contentNodes_; }
+
+private:
+    bool hasGeometry(uint32_t n) const {
+        const HierarchyNode& node = nodes_.nodes[n];
+        return !node.indices.empty() || !node.children.empty();
+    }
+
+    Box box(uint32_t n) const {
+        const HierarchyNode& node = nodes_.nodes[n];
+        Box b;
+        for (int k = 0; k < 3; ++k) {
+            b.lo[k] = node.boundsMin[k];
+            b.hi[k] = node.boundsMax[k];
+        }
+        return b;
+    }
+
+    static Box unite(const Box& a, const Box& b) {
+        Box r;
+        for (int k = 0; k < 3; ++k) {
+            r.lo[k] = std::min(a.lo[k], b.lo[k]);
+            r.hi[k] = std::max(a.hi[k], b.hi[k]);
+        }
+        return r;
+    }
+
+    void writeTile(uint32_t n, int indent) {
+        const HierarchyNode& node = nodes_.nodes[n];
+        const std::string in(size_t(indent) + 2, ' ');
+        ++tileCount_;
+        out_ += "{\n";
+        out_ += in + "\"boundingVolume\": {\"box\": " + tilesBox(box(n), pad_) + "},\n";
+        out_ += in + "\"geometricError\": " + number(node.leaf ? 0.0 : node.geometricError) + ",\n";
+        out_ += in + "\"refine\": \"REPLACE\",\n";
+        if (!node.indices.empty()) {
+            ++contentCount_;
+            contentNodes_.push_back(n);
+            out_ += in + "\"content\": {\"uri\": \"node" + std::to_string(n) + ".glb\"},\n";
+        }
+        out_ += in + "\"extras\": {\"node\": " + std::to_string(n);
+        if (node.leaf) {
+            out_ += ", \"object\": " + jsonString(objects_[n].name) + ", \"id\": " + std::to_string(objects_[n].id);
+        } else {
+            out_ += ", \"level\": " + std::to_string(node.firstLevel) + ", \"lastLevel\": " +
+                    std::to_string(node.lastLevel) + ", \"delta\": " + number(node.delta) +
+                    ", \"objects\": " + std::to_string(node.sources.size());
+        }
+        out_ += "}";
+        std::vector<uint32_t> children;
+        for (uint32_t c : node.children)
+            if (hasGeometry(c)) children.push_back(c);
+        if (!children.empty()) {
+            out_ += ",\n" + in + "\"children\": [\n";
+            for (size_t i = 0; i < children.size(); ++i) {
+                out_ += in + "  ";
+                writeTile(children[i], indent + 4);
+                out_ += i + 1 < children.size() ? ",\n" : "\n";
+            }
+            out_ += in + "]";
+        }
+        out_ += "\n" + std::string(size_t(indent), ' ') + "}";
+    }
+
+    const HierarchyNodes& nodes_;
+    const std::vector<InputObject>& objects_;
+    double pad_ = 0;
+    std::string out_;
+    size_t tileCount_ = 0, contentCount_ = 0;
+    std::vector<uint32_t> contentNodes_;
+};
+
+}  // namespace
+
+bool makeTilesetJson(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, std::string& json,
+                     TilesetSummary& summary, std::string& error) {
+    TilesetWriter writer(nodes, objects);
+    return writer.run(json, summary, error);
+}
+
+bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, const std::string& dir,
+                  TilesetSummary& summary, std::string& error) {
+    namespace fs = std::filesystem;
+    TilesetWriter writer(nodes, objects);
+    std::string json;
+    if (!writer.run(json, summary, error)) {
+        error = (fs::path(dir) / "tileset.json").string() + ": " + error;
+        return false;
+    }
+    int levelCount = 0;
+    for (const HierarchyNode& n : nodes.nodes) levelCount = std::max(levelCount, n.lastLevel + 1);
+    for (uint32_t n : writer.contentNodes()) {
+        const HierarchyNode& node = nodes.nodes[n];
+        TileMesh tile;
+        tile.name = node.leaf ? "object_" + objects[n].name : "node" + std::to_string(n) + "_level" +
+                                                                  std::to_string(node.firstLevel);
+        tile.positions = node.positions;
+        tile.indices = node.indices;
+        if (!node.leaf) {
+            const std::vector<double> colour = levelBaseColour(size_t(node.firstLevel), size_t(levelCount));
+            std::copy(colour.begin(), colour.begin() + 4, tile.baseColor);
+        }
+        tile.node = n;
+        tile.geometricError = node.leaf ? 0.0 : node.geometricError;
+        for (uint32_t s : node.sources) {
+            if (s >= objects.size()) {
+                error = (fs::path(dir) / "tileset.json").string() + ": hierarchy node " + std::to_string(n) +
+                        " refers to object " + std::to_string(s) + " of " + std::to_string(objects.size());
+                return false;
+            }
+            tile.sourceIds.push_back(objects[s].id);
+        }
+        const std::string path = (fs::path(dir) / ("node" + std::to_string(n) + ".glb")).string();
+        if (!writeTileGlb(tile, path, error)) return false;
+    }
+    const fs::path jsonPath = fs::path(dir) / "tileset.json";
+    std::ofstream out(jsonPath, std::ios::binary | std::ios::trunc);
+    if (!out) {
+        error = jsonPath.string() + ": cannot create";
+        return false;
+    }
+    out.write(json.data(), std::streamsize(json.size()));
+    out.close();
+    if (!out) {
+        error = jsonPath.string() + ": write error (disk full?)";
+        return false;
+    }
+    return true;
+}
+
+}  // namespace aggrelod::io
