@@ -84,9 +84,22 @@ function sceneBounds(tile) {
   return { center, radius, error: tile.geometricError };
 }
 
-function firstLeaf(tile) {
-  if (!tile.children || tile.children.length === 0) return tile;
-  return firstLeaf(tile.children[0]);
+function leavesOf(tile, out = []) {
+  if (!tile.children || tile.children.length === 0) out.push(tile);
+  else for (const c of tile.children) leavesOf(c, out);
+  return out;
+}
+
+/** The leaf farthest from `center` (first one on ties): off every axis, so that a box in
+ * the wrong axis convention would put it elsewhere and the near view would not draw it. */
+function farthestLeaf(root, center) {
+  let best = null, bestDistance = -1;
+  for (const leaf of leavesOf(root)) {
+    const c = sceneBounds(leaf).center;
+    const d = Math.hypot(c[0] - center[0], c[1] - center[1], c[2] - center[2]);
+    if (d > bestDistance) { best = leaf; bestDistance = d; }
+  }
+  return best;
 }
 
 /** Camera along a fixed oblique direction from `center` at `distance`. */
@@ -135,12 +148,13 @@ async function run(o) {
   }
   fs.mkdirSync(o.out, { recursive: true });
 
-  // Far: where the root's screen-space error is half the target, and at least 3 radii away,
-  // so that the root proxy alone is enough. Near: 3 radii of the first leaf from that leaf.
+  // Far: 3 radii of the scene from its centre (the whole scene in view). Near: 3 radii of a
+  // leaf (the original object farthest from the centre) from that leaf.
   const scene = sceneBounds(tileset.root);
-  const pixelsPerUnitAtOne = HEIGHT / (2 * Math.tan((FOV * Math.PI) / 360));
-  const farDistance = Math.max(3 * scene.radius, scene.radius + (scene.error * pixelsPerUnitAtOne) / (ERROR_TARGET / 2));
-  const leaf = sceneBounds(firstLeaf(tileset.root));
+  const farDistance = 3 * scene.radius;
+  const leafTile = farthestLeaf(tileset.root, scene.center);
+  const leafNode = leafTile.extras ? leafTile.extras.node : undefined;
+  const leaf = sceneBounds(leafTile);
   const nearDistance = 3 * leaf.radius;
   const views = [
     { name: 'far', camera: cameraAt(scene.center, farDistance), target: scene.center },
@@ -200,7 +214,9 @@ async function run(o) {
   const farLeaves = far.filter((t) => t.leaf), nearLeaves = near.filter((t) => t.leaf);
   if (far.length === 0) failures.push('far: no tile drawn');
   if (farLeaves.length > 0) failures.push(`far: ${farLeaves.length} original objects drawn (expected proxies only)`);
-  if (nearLeaves.length === 0) failures.push('near: no original object drawn (expected the leaf in front of the camera)');
+  if (!near.some((t) => t.leaf && t.node === leafNode)) {
+    failures.push(`near: the original object in front of the camera (node ${leafNode}) is not drawn`);
+  }
   const farMinError = Math.min(...far.map((t) => t.geometricError));
   const nearMinError = Math.min(...near.map((t) => t.geometricError));
   if (!(nearMinError < farMinError)) failures.push(`near tiles (min error ${nearMinError}) are not finer than far ones (min error ${farMinError})`);
@@ -208,7 +224,7 @@ async function run(o) {
   const notServed = requests.filter((r) => r.startsWith('404'));
   if (notServed.length) failures.push(`requests not served: ${notServed.join(', ')}`);
   fs.writeFileSync(path.join(o.out, 'result.json'), JSON.stringify({ views, far, near, failures }, null, 2) + '\n');
-  console.log(`far: ${far.length} tiles, ${farLeaves.length} originals, min error ${farMinError}; ` +
+  console.log(`near view looks at node ${leafNode}; far: ${far.length} tiles, ${farLeaves.length} originals, min error ${farMinError}; ` +
     `near: ${near.length} tiles, ${nearLeaves.length} originals, min error ${nearMinError}`);
   for (const f of failures) console.log(`failure: ${f}`);
   return failures.length ? 1 : 0;
