@@ -14,7 +14,7 @@ cmake --build build -j2
 mkdir -p out
 build/samples/aggrelod_make_sample spheres15 --seed 1 -o out/spheres15.glb
 mkdir -p out/spheres15
-build/bake/aggrelod bake out/spheres15.glb -o out/spheres15 --stats out/spheres15/stats.json
+build/bake/aggrelod bake out/spheres15.glb -o out/spheres15 --stats out/spheres15/stats.json --tiles
 
 
 # What an engine does with the baked file: open it, fly a camera, print the cut, cast a ray.
@@ -28,4 +28,5 @@ echo "2D evaluation (paper Fig. 4 and 6): out/reproduce2d/table.md, fig4-<enviro
 
 echo
 echo "Wrote out/spheres15/levels.glb (one node per aggregate per level), proxies.glb (the runtime"
-echo "tree as glTF), scene.aglod (the runtime file) and stats.json."
+echo "tree as glTF), scene.aglod (the runtime file), stats.json and tiles/ (3D Tiles); view the"
+echo "tiles with: node samples/web/serve.mjs --tileset out/spheres15/tiles  (http://127.0.0.1:8080/)"
