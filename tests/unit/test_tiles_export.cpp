@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <regex>
 #include <string>
 #include <vector>
@@ -230,4 +231,26 @@ TEST(TilesExport, BakedSampleTilesetIsValid) {
     const RunResult r = runChecker(tiles / "tileset.json", dir);
     EXPECT_TRUE(r.exited && r.exitCode == 1) << r.describe();
     EXPECT_GT(summaryValue(r.out, "glbErrors"), 0) << r.describe();
+}
+
+// An object with a NaN coordinate is left out of the bake: the tileset skips it and stays valid.
+TEST(TilesExport, ObjectLeftOutOfTheBakeHasNoTile) {
+    const std::string missing = validatorMissing();
+    ASSERT_TRUE(missing.empty()) << missing;
+    const fs::path dir = freshTestDir(currentTestName());
+    auto objects = samples::makeTwoCubes(0.5);
+    InputObject bad = samples::makeBox("broken", {5, 0, 0}, {6, 1, 1});
+    bad.positions[4] = std::numeric_limits<double>::quiet_NaN();
+    objects.push_back(bad);
+    std::string error;
+    ASSERT_TRUE(io::writeObjectsGlb(objects, (dir / "scene.glb").string(), error)) << error;
+    const RunResult r = runProgram(
+        {AGGRELOD_CLI, "bake", (dir / "scene.glb").string(), "-o", (dir / "out").string(), "--tiles", "--delta", "1"}, dir);
+    ASSERT_TRUE(r.exited && r.exitCode == 0) << r.describe();
+    EXPECT_NE(r.err.find("broken"), std::string::npos) << r.describe();
+    const std::string json = readFile(dir / "out" / "tiles" / "tileset.json");
+    EXPECT_EQ(json.find("\"broken\""), std::string::npos) << json;
+    const RunResult check = runChecker(dir / "out" / "tiles" / "tileset.json", dir);
+    EXPECT_TRUE(check.exited && check.exitCode == 0) << check.describe();
+    EXPECT_EQ(summaryValue(check.out, "leaves"), 2) << check.out;
 }
