@@ -138,11 +138,10 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
     return cmd;
 }
 
-/// Writes the 3D Tiles tileset into a fresh `outDir`/tiles.tmp, then puts it in place of
-/// `outDir`/tiles. On failure nothing of an older tileset is lost and tiles.tmp is removed.
-bool writeTilesDirectory(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, const fs::path& outDir,
-                         io::TilesetSummary& summary, std::string& error) {
-    const fs::path tilesDir = outDir / "tiles", tilesTmp = outDir / "tiles.tmp", tilesOld = outDir / "tiles.old";
+/// Writes the 3D Tiles tileset into a fresh `outDir`/tiles.tmp (removed again on failure).
+bool writeTilesTmp(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, const fs::path& outDir,
+                   io::TilesetSummary& summary, std::string& error) {
+    const fs::path tilesTmp = outDir / "tiles.tmp";
     std::error_code ec;
     fs::remove_all(tilesTmp, ec);
     fs::create_directories(tilesTmp, ec);
@@ -154,6 +153,13 @@ bool writeTilesDirectory(const HierarchyNodes& nodes, const std::vector<InputObj
         fs::remove_all(tilesTmp, ec);
         return false;
     }
+    return true;
+}
+
+/// Puts `outDir`/tiles.tmp in place of `outDir`/tiles (an older tileset is replaced whole).
+bool renameTilesIntoPlace(const fs::path& outDir, std::string& error) {
+    const fs::path tilesDir = outDir / "tiles", tilesTmp = outDir / "tiles.tmp", tilesOld = outDir / "tiles.old";
+    std::error_code ec;
     fs::remove_all(tilesOld, ec);
     if (fs::exists(tilesDir)) {
         fs::rename(tilesDir, tilesOld, ec);
@@ -284,6 +290,19 @@ int runBake(BakeOptions o) {
         printError(error);
         return kFileError;
     }
+    io::TilesetSummary tiles;
+    if (o.tiles && !writeTilesTmp(nodes, scene.objects, outDir, tiles, error)) {
+        removeQuietly(levelsTmp);
+        removeQuietly(proxiesTmp);
+        removeQuietly(runtimeTmp);
+        printError(error);
+        return kFileError;
+    }
+    // A leftover tiles.tmp would only be replaced by the next bake; remove it on failure.
+    const auto removeTilesTmp = [&outDir, &o] {
+        std::error_code removeError;
+        if (o.tiles) fs::remove_all(outDir / "tiles.tmp", removeError);
+    };
     fs::path statsPath, statsTmp;
     if (!o.statsPath.empty()) {
         statsPath = fs::path(o.statsPath);
@@ -295,6 +314,7 @@ int runBake(BakeOptions o) {
             removeQuietly(proxiesTmp);
             removeQuietly(runtimeTmp);
             removeQuietly(statsTmp);
+            removeTilesTmp();
             printError(error);
             return kFileError;
         }
@@ -304,6 +324,7 @@ int runBake(BakeOptions o) {
         removeQuietly(proxiesTmp);
         removeQuietly(runtimeTmp);
         if (!statsTmp.empty()) removeQuietly(statsTmp);
+        removeTilesTmp();
         printError(error);
         return kFileError;
     }
@@ -311,22 +332,24 @@ int runBake(BakeOptions o) {
         removeQuietly(proxiesTmp);
         removeQuietly(runtimeTmp);
         if (!statsTmp.empty()) removeQuietly(statsTmp);
+        removeTilesTmp();
         printError(error);
         return kFileError;
     }
     if (!renameOver(runtimeTmp, runtimePath, error)) {
         removeQuietly(runtimeTmp);
         if (!statsTmp.empty()) removeQuietly(statsTmp);
+        removeTilesTmp();
         printError(error);
         return kFileError;
     }
     if (!statsTmp.empty() && !renameOver(statsTmp, statsPath, error)) {
         removeQuietly(statsTmp);
+        removeTilesTmp();
         printError(error);
         return kFileError;
     }
-    io::TilesetSummary tiles;
-    if (o.tiles && !writeTilesDirectory(nodes, scene.objects, outDir, tiles, error)) {
+    if (o.tiles && !renameTilesIntoPlace(outDir, error)) {
         printError(error);
         return kFileError;
     }
