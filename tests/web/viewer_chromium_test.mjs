@@ -19,6 +19,7 @@ const here = path.dirname(fileURLToPath(import.meta.url));
 const webDir = path.resolve(here, '..', '..', 'samples', 'web');
 const WIDTH = 800, HEIGHT = 600, FOV = 60, ERROR_TARGET = 16;
 const PAGE_TIMEOUT_MS = 20000;
+const WATCHDOG_MS = 90000;
 
 function parseArgs() {
   const args = process.argv.slice(2);
@@ -44,6 +45,12 @@ class Cdp {
     this.pending = new Map();
     this.listeners = [];
     this.writer = child.stdio[3];
+    const failAll = (e) => {
+      for (const { reject, method } of this.pending.values()) reject(new Error(`${method}: ${e.message}`));
+      this.pending.clear();
+    };
+    this.writer.on('error', failAll);
+    child.stdio[4].on('error', failAll);
     let buffer = '';
     child.stdio[4].on('data', (chunk) => {
       buffer += chunk.toString('utf8');
@@ -198,6 +205,16 @@ async function run(o) {
   child.stderr.on('data', (d) => { stderr += d.toString(); });
   const exited = new Promise((resolve) => child.on('exit', resolve));
   const cdp = new Cdp(child);
+  child.on('exit', (code, signal) => {
+    for (const { reject, method } of cdp.pending.values()) {
+      reject(new Error(`${method}: Chromium exited (code ${code}, signal ${signal})`));
+    }
+    cdp.pending.clear();
+  });
+  child.on('error', (e) => {
+    for (const { reject } of cdp.pending.values()) reject(new Error(`cannot start ${chromium}: ${e.message}`));
+    cdp.pending.clear();
+  });
   const consoleLines = [];
   cdp.listeners.push((m) => {
     if (m.method === 'Runtime.consoleAPICalled') {
@@ -251,6 +268,14 @@ async function run(o) {
   for (const f of failures) console.log(`failure: ${f}`);
   return failures.length ? 1 : 0;
 }
+
+// Whatever hangs (Chromium not answering, a page that never settles), the test ends.
+const watchdog = setTimeout(() => {
+  console.log(`error: no result after ${WATCHDOG_MS / 1000} s`);
+  console.log('viewer test: FAILED');
+  process.exit(1);
+}, WATCHDOG_MS);
+watchdog.unref();
 
 let status;
 try {
