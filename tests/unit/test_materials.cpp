@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 namespace aggrelod {
 namespace {
@@ -203,6 +204,43 @@ TEST(Materials, BaseColoursRoundTripThroughGlb) {
     ASSERT_TRUE(io::writeObjectsGlb(plain, (dir / "plain.glb").string(), error)) << error;
     ASSERT_TRUE(io::readGltfScene((dir / "plain.glb").string(), {}, back, error)) << error;
     for (const InputObject& o : back.objects) EXPECT_TRUE(o.triangleColors.empty()) << o.name;
+}
+
+/// Rewrites the JSON chunk of a GLB made by makeGlb (lengths recomputed).
+std::string withJsonEdits(const std::string& glb, const std::vector<std::pair<std::string, std::string>>& edits) {
+    uint32_t jsonLength = 0;
+    std::memcpy(&jsonLength, glb.data() + 12, 4);
+    std::string json = glb.substr(20, jsonLength);
+    const std::string rest = glb.substr(20 + jsonLength);
+    for (const auto& e : edits) {
+        const size_t at = json.find(e.first);
+        EXPECT_NE(at, std::string::npos) << e.first;
+        if (at != std::string::npos) json.replace(at, e.first.size(), e.second);
+    }
+    while (json.size() % 4) json += ' ';
+    auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    return "glTF" + u32(2) + u32(uint32_t(20 + json.size() + rest.size())) + u32(uint32_t(json.size())) +
+           u32(0x4E4F534A) + json + rest;
+}
+
+TEST(Materials, BadColourDataIsReportedNotFatal) {
+    const fs::path dir = freshTestDir(currentTestName());
+    const std::vector<InputObject> cubes = samples::makeTwoCubes(0.5);
+    // Mesh 0 names material 7 (there is none); mesh 1's COLOR_0 is its SCALAR index accessor.
+    const std::string glb = withJsonEdits(makeGlb({rawMeshOf(cubes[0]), rawMeshOf(cubes[1])}),
+                                          {{"\"mode\":4}", "\"mode\":4,\"material\":7}"},
+                                           {"{\"POSITION\":2}", "{\"POSITION\":2,\"COLOR_0\":3}"}});
+    writeFile(dir / "bad_colours.glb", glb);
+    io::SceneReadResult scene;
+    std::string error;
+    ASSERT_TRUE(io::readGltfScene((dir / "bad_colours.glb").string(), {}, scene, error)) << error;
+    ASSERT_EQ(scene.objects.size(), 2u);  // both objects kept, white
+    for (const InputObject& o : scene.objects) EXPECT_TRUE(o.triangleColors.empty()) << o.name;
+    std::string all;
+    for (const Diagnostic& d : scene.diagnostics) all += d.object + ": " + d.message + "\n";
+    EXPECT_NE(all.find("material 7 does not exist"), std::string::npos) << all;
+    EXPECT_NE(all.find("COLOR_0 unusable"), std::string::npos) << all;
+    EXPECT_NE(all.find("neither VEC3 nor VEC4"), std::string::npos) << all;
 }
 
 TEST(Materials, ProxyFaceNextToRedObjectIsRed) {
