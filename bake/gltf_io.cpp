@@ -2,8 +2,10 @@
 // (Debian ships tinygltf's implementation compiled in libtinygltf.so, so no
 // TINYGLTF_IMPLEMENTATION here).
 //
-// Reading: geometry only. Images are never decoded (a loader callback that accepts
-// anything), materials and unknown extensions are ignored, every accessor and
+// Reading: geometry and base colours. Images are never decoded (a loader callback that
+// accepts anything); of the materials only baseColorFactor is read (times the mean COLOR_0
+// of each triangle's corners when present; base colour textures are ignored with a note);
+// unknown extensions are ignored; every accessor and
 // buffer view is range-checked here before a byte is read, and a bad object is
 // skipped with a diagnostic so that the rest of the scene can still be baked.
 #include "scene_io.h"
@@ -11,6 +13,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -219,9 +222,10 @@ const unsigned char* viewBytes(const tinygltf::Model& model, int viewIndex, size
 }
 
 /// Reads accessor `index` into doubles (count * components values). `indices`: a SCALAR
-/// index accessor (unsigned integer types only); otherwise a VEC3 position accessor.
+/// index accessor (unsigned integer types only); `colours`: a VEC3 or VEC4 COLOR_n accessor
+/// (components = 3 or 4); otherwise a VEC3 position accessor.
 bool readAccessor(const tinygltf::Model& model, int index, bool indices,
-                  std::vector<double>& out, std::string& why) {
+                  std::vector<double>& out, std::string& why, bool colours = false) {
     if (index < 0 || size_t(index) >= model.accessors.size()) {
         why = "accessor " + std::to_string(index) + " does not exist (" +
               std::to_string(model.accessors.size()) + " accessors)";
@@ -229,12 +233,16 @@ bool readAccessor(const tinygltf::Model& model, int index, bool indices,
     }
     const tinygltf::Accessor& acc = model.accessors[size_t(index)];
     const std::string name = "accessor " + std::to_string(index);
-    const int components = indices ? 1 : 3;
+    const int components = indices ? 1 : (colours && acc.type == TINYGLTF_TYPE_VEC4 ? 4 : 3);
+    if (colours && acc.type != TINYGLTF_TYPE_VEC3 && acc.type != TINYGLTF_TYPE_VEC4) {
+        why = name + " of colours is neither VEC3 nor VEC4";
+        return false;
+    }
     if (indices && acc.type != TINYGLTF_TYPE_SCALAR) {
         why = name + " of indices is not SCALAR";
         return false;
     }
-    if (!indices && acc.type != TINYGLTF_TYPE_VEC3) {
+    if (!indices && !colours && acc.type != TINYGLTF_TYPE_VEC3) {
         why = name + " of positions is not VEC3";
         return false;
     }
@@ -402,6 +410,7 @@ struct ObjectBuilder {
     bool failed = false;     ///< a data error: the object is skipped
     std::vector<double> positions;
     std::vector<uint32_t> indices;
+    std::vector<float> colors;  ///< linear RGBA per triangle (InputObject::triangleColors)
 };
 
 class SceneReader {
@@ -441,6 +450,7 @@ private:
     std::vector<Diagnostic>& diags_;
     std::regex regex_;
     bool hasRegex_ = false;
+    bool notedTexture_ = false;  ///< the texture note is given once per file
 };
 
 bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat4& world,
@@ -538,6 +548,59 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
         }
     }
     if (tri.empty()) return true;
+
+    // Base colour of each triangle: the material's baseColorFactor (white without a
+    // material), times the mean COLOR_0 of its corners when the primitive has vertex colours.
+    double factor[4] = {1, 1, 1, 1};
+    if (prim.material >= 0 && size_t(prim.material) < model_.materials.size()) {
+        const tinygltf::Material& material = model_.materials[size_t(prim.material)];
+        const std::vector<double>& f = material.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() == 4 && std::all_of(f.begin(), f.end(), [](double x) { return std::isfinite(x); }))
+            for (int c = 0; c < 4; ++c) factor[c] = std::min(1.0, std::max(0.0, f[size_t(c)]));
+        if (material.pbrMetallicRoughness.baseColorTexture.index >= 0 && !notedTexture_) {
+            notedTexture_ = true;
+            note(Severity::Note, object.name,
+                 "material " + std::to_string(prim.material) + " '" + material.name +
+                     "' has a base colour texture; textures are not read, proxies take its baseColorFactor");
+        }
+    } else if (prim.material >= 0) {
+        note(Severity::Warning, object.name,
+             "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where + ": material " +
+                 std::to_string(prim.material) + " does not exist; white is used");
+    }
+    std::vector<double> vertexColours;
+    int colourComponents = 0;
+    const auto col = prim.attributes.find("COLOR_0");
+    if (col != prim.attributes.end()) {
+        why.clear();
+        if (!readAccessor(model_, col->second, false, vertexColours, why, true) ||
+            (vertexColours.size() != 3 * vertexCount && vertexColours.size() != 4 * vertexCount)) {
+            note(Severity::Warning, object.name,
+                 "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+                     ": COLOR_0 unusable (" + (why.empty() ? "count differs from POSITION" : why) +
+                     "); the material colour is used");
+            vertexColours.clear();
+        } else {
+            colourComponents = int(vertexColours.size() / vertexCount);
+        }
+    }
+    const size_t firstTriangle = object.indices.size() / 3;
+    object.colors.resize(4 * firstTriangle, 1.0f);  // earlier primitives without colour data
+    for (size_t t = 0; t < tri.size(); t += 3) {
+        for (int c = 0; c < 4; ++c) {
+            double v = factor[c];
+            if (colourComponents > 0) {
+                double mean = 1;
+                if (c < colourComponents) {
+                    mean = 0;
+                    for (int k = 0; k < 3; ++k) mean += vertexColours[size_t(colourComponents) * tri[t + size_t(k)] + size_t(c)];
+                    mean /= 3;
+                }
+                v *= std::isfinite(mean) ? std::min(1.0, std::max(0.0, mean)) : 1.0;
+            }
+            object.colors.push_back(float(v));
+        }
+    }
 
     const size_t base = object.positions.size() / 3;
     if (base + vertexCount > size_t(std::numeric_limits<uint32_t>::max())) {
@@ -780,6 +843,10 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
         obj.id = uint32_t(objects.size());
         obj.positions = std::move(b->positions);
         obj.indices = std::move(b->indices);
+        // Triangle colours only when some triangle is not white (white is the default).
+        b->colors.resize(4 * (obj.indices.size() / 3), 1.0f);
+        if (std::any_of(b->colors.begin(), b->colors.end(), [](float c) { return c != 1.0f; }))
+            obj.triangleColors = std::move(b->colors);
         objects.push_back(std::move(obj));
     }
     return true;
@@ -956,11 +1023,39 @@ public:
     }
 
     /// Adds a mesh with one triangle primitive; returns its index, or -1 when there is
-    /// nothing to draw. Positions are converted to float32.
-    int addMesh(const std::string& name, const std::vector<double>& positions,
-                const std::vector<uint32_t>& indices, int material) {
+    /// nothing to draw. Positions are converted to float32. With `faceColors` (linear RGBA,
+    /// 4 per triangle) the primitive gets COLOR_0 (float VEC4): a vertex shared by faces of
+    /// different colours is split, one copy per colour.
+    int addMesh(const std::string& name, const std::vector<double>& positionsIn,
+                const std::vector<uint32_t>& indicesIn, int material,
+                const std::vector<float>* faceColors = nullptr) {
+        if (positionsIn.empty() || indicesIn.empty()) return -1;
+        const bool coloured = faceColors && faceColors->size() == 4 * (indicesIn.size() / 3) &&
+                              indicesIn.size() % 3 == 0;
+        std::vector<double> splitPositions;
+        std::vector<uint32_t> splitIndices;
+        std::vector<float> colours;
+        if (coloured) {
+            // New vertex per (vertex, colour) pair, numbered in order of first use.
+            std::map<std::pair<uint32_t, std::array<float, 4>>, uint32_t> copies;
+            splitIndices.reserve(indicesIn.size());
+            for (size_t i = 0; i < indicesIn.size(); ++i) {
+                const float* c = &(*faceColors)[4 * (i / 3)];
+                const std::array<float, 4> colour = {c[0], c[1], c[2], c[3]};
+                const auto key = std::make_pair(indicesIn[i], colour);
+                auto it = copies.find(key);
+                if (it == copies.end()) {
+                    it = copies.emplace(key, uint32_t(splitPositions.size() / 3)).first;
+                    splitPositions.insert(splitPositions.end(), &positionsIn[3 * size_t(indicesIn[i])],
+                                          &positionsIn[3 * size_t(indicesIn[i])] + 3);
+                    colours.insert(colours.end(), colour.begin(), colour.end());
+                }
+                splitIndices.push_back(it->second);
+            }
+        }
+        const std::vector<double>& positions = coloured ? splitPositions : positionsIn;
+        const std::vector<uint32_t>& indices = coloured ? splitIndices : indicesIn;
         const size_t vertexCount = positions.size() / 3;
-        if (vertexCount == 0 || indices.empty()) return -1;
 
         std::vector<float> p(vertexCount * 3);
         // min/max (required for POSITION) over the finite values of each component.
@@ -999,6 +1094,15 @@ public:
 
         tinygltf::Primitive prim;
         prim.attributes["POSITION"] = posIndex;
+        if (coloured) {
+            tinygltf::Accessor col;
+            col.bufferView = addView(colours.data(), colours.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+            col.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+            col.type = TINYGLTF_TYPE_VEC4;
+            col.count = vertexCount;
+            model_.accessors.push_back(std::move(col));
+            prim.attributes["COLOR_0"] = int(model_.accessors.size()) - 1;
+        }
         prim.indices = idxIndex;
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         prim.material = material;
@@ -1121,6 +1225,7 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
     try {
         GlbBuilder glb;
         std::vector<int> roots;
+        std::map<std::vector<double>, int> materialOfColour;
         for (const InputObject& o : objects) {
             if (o.positions.size() % 3 != 0 || o.indices.size() % 3 != 0) {
                 error = path + ": object '" + o.name +
@@ -1129,7 +1234,28 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
             }
             tinygltf::Node node;
             node.name = o.name;
-            node.mesh = glb.addMesh(o.name, o.positions, o.indices, -1);
+            // Colours: one material when the object has one colour, else COLOR_0.
+            const bool coloured = !o.triangleColors.empty() && o.triangleColors.size() == 4 * (o.indices.size() / 3);
+            bool uniform = coloured;
+            for (size_t i = 4; uniform && i < o.triangleColors.size(); ++i)
+                uniform = o.triangleColors[i] == o.triangleColors[i % 4];
+            int material = -1;
+            if (uniform) {
+                const std::vector<double> colour(o.triangleColors.begin(), o.triangleColors.begin() + 4);
+                auto it = materialOfColour.find(colour);
+                if (it == materialOfColour.end()) {
+                    tinygltf::Material m;
+                    m.name = "colour" + std::to_string(materialOfColour.size());
+                    m.pbrMetallicRoughness.baseColorFactor = colour;
+                    m.pbrMetallicRoughness.metallicFactor = 0.0;
+                    m.pbrMetallicRoughness.roughnessFactor = 0.8;
+                    glb.model().materials.push_back(std::move(m));
+                    it = materialOfColour.emplace(colour, int(glb.model().materials.size()) - 1).first;
+                }
+                material = it->second;
+            }
+            node.mesh = glb.addMesh(o.name, o.positions, o.indices, material,
+                                    coloured && !uniform ? &o.triangleColors : nullptr);
             tinygltf::Value::Object extras;
             extras["id"] = intValue(o.id);
             node.extras = tinygltf::Value(std::move(extras));
@@ -1153,13 +1279,19 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
         tinygltf::Model& model = glb.model();
         std::vector<int> roots;
         const size_t levelCount = hierarchy.levels.size();
+        bool anyColours = false;
+        for (const Level& level : hierarchy.levels)
+            for (const Aggregate& agg : level.aggregates) anyColours = anyColours || !agg.faceColors.empty();
         for (size_t k = 0; k < levelCount; ++k) {
             const Level& level = hierarchy.levels[k];
             const std::string levelName = "level" + std::to_string(k);
 
             tinygltf::Material material;
             material.name = levelName;
-            material.pbrMetallicRoughness.baseColorFactor = levelColour(k, levelCount);
+            // With colours the faces carry them (COLOR_0 times a white base colour); without,
+            // each level gets a distinct tint.
+            material.pbrMetallicRoughness.baseColorFactor =
+                anyColours ? std::vector<double>{1, 1, 1, 1} : levelColour(k, levelCount);
             material.pbrMetallicRoughness.metallicFactor = 0.0;
             material.pbrMetallicRoughness.roughnessFactor = 0.8;
             model.materials.push_back(std::move(material));
@@ -1194,7 +1326,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 }
                 tinygltf::Node node;
                 node.name = name;
-                node.mesh = glb.addMesh(name, agg.positions, agg.indices, materialIndex);
+                node.mesh = glb.addMesh(name, agg.positions, agg.indices, materialIndex, &agg.faceColors);
                 tinygltf::Value::Object extras;
                 extras["level"] = intValue(k);
                 extras["group"] = intValue(g);
@@ -1251,11 +1383,16 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
         GlbBuilder glb;
         tinygltf::Model& model = glb.model();
         int levelCount = 0;
-        for (const HierarchyNode& n : nodes.nodes) levelCount = std::max(levelCount, n.lastLevel + 1);
+        bool anyColours = false;
+        for (const HierarchyNode& n : nodes.nodes) {
+            levelCount = std::max(levelCount, n.lastLevel + 1);
+            anyColours = anyColours || (!n.leaf && !n.faceColors.empty());
+        }
         for (int k = 0; k < levelCount; ++k) {
             tinygltf::Material material;
             material.name = "level" + std::to_string(k);
-            material.pbrMetallicRoughness.baseColorFactor = levelColour(size_t(k), size_t(levelCount));
+            material.pbrMetallicRoughness.baseColorFactor =
+                anyColours ? std::vector<double>{1, 1, 1, 1} : levelColour(size_t(k), size_t(levelCount));
             material.pbrMetallicRoughness.metallicFactor = 0.0;
             material.pbrMetallicRoughness.roughnessFactor = 0.8;
             model.materials.push_back(std::move(material));
@@ -1294,7 +1431,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 extras["proxy_error_bound"] = tinygltf::Value(n.error.bound());
                 extras["exact_triangles"] = intValue(n.exactTriangleCount);
                 const std::vector<double> positions(n.positions.begin(), n.positions.end());
-                node.mesh = glb.addMesh(node.name, positions, n.indices, n.firstLevel);
+                node.mesh = glb.addMesh(node.name, positions, n.indices, n.firstLevel, &n.faceColors);
             }
             for (uint32_t c : n.children) node.children.push_back(int(c));
             node.extras = tinygltf::Value(std::move(extras));

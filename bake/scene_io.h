@@ -32,6 +32,8 @@ bool readGltfScene(const std::string& path, const SceneReadOptions& options,
                    SceneReadResult& out, std::string& error);
 
 /// Writes objects as a GLB, one node (with extras.id) per object. For samples and tests.
+/// An object with triangleColors gets one material of that colour when all its triangles
+/// share it, else COLOR_0 vertex colours (so reading the file back gives the same colours).
 bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string& path,
                      std::string& error);
 
@@ -42,14 +44,16 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 /// original object), first_level, last_level, geometric_error (stored, monotone),
 /// proxy_error {proxy_to_originals, originals_to_proxy (certified upper bounds),
 /// proxy_to_originals_found, originals_to_proxy_found (largest distances found), tolerance, bound},
-/// proxy_triangles. World units throughout.
+/// proxy_triangles. World units throughout. Aggregates with face colours carry them as
+/// COLOR_0 (linear RGBA) and the level materials are white; without colours each level's
+/// material has its own tint.
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                     const std::string& path, std::string& error,
                     const HierarchyNodes* nodes = nullptr);
 
 /// Writes OUTDIR/proxies.glb: glTF node i = hierarchy node i, nested as the hierarchy (scene
 /// roots = its roots). Aggregate nodes carry their simplified proxy as a mesh (one material
-/// per level) and extras {node, level, last_level, delta, geometric_error, proxy_error_bound,
+/// per level; face colours as COLOR_0 as in levels.glb) and extras {node, level, last_level, delta, geometric_error, proxy_error_bound,
 /// exact_triangles, bounding_sphere [x, y, z, r], sources, source_ids}; leaves (the original
 /// objects, named "object_<name>") have no mesh and extras {node, leaf, geometric_error 0,
 /// bounding_sphere, sources, source_ids}. World units.

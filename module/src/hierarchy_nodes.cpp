@@ -1,10 +1,12 @@
 // aggrelod module: hierarchy nodes for real-time use (DESIGN sections 2.5 and 2.6).
 // Builds the tree (leaves = original objects, inner nodes = aggregates, unchanged aggregates
 // collapsed across levels), simplifies every aggregate into a proxy (mesh_simplify.cpp),
-// measures its error (proxy_error.cpp), and makes bounds nested and errors monotone so that
+// measures its error (proxy_error.cpp), colours its faces after the nearest original surface
+// (surface_colors.cpp), and makes bounds nested and errors monotone so that
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
 #include "mesh_simplify.h"
 #include "parallel_for.h"
+#include "surface_colors.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 
@@ -184,6 +186,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         if (inHierarchy && finite) {
             n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
             n.indices = objects[o].indices;
+            if (detail::hasTriangleColors(objects[o])) n.faceColors = objects[o].triangleColors;
         }
     }
     // Aggregates, level by level; an aggregate that is the same solid as the one holding the
@@ -236,6 +239,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         detail::simplifyMesh(exact, agg.indices, settings.simplifyFraction * n.delta, n.positions, n.indices);
         std::vector<const InputObject*> originals;
         for (uint32_t o : n.sources) originals.push_back(&objects[o]);
+        detail::nearestSurfaceColors(n.positions, n.indices, originals, n.faceColors);
         n.error = measureProxyError(n.positions, n.indices, originals, settings.toleranceFraction * n.delta,
                                     settings.maxRefinementsPerDirection);
     }, [&](size_t done) {

@@ -6,6 +6,7 @@
 #include "mesh_distance.h"
 #include "mesh_preparation.h"
 #include "parallel_for.h"
+#include "surface_colors.h"
 #include "sculpt_3d.h"
 #include "tetgen_backend.h"
 
@@ -237,6 +238,11 @@ bool Baker::prepare() {
     diagonal_ = b[0] <= b[3] ? std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2])) : 0.0;
     tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal_;
     const double areaEpsilon = 1e-14 * diagonal_ * diagonal_;
+    for (const InputObject& o : objects_)
+        if (!o.triangleColors.empty() && !detail::hasTriangleColors(o))
+            diag(out_, Diagnostic::Severity::Warning, o.name,
+                 "triangleColors has " + std::to_string(o.triangleColors.size()) + " values, expected 4 per triangle (" +
+                     std::to_string(4 * (o.indices.size() / 3)) + "); the object counts as white");
     prepared_.resize(objects_.size());
     size_t usable = 0;
     for (size_t i = 0; i < objects_.size(); ++i) {
@@ -949,6 +955,9 @@ void Baker::buildLevels() {
             }
             for (Aggregate& agg : w.aggregates) {
                 std::sort(agg.sourceObjects.begin(), agg.sourceObjects.end());
+                std::vector<const InputObject*> sources;
+                for (uint32_t o : agg.sourceObjects) sources.push_back(&objects_[o]);
+                detail::nearestSurfaceColors(agg.positions, agg.indices, sources, agg.faceColors);
                 double v = 0, a = 0;
                 detail::meshVolumeArea(agg.positions, agg.indices, v, a);
                 agg.measures = measuresOf(v, a);

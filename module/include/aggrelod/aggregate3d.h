@@ -27,6 +27,11 @@ struct InputObject {
     uint32_t id = 0;                 ///< caller's id, copied to outputs (sources)
     std::vector<double> positions;   ///< 3 * vertexCount, world units
     std::vector<uint32_t> indices;   ///< 3 * triangleCount
+    /// Base colour of each triangle, linear RGBA in [0, 1] (glTF baseColorFactor meaning),
+    /// 4 * triangleCount floats. Empty = every triangle white (1, 1, 1, 1), glTF's default.
+    /// Proxies take the colour of the nearest original surface (see Aggregate::faceColors);
+    /// any other size is ignored with a warning.
+    std::vector<float> triangleColors;
 };
 
 /// Which distance weights the neighbourhood graph (DESIGN 2.2).
@@ -61,6 +66,10 @@ struct Aggregate {
     std::vector<double> positions;       ///< 3 * vertexCount
     std::vector<uint32_t> indices;       ///< 3 * triangleCount, closed, edge-manifold, outward
     std::vector<uint32_t> sourceObjects; ///< indices into the input object array, ascending
+    /// Per triangle, linear RGBA (4 * triangleCount): the base colour of the source objects'
+    /// surface nearest to the triangle's centroid. Empty when no source object has colours
+    /// (every face white).
+    std::vector<float> faceColors;
     int componentCount = 0;              ///< connected shells in this aggregate
     SolidMeasures measures;
     double volumeOriginal = 0;           ///< sum of the source objects' volumes

@@ -64,6 +64,10 @@ struct HierarchyNode {
     double delta = 0;                  ///< delta of firstLevel, world units (0 for leaves)
     std::vector<float> positions;      ///< proxy (leaf: the original; empty for a left-out object), 3 * vertexCount, world units
     std::vector<uint32_t> indices;     ///< 3 * triangleCount, outward
+    /// Per proxy triangle, linear RGBA (4 * triangleCount): the base colour of the original
+    /// surface nearest to the triangle's centroid (leaf: the object's triangleColors).
+    /// Empty when none of the sources has colours (every face white).
+    std::vector<float> faceColors;
     size_t exactTriangleCount = 0;     ///< triangles of the unsimplified aggregate (leaf: of the object)
     ProxyError error;                  ///< measured error of this node's proxy (zeros for leaves)
     /// Stored geometric error, world units: max(error.bound(), every child's geometricError),

@@ -1,0 +1,68 @@
+// aggrelod module: proxy face colours from the nearest original surface (surface_colors.h).
+// An engine-facing addition, not a section of the paper.
+#include "surface_colors.h"
+
+#include "mesh_distance.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace aggrelod::detail {
+
+bool hasTriangleColors(const InputObject& o) {
+    return !o.triangleColors.empty() && o.triangleColors.size() == 4 * (o.indices.size() / 3);
+}
+
+namespace {
+
+template <typename Real>
+void colorsOfNearest(const std::vector<Real>& positions, const std::vector<uint32_t>& indices,
+                     const std::vector<const InputObject*>& originals, std::vector<float>& faceColors) {
+    faceColors.clear();
+    if (std::none_of(originals.begin(), originals.end(), [](const InputObject* o) { return hasTriangleColors(*o); }))
+        return;
+    // One triangle soup of every usable original, with its colours in the same order.
+    std::vector<double> soupPositions;
+    std::vector<uint32_t> soupIndices;
+    std::vector<float> soupColors;
+    for (const InputObject* o : originals) {
+        const bool finite = std::all_of(o->positions.begin(), o->positions.end(), [](double x) { return std::isfinite(x); });
+        const size_t vertexCount = o->positions.size() / 3;
+        if (!finite || o->positions.size() % 3 || o->indices.size() % 3) continue;
+        if (std::any_of(o->indices.begin(), o->indices.end(), [&](uint32_t i) { return i >= vertexCount; })) continue;
+        const uint32_t base = static_cast<uint32_t>(soupPositions.size() / 3);
+        soupPositions.insert(soupPositions.end(), o->positions.begin(), o->positions.end());
+        for (uint32_t i : o->indices) soupIndices.push_back(base + i);
+        if (hasTriangleColors(*o))
+            soupColors.insert(soupColors.end(), o->triangleColors.begin(), o->triangleColors.end());
+        else
+            soupColors.resize(soupColors.size() + 4 * (o->indices.size() / 3), 1.0f);
+    }
+    const size_t faceCount = indices.size() / 3;
+    faceColors.assign(4 * faceCount, 1.0f);
+    if (soupIndices.empty()) return;
+    TriangleBvh bvh;
+    bvh.build(soupPositions.data(), soupPositions.size() / 3, soupIndices.data(), soupIndices.size() / 3);
+    for (size_t f = 0; f < faceCount; ++f) {
+        double centroid[3] = {0, 0, 0};
+        for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < 3; ++k) centroid[k] += double(positions[3 * size_t(indices[3 * f + c]) + k]) / 3.0;
+        const ClosestPoint nearest = closestPoint(bvh, centroid);
+        if (nearest.triangle == ~0u) continue;  // non-finite centroid: stays white
+        std::copy_n(&soupColors[4 * size_t(nearest.triangle)], 4, &faceColors[4 * f]);
+    }
+}
+
+}  // namespace
+
+void nearestSurfaceColors(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
+                          const std::vector<const InputObject*>& originals, std::vector<float>& faceColors) {
+    colorsOfNearest(positions, indices, originals, faceColors);
+}
+
+void nearestSurfaceColors(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
+                          const std::vector<const InputObject*>& originals, std::vector<float>& faceColors) {
+    colorsOfNearest(positions, indices, originals, faceColors);
+}
+
+}  // namespace aggrelod::detail
