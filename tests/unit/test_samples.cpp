@@ -361,10 +361,10 @@ size_t countPrefix(const std::vector<InputObject>& scene, const std::string& pre
 // Smallest and largest gap between an object and its nearest other object, over all objects,
 // measured between vertical columns (a lower bound of the true gap): varied spacing means
 // some objects nearly touch and some stand far from every other one.
-std::pair<double, double> nearestColumnGapRange(const std::vector<InputObject>& scene, const std::string& prefix) {
+std::pair<double, double> nearestColumnGapRange(const std::vector<InputObject>& scene, const std::string& suffix) {
     std::vector<std::array<double, 3>> c;
     for (const auto& o : scene) {
-        if (o.name.rfind(prefix, 0) != 0) continue;
+        if (o.name.size() < suffix.size() || o.name.compare(o.name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
         const Box3 b = boundsOf(o);
         std::array<double, 3> col{0.5 * (b.lo[0] + b.hi[0]), 0.5 * (b.lo[1] + b.hi[1]), 0};
         for (size_t i = 0; i + 2 < o.positions.size(); i += 3)
@@ -400,7 +400,7 @@ TEST(SamplesScenes, ForestTrunksCanopiesVariedSpacing) {
         EXPECT_NEAR(boundsOf(forest[i + 1]).lo[2] - boundsOf(forest[i]).hi[2], 0.05, 1e-9) << forest[i].name;
     }
     // Varied spacing: canopies in clumps nearly touch, scattered ones stand >= 1.5 apart.
-    const auto gaps = nearestColumnGapRange(forest, "tree");
+    const auto gaps = nearestColumnGapRange(forest, "_canopy");
     EXPECT_LT(gaps.first, 0.3);
     EXPECT_GT(gaps.second, 1.5);
 }
