@@ -79,6 +79,15 @@ std::pair<double, double> project(const render::Camera& c, const float q[3], int
     return {(x + 1) * 0.5 * w, (1 - y) * 0.5 * h};
 }
 
+/// The AddressSanitizer build of the CLI when there is one: bad input must not read out of bounds.
+std::string cliForBadInput() {
+#ifdef AGGRELOD_CLI_ASAN
+    return AGGRELOD_CLI_ASAN;
+#else
+    return AGGRELOD_CLI;
+#endif
+}
+
 }  // namespace
 
 TEST(Render, SameBytesTwiceAnyThreadCountAndRequestedSize) {
@@ -199,7 +208,7 @@ TEST(Render, BadInputClearMessageAndExitCode) {
     const fs::path dir = aggrelod::testing::freshTestDir(aggrelod::testing::currentTestName());
     const std::string out = (dir / "x.png").string();
     auto run = [&](std::vector<std::string> args) {
-        args.insert(args.begin(), {AGGRELOD_CLI, "render"});
+        args.insert(args.begin(), {cliForBadInput(), "render"});
         return runProgram(args, dir);
     };
     // Missing file.
