@@ -9,6 +9,7 @@
 #include <aggrelod/collision.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
