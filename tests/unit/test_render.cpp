@@ -8,6 +8,7 @@
 #include <aggrelod/collision.h>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -26,17 +27,25 @@ namespace fs = std::filesystem;
 namespace render = aggrelod::render;
 namespace runtime = aggrelod::runtime;
 
-/// The 15-spheres sample baked once for all tests here (about a second).
-const fs::path& bakedDir() {
-    static const fs::path dir = [] {
-        const fs::path d = aggrelod::testing::freshTestDir("RenderFixture");
-        const auto made = runProgram({AGGRELOD_MAKE_SAMPLE, "spheres15", "--seed", "1", "-o", (d / "s.glb").string()}, d);
+/// The 15-spheres sample baked once per test process (about a second). CTest runs every
+/// test in its own process, in parallel: each process has its own directory, removed at exit.
+struct BakedSample {
+    fs::path dir;
+    BakedSample() {
+        dir = aggrelod::testing::freshTestDir("RenderFixture." + std::to_string(::getpid()));
+        const auto made = runProgram({AGGRELOD_MAKE_SAMPLE, "spheres15", "--seed", "1", "-o", (dir / "s.glb").string()}, dir);
         EXPECT_EQ(made.exitCode, 0) << made.describe();
-        const auto baked = runProgram({AGGRELOD_CLI, "bake", (d / "s.glb").string(), "-o", (d / "out").string(), "--quiet"}, d);
+        const auto baked = runProgram({AGGRELOD_CLI, "bake", (dir / "s.glb").string(), "-o", (dir / "out").string(), "--quiet"}, dir);
         EXPECT_EQ(baked.exitCode, 0) << baked.describe();
-        return d;
-    }();
-    return dir;
+    }
+    ~BakedSample() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    }
+};
+const fs::path& bakedDir() {
+    static const BakedSample sample;
+    return sample.dir;
 }
 fs::path aglodPath() { return bakedDir() / "out" / "scene.aglod"; }
 fs::path levelsPath() { return bakedDir() / "out" / "levels.glb"; }
