@@ -2,6 +2,7 @@
 // charts of reproduce2d. A scanline polygon filler (even-odd per feature), line drawing and
 // a 5x7 bitmap font: enough for clear figures without a graphics dependency.
 #include "geo_io.h"
+#include "raster.h"
 
 #include <algorithm>
 #include <cmath>
@@ -70,6 +71,7 @@ public:
         }
     }
     void text(int x, int y, const std::string& s, Rgb c, int scale = 2);
+    std::vector<unsigned char>& pixels() { return px_; }
     bool save(const std::string& path) const {
         return stbi_write_png(path.c_str(), w_, h_, 3, px_.data(), w_ * 3) != 0;
     }
@@ -310,6 +312,33 @@ bool writeBarChartPng(const BarChart& chart, const std::string& path, std::strin
     }
     if (!img.save(path)) {
         error = path + ": cannot write PNG";
+        return false;
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------
+// Raster helpers for other pictures (raster.h): the same font and PNG writer.
+
+void drawText(std::vector<unsigned char>& rgb, int width, int height, int x, int y,
+              const std::string& text, const unsigned char colour[3], int scale) {
+    if (width <= 0 || height <= 0 || rgb.size() != static_cast<size_t>(width) * height * 3) return;
+    Image image(width, height);
+    image.pixels().swap(rgb);
+    image.text(x, y, text, Rgb{colour[0], colour[1], colour[2]}, scale);
+    image.pixels().swap(rgb);
+}
+
+int textWidth(const std::string& text, int scale) { return static_cast<int>(text.size()) * 6 * scale; }
+
+bool writeRgbPng(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb,
+                 std::string& error) {
+    if (width <= 0 || height <= 0 || rgb.size() != static_cast<size_t>(width) * height * 3) {
+        error = path + ": image size does not match its pixels";
+        return false;
+    }
+    if (stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3) == 0) {
+        error = path + ": cannot write the PNG file";
         return false;
     }
     return true;

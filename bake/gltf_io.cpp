@@ -1220,6 +1220,77 @@ bool readGltfScene(const std::string& path, const SceneReadOptions& options,
     return false;
 }
 
+bool readLevelsGlb(const std::string& path, std::vector<LevelsGlbNode>& out, std::string& error) {
+    out.clear();
+    error.clear();
+    try {
+        tinygltf::Model model;
+        std::vector<Diagnostic> diagnostics;
+        if (!loadModel(path, model, diagnostics, error)) {
+            error = path + ": " + error;
+            return false;
+        }
+        // Geometry through the scene reader (one object per mesh node, world space, checked
+        // accessors); the extras of the node with the same (unique) name give level and group.
+        SceneReadOptions options;
+        options.objectUnit = ObjectUnit::Node;
+        std::vector<InputObject> objects;
+        SceneReader reader(model, options, diagnostics);
+        if (!reader.run(objects, error)) {
+            error = path + ": " + error;
+            return false;
+        }
+        std::map<std::string, int> nodeByName;
+        for (size_t i = 0; i < model.nodes.size(); ++i)
+            if (model.nodes[i].mesh >= 0) nodeByName.emplace(displayName(model, int(i)), int(i));
+        auto number = [](const tinygltf::Value& extras, const char* key, double& value) {
+            if (!extras.IsObject() || !extras.Has(key)) return false;
+            const tinygltf::Value& v = extras.Get(key);
+            if (!v.IsNumber()) return false;
+            value = v.GetNumberAsDouble();
+            return std::isfinite(value);
+        };
+        for (InputObject& object : objects) {
+            const auto found = nodeByName.find(object.name);
+            if (found == nodeByName.end()) {
+                error = path + ": node '" + object.name + "' has a duplicate name: not a levels.glb of aggrelod";
+                return false;
+            }
+            const tinygltf::Value& extras = model.nodes[size_t(found->second)].extras;
+            double level = 0, group = 0, delta = 0;
+            if (!number(extras, "level", level) || level < 0 || level > 1e6 || level != std::floor(level)) {
+                error = path + ": node '" + object.name +
+                        "' has no integer extras.level: not a levels.glb written by aggrelod bake";
+                return false;
+            }
+            number(extras, "group", group);
+            number(extras, "delta", delta);
+            LevelsGlbNode node;
+            node.name = object.name;
+            node.level = uint32_t(level);
+            node.group = group >= 0 && group < 4e9 ? uint32_t(group) : 0;
+            node.delta = delta;
+            node.sourceCount = extras.IsObject() && extras.Has("sources") && extras.Get("sources").IsArray()
+                                   ? uint32_t(extras.Get("sources").ArrayLen())
+                                   : 0;
+            node.positions = std::move(object.positions);
+            node.indices = std::move(object.indices);
+            out.push_back(std::move(node));
+        }
+        if (out.empty()) {
+            error = path + ": no mesh nodes: not a levels.glb written by aggrelod bake";
+            return false;
+        }
+        return true;
+    } catch (const std::bad_alloc&) {
+        error = path + ": out of memory while reading the levels";
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+    }
+    out.clear();
+    return false;
+}
+
 bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string& path,
                      std::string& error) {
     try {

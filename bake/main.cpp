@@ -7,6 +7,7 @@
 // options, and a run<Name>() that does the work; add new subcommands the same way.
 #include "runtime_export.h"
 #include "commands_2d.h"
+#include "commands_render.h"
 #include "scene_io.h"
 #include "terminal.h"
 #include "tiles_export.h"
@@ -507,6 +508,35 @@ CLI::App* addReproduce2DCommand(CLI::App& app, cli::Reproduce2DOptions& o) {
 }
 
 // ---------------------------------------------------------------------------
+// render (work in render_command.cpp)
+
+CLI::App* addRenderCommand(CLI::App& app, cli::RenderOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "render", "Ray-cast a PNG of one level (or, with --sheet, of every level side by side) of a baked .aglod or "
+                  "levels.glb: one colour per aggregate, originals grey");
+    cmd->add_option("file", o.input, "OUTDIR/scene.aglod or OUTDIR/levels.glb written by `aggrelod bake`")->required();
+    cmd->add_option("-o,--output", o.output, "Output PNG")->required();
+    CLI::Option* level = cmd->add_option(
+        "--level", o.level, "Level to draw: a level number or 'originals' (default: originals for .aglod, the first "
+                            "level for levels.glb)");
+    CLI::Option* sheet = cmd->add_flag("--sheet", o.sheet, "Draw every level (and the originals) side by side, labelled");
+    level->excludes(sheet);
+    cmd->add_option("--camera", o.camera,
+                    "Camera x,y,z,tx,ty,tz[,fovDegrees]: eye and target (world units) and vertical field of view "
+                    "(default 25); default: a 3/4 view from the front-right fitting the scene")
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    cmd->add_option("--up", o.up, "Up axis of the scene: y (glTF), z (the samples) or auto (default: the thinner of y and z)")
+        ->transform(CLI::IsMember({"auto", "y", "z"}, CLI::ignore_case));
+    cmd->add_option("--size", o.size, "Image size WIDTHxHEIGHT in pixels (default 640x480; with --sheet 400x300 per panel)");
+    cmd->add_option("--columns", o.columns, "Panels per row of the sheet (default: up to 4)")->check(CLI::Range(0, 64));
+    cmd->add_option("--threads", o.threads, "Ray-casting threads (default 0: 2); output is identical for any count")
+        ->check(CLI::Range(0, 64));
+    cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors");
+    return cmd;
+}
+
+// ---------------------------------------------------------------------------
 
 int run(int argc, char** argv) {
     CLI::App app{"aggrelod: aggregate separate objects into a level-of-detail hierarchy"};
@@ -521,6 +551,8 @@ int run(int argc, char** argv) {
     CLI::App* aggregate2dCommand = addAggregate2DCommand(app, aggregate2d);
     cli::Reproduce2DOptions reproduce2d;
     CLI::App* reproduce2dCommand = addReproduce2DCommand(app, reproduce2d);
+    cli::RenderOptions render;
+    CLI::App* renderCommand = addRenderCommand(app, render);
 
     if (argc <= 1) {
         std::fputs(app.help().c_str(), stderr);
@@ -536,6 +568,7 @@ int run(int argc, char** argv) {
     if (inspectCommand->parsed()) return runInspect(inspect);
     if (aggregate2dCommand->parsed()) return cli::runAggregate2D(aggregate2d);
     if (reproduce2dCommand->parsed()) return cli::runReproduce2D(reproduce2d);
+    if (renderCommand->parsed()) return cli::runRender(render);
     return kUsage;
 }
 

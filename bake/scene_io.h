@@ -31,6 +31,22 @@ struct SceneReadResult {
 bool readGltfScene(const std::string& path, const SceneReadOptions& options,
                    SceneReadResult& out, std::string& error);
 
+/// One mesh node of a levels.glb file (written by writeLevelsGlb).
+struct LevelsGlbNode {
+    std::string name;                ///< node name, e.g. "level2_group5"
+    uint32_t level = 0;              ///< extras.level
+    uint32_t group = 0;              ///< extras.group (aggregate index in its level)
+    double delta = 0;                ///< extras.delta, world units
+    uint32_t sourceCount = 0;        ///< size of extras.sources (1: an original object, not merged)
+    std::vector<double> positions;   ///< world space, 3 per vertex
+    std::vector<uint32_t> indices;   ///< 3 per triangle
+};
+
+/// Reads a levels.glb written by `aggrelod bake`: every node with a mesh, in file order, with
+/// its extras. False with a message naming the node when the file cannot be read or a mesh
+/// node lacks extras.level (not a levels.glb). Never throws.
+bool readLevelsGlb(const std::string& path, std::vector<LevelsGlbNode>& out, std::string& error);
+
 /// Writes objects as a GLB, one node (with extras.id) per object. For samples and tests.
 /// An object with triangleColors gets one material of that colour when all its triangles
 /// share it, else COLOR_0 vertex colours (so reading the file back gives the same colours).

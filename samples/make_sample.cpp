@@ -2,7 +2,7 @@
 //
 //   aggrelod_make_sample NAME -o FILE.glb [--seed N] [options]
 //
-// NAME: two_cubes [--gap G] | slabs | spheres15 | chess [--board] | random [--objects N]
+// NAME: two_cubes [--gap G] | slabs | spheres15 | chess [--board] | forest | village | random [--objects N]
 // [--triangles T]. Exit status: 0 written, 1 could not write, 2 bad command line.
 #include <aggrelod/samples.h>
 
@@ -18,8 +18,8 @@ namespace {
 
 const char* const kUsage =
     "usage: aggrelod_make_sample NAME -o FILE.glb [--seed N] [options]\n"
-    "  NAME       two_cubes | slabs | spheres15 | chess | random\n"
-    "  --seed N   random seed (spheres15, chess, random; default 1)\n"
+    "  NAME       two_cubes | slabs | spheres15 | chess | forest | village | random\n"
+    "  --seed N   random seed (spheres15, chess, forest, village, random; default 1)\n"
     "  --gap G    two_cubes: gap between the cubes (default 0.5)\n"
     "  --board    chess: also write the board, 0.05 below the pieces (default: pieces only)\n"
     "  --objects N    random: object count (default 1000)\n"
@@ -95,6 +95,8 @@ int main(int argc, char** argv) {
         else if (name == "slabs") scene = s::makeOffsetSlabs();
         else if (name == "spheres15") scene = s::makeSpheres15(uint32_t(seed));
         else if (name == "chess") scene = s::makeChessBoard(uint32_t(seed), board);
+        else if (name == "forest") scene = s::makeForest(uint32_t(seed));
+        else if (name == "village") scene = s::makeVillage(uint32_t(seed));
         else if (name == "random") scene = s::makeRandomScene(int(objects), int(triangles), uint32_t(seed));
         else return usage("unknown scene '" + name + "'");
     } catch (const std::exception& e) {

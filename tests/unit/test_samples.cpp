@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <random>
 #include <cmath>
@@ -316,4 +317,144 @@ TEST(SamplesScenes, Deterministic) {
     EXPECT_TRUE(sameScene(s::makeRandomScene(100, 10000, 9), s::makeRandomScene(100, 10000, 9)));
     EXPECT_FALSE(sameScene(s::makeRandomScene(100, 10000, 9), s::makeRandomScene(100, 10000, 10)));
     EXPECT_TRUE(sameScene(s::makeOffsetSlabs(), s::makeOffsetSlabs()));
+}
+
+namespace {
+
+// No two objects overlap, proved by one of: disjoint boxes, disjoint bounding spheres, or
+// disjoint vertical cylinders (circle around the box's xy centre containing every vertex).
+void expectApartInBoxSphereOrColumn(const std::vector<InputObject>& scene, const std::string& label) {
+    struct Column { double x, y, r; };
+    std::vector<Box3> boxes;
+    std::vector<std::pair<s::Vec3, double>> spheres;
+    std::vector<Column> columns;
+    for (const auto& o : scene) {
+        boxes.push_back(boundsOf(o));
+        spheres.push_back(s::boundingSphere(o));
+        Column c{0.5 * (boxes.back().lo[0] + boxes.back().hi[0]), 0.5 * (boxes.back().lo[1] + boxes.back().hi[1]), 0};
+        for (size_t i = 0; i + 2 < o.positions.size(); i += 3)
+            c.r = std::max(c.r, std::hypot(o.positions[i] - c.x, o.positions[i + 1] - c.y));
+        columns.push_back(c);
+    }
+    int failures = 0;
+    for (size_t i = 0; i < scene.size(); ++i)
+        for (size_t j = i + 1; j < scene.size(); ++j) {
+            const bool separated =
+                boxesDisjoint(boxes[i], boxes[j]) ||
+                dist(spheres[i].first, spheres[j].first) > spheres[i].second + spheres[j].second ||
+                std::hypot(columns[i].x - columns[j].x, columns[i].y - columns[j].y) > columns[i].r + columns[j].r;
+            if (!separated && ++failures <= 5)
+                ADD_FAILURE() << label << ": " << scene[i].name << " and " << scene[j].name << " may overlap";
+        }
+    EXPECT_EQ(failures, 0) << label;
+}
+
+size_t countPrefix(const std::vector<InputObject>& scene, const std::string& prefix, const std::string& suffix = "") {
+    size_t n = 0;
+    for (const auto& o : scene)
+        if (o.name.rfind(prefix, 0) == 0 && o.name.size() >= suffix.size() &&
+            o.name.compare(o.name.size() - suffix.size(), suffix.size(), suffix) == 0)
+            ++n;
+    return n;
+}
+
+// Smallest and largest gap between an object and its nearest other object, over all objects,
+// measured between vertical columns (a lower bound of the true gap): varied spacing means
+// some objects nearly touch and some stand far from every other one.
+std::pair<double, double> nearestColumnGapRange(const std::vector<InputObject>& scene, const std::string& suffix) {
+    std::vector<std::array<double, 3>> c;
+    for (const auto& o : scene) {
+        if (o.name.size() < suffix.size() || o.name.compare(o.name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+        const Box3 b = boundsOf(o);
+        std::array<double, 3> col{0.5 * (b.lo[0] + b.hi[0]), 0.5 * (b.lo[1] + b.hi[1]), 0};
+        for (size_t i = 0; i + 2 < o.positions.size(); i += 3)
+            col[2] = std::max(col[2], std::hypot(o.positions[i] - col[0], o.positions[i + 1] - col[1]));
+        c.push_back(col);
+    }
+    double lo = 1e300, hi = 0;
+    for (size_t i = 0; i < c.size(); ++i) {
+        double nearest = 1e300;
+        for (size_t j = 0; j < c.size(); ++j)
+            if (i != j) nearest = std::min(nearest, std::hypot(c[i][0] - c[j][0], c[i][1] - c[j][1]) - c[i][2] - c[j][2]);
+        lo = std::min(lo, nearest);
+        hi = std::max(hi, nearest);
+    }
+    return {lo, hi};
+}
+
+}  // namespace
+
+TEST(SamplesScenes, ForestTrunksCanopiesVariedSpacing) {
+    const auto forest = s::makeForest(1);
+    expectValidScene(forest, "forest");
+    expectApartInBoxSphereOrColumn(forest, "forest");
+    const size_t trunks = countPrefix(forest, "tree", "_trunk"), canopies = countPrefix(forest, "tree", "_canopy");
+    EXPECT_EQ(trunks, canopies);
+    EXPECT_EQ(trunks + canopies, forest.size());
+    EXPECT_GE(trunks, 40u);
+    // Moderate size: bakes in seconds.
+    EXPECT_GE(triangleCount(forest), 4000u);
+    EXPECT_LE(triangleCount(forest), 20000u);
+    // Every canopy stands 0.05 above its trunk (the tree's two objects nearly touch).
+    for (size_t i = 0; i + 1 < forest.size(); i += 2) {
+        EXPECT_NEAR(boundsOf(forest[i + 1]).lo[2] - boundsOf(forest[i]).hi[2], 0.05, 1e-9) << forest[i].name;
+    }
+    // Varied spacing: canopies in clumps nearly touch, scattered ones stand >= 1.5 apart.
+    const auto gaps = nearestColumnGapRange(forest, "_canopy");
+    EXPECT_LT(gaps.first, 0.3);
+    EXPECT_GT(gaps.second, 1.5);
+}
+
+TEST(SamplesScenes, VillageHousesFencesBarrels) {
+    const auto village = s::makeVillage(1);
+    expectValidScene(village, "village");
+    expectNoOverlap(village, "village");  // every object has its own axis-aligned ground rectangle
+    const size_t houses = countPrefix(village, "house"), fences = countPrefix(village, "fence"),
+                 barrels = countPrefix(village, "barrel");
+    EXPECT_EQ(houses + fences + barrels, village.size());
+    EXPECT_GE(houses, 12u);
+    EXPECT_GE(fences, 3u);
+    EXPECT_GE(barrels, 4u);
+    EXPECT_GE(triangleCount(village), 2000u);
+    EXPECT_LE(triangleCount(village), 20000u);
+    // Pitched roofs: a house is taller at its ridge (the middle) than at its walls.
+    for (const auto& o : village) {
+        if (o.name.rfind("house", 0) != 0) continue;
+        const Box3 b = boundsOf(o);
+        double wallTop = 0;
+        for (size_t i = 0; i + 2 < o.positions.size(); i += 3)
+            if (std::fabs(o.positions[i] - b.lo[0]) < 1e-9) wallTop = std::max(wallTop, o.positions[i + 2]);
+        EXPECT_GT(b.hi[2], wallTop + 1.0) << o.name;
+    }
+    // Varied spacing: terraced houses 0.6-1.2 apart, open plots 3-8 apart.
+    std::vector<Box3> houseBoxes;
+    for (const auto& o : village)
+        if (o.name.rfind("house", 0) == 0) houseBoxes.push_back(boundsOf(o));
+    double smallest = 1e300, largest = 0;
+    for (size_t i = 0; i < houseBoxes.size(); ++i) {
+        double nearest = 1e300;
+        for (size_t j = 0; j < houseBoxes.size(); ++j) {
+            if (i == j) continue;
+            const double dx = std::max({0.0, houseBoxes[j].lo[0] - houseBoxes[i].hi[0], houseBoxes[i].lo[0] - houseBoxes[j].hi[0]});
+            const double dy = std::max({0.0, houseBoxes[j].lo[1] - houseBoxes[i].hi[1], houseBoxes[i].lo[1] - houseBoxes[j].hi[1]});
+            nearest = std::min(nearest, std::hypot(dx, dy));
+        }
+        smallest = std::min(smallest, nearest);
+        largest = std::max(largest, nearest);
+    }
+    EXPECT_LT(smallest, 1.3);
+    EXPECT_GT(largest, 2.9);
+}
+
+TEST(SamplesScenes, ForestAndVillageDeterministic) {
+    EXPECT_TRUE(sameScene(s::makeForest(7), s::makeForest(7)));
+    EXPECT_TRUE(sameScene(s::makeVillage(7), s::makeVillage(7)));
+    EXPECT_FALSE(sameScene(s::makeForest(7), s::makeForest(8)));
+    EXPECT_FALSE(sameScene(s::makeVillage(7), s::makeVillage(8)));
+    for (uint32_t seed : {2u, 3u, 4u}) {
+        expectValidScene(s::makeForest(seed), "forest seed " + std::to_string(seed));
+        expectApartInBoxSphereOrColumn(s::makeForest(seed), "forest seed " + std::to_string(seed));
+        expectValidScene(s::makeVillage(seed), "village seed " + std::to_string(seed));
+        expectNoOverlap(s::makeVillage(seed), "village seed " + std::to_string(seed));
+    }
 }

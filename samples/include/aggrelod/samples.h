@@ -130,6 +130,21 @@ std::vector<InputObject> makeChessBoard(uint32_t seed, bool withBoard = false);
 std::vector<InputObject> makeRandomScene(int objectCount, int approxTotalTriangles,
                                          uint32_t seed);
 
+/// Forest (samples/outdoor_scenes.cpp): 36 x 36 ground (z = 0, z up), 5-7 dense clumps of
+/// 6-12 trees (neighbouring canopies 0.1-0.8 apart), about 18 scattered trees (>= 1.5 from any
+/// other) and two clearings. A tree is two objects: "treeNNN_trunk" (cylinder, 32 triangles) and,
+/// 0.05 above it, "treeNNN_canopy": a sphere (broadleaf, 144 triangles) or a cone (conifer, 72
+/// triangles). Every part of a tree lies inside the vertical cylinder of its canopy radius
+/// (0.8-1.5) around its axis; those cylinders are >= 0.1 apart, so no two objects overlap.
+std::vector<InputObject> makeForest(uint32_t seed);
+
+/// Village (samples/outdoor_scenes.cpp): two rows of houses along a street (the x axis, z up),
+/// tight terraces (0.6-1.2 apart) mixed with open plots (3-8 apart). Objects: "houseNNN" (walls
+/// and pitched roof in one prism, 4-6.5 x 4-6), "fenceNNN" (pickets on a rail, 0.06 thick, in
+/// front of some houses), "barrelNNN" (bulged lathe, 0.76 across, 1-4 by a side wall). All
+/// ground rectangles are axis-aligned and >= 0.05 apart (houses >= 0.3), so no overlaps.
+std::vector<InputObject> makeVillage(uint32_t seed);
+
 // ---------------------------------------------------------------------------------------
 // Checks (used by the tests and by aggrelod_make_sample before writing).
 // ---------------------------------------------------------------------------------------
