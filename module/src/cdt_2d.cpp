@@ -75,14 +75,25 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
         out.points.push_back(v->point().y());
         out.vertexInput.push_back(keyed[i].first < static_cast<long long>(n) ? static_cast<int>(keyed[i].first) : -1);
     }
-    std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> faces;
-    faces.reserve(cdt.number_of_faces());
+    // Faces by sorted vertex triple: a counting sort on the smallest vertex, then tiny sorts.
+    std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> unsortedFaces, faces;
+    unsortedFaces.reserve(cdt.number_of_faces());
+    std::vector<uint32_t> bucketStart(keyed.size() + 1, 0);
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
         std::array<int, 3> key{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
         std::sort(key.begin(), key.end());
-        faces.emplace_back(key, f);
+        ++bucketStart[key[0] + 1];
+        unsortedFaces.emplace_back(key, f);
     }
-    std::sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (size_t v = 0; v < keyed.size(); ++v) bucketStart[v + 1] += bucketStart[v];
+    faces.resize(unsortedFaces.size());
+    {
+        std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
+        for (const auto& f : unsortedFaces) faces[fill[f.first[0]]++] = f;
+    }
+    for (size_t v = 0; v < keyed.size(); ++v)
+        std::sort(faces.begin() + bucketStart[v], faces.begin() + bucketStart[v + 1],
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
     for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
     for (size_t i = 0; i < faces.size(); ++i) faces[i].second->info() = static_cast<int>(i);
     out.faces.resize(3 * faces.size());

@@ -186,8 +186,11 @@ struct FreeSpaceModels {
 };
 
 /// Stages 3-5 on the triangulation in space.tri: inside/outside, models, voids, model pairs.
+/// graphOnly: only what the dendrogram and the Steiner points need (models, pairs with their
+/// shortest connection, edge lengths); no voids, per-pair length statistics, edge pairs or
+/// model points (the pass before the Steiner points, whose result is replaced).
 void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
-                    FreeSpaceModels& models) {
+                    FreeSpaceModels& models, bool graphOnly) {
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
 
@@ -214,10 +217,12 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         const int* v = &tri.faces[3 * f];
         auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
         const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
-        double longest = 0;
-        for (int k = 0; k < 3; ++k)
-            longest = std::max(longest, std::hypot(P((k + 1) % 3)[0] - P(k)[0], P((k + 1) % 3)[1] - P(k)[1]));
-        sliver[f] = area2 <= 1e-12 * longest * longest;
+        double longest2 = 0;  // squared
+        for (int k = 0; k < 3; ++k) {
+            const double dx = P((k + 1) % 3)[0] - P(k)[0], dy = P((k + 1) % 3)[1] - P(k)[1];
+            longest2 = std::max(longest2, dx * dx + dy * dy);
+        }
+        sliver[f] = area2 <= 1e-12 * longest2;
     }
     auto unreliable = [&](int f, int j) {
         const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
@@ -307,8 +312,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     space.faceModel.assign(faceCount, -1);
     for (size_t f = 0; f < faceCount; ++f)
         if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;
-    space.modelPoints.resize(space.modelCount);
-    for (size_t v = 0; v < in.part.size(); ++v) {
+    if (!graphOnly) space.modelPoints.resize(space.modelCount);
+    for (size_t v = 0; v < in.part.size() && !graphOnly; ++v) {
         auto& pts = space.modelPoints[partModel[in.part[v]]];
         pts.push_back(in.x(v));
         pts.push_back(in.y(v));
@@ -317,7 +322,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // Voids: free faces not reachable from the hull through free faces (input holes, or
     // gaps enclosed by touching polygons) and owned by one model only: never filled.
     space.faceVoid.assign(faceCount, 0);
-    {
+    if (!graphOnly) {
         std::vector<char> reached(faceCount, 0);
         std::vector<int> stack;
         for (size_t f = 0; f < faceCount; ++f)
@@ -356,7 +361,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // shortest connection seen in a free triangle (edge, or vertex to a model's boundary edge).
     space.faceArea.resize(faceCount);
     space.edgeLength.resize(3 * faceCount);
-    space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
+    if (!graphOnly) space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
     struct PairEntry {
         uint32_t a, b;
         double length;   // free edge length, or -1 for a distance-only entry
@@ -373,7 +378,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                                    (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
         for (int j = 0; j < 3; ++j) {
             const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
-            space.edgeLength[3 * f + j] = std::hypot(P(w)[0] - P(u)[0], P(w)[1] - P(u)[1]);
+            const double dx = P(w)[0] - P(u)[0], dy = P(w)[1] - P(u)[1];
+            space.edgeLength[3 * f + j] = std::sqrt(dx * dx + dy * dy);  // not hypot: 5x slower, no overflow risk here
         }
         if (space.faceModel[f] >= 0) continue;
         for (int j = 0; j < 3; ++j) {
@@ -397,9 +403,23 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                                static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
         }
     }
-    std::sort(entries.begin(), entries.end(), [](const PairEntry& x, const PairEntry& y) {
-        return std::tie(x.a, x.b, x.distance, x.face) < std::tie(y.a, y.b, y.distance, y.face);
-    });
+    // Sorted by (a, b, distance, face, edge, connection): a counting sort on a, then small
+    // sorts per model (much cheaper than one sort of the whole array; same total order).
+    {
+        std::vector<uint32_t> start(space.modelCount + 1, 0);
+        for (const PairEntry& e : entries) ++start[e.a + 1];
+        for (size_t m = 0; m < space.modelCount; ++m) start[m + 1] += start[m];
+        std::vector<PairEntry> bucketed(entries.size());
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+        for (const PairEntry& e : entries) bucketed[fill[e.a]++] = e;
+        auto less = [](const PairEntry& x, const PairEntry& y) {
+            return std::tie(x.b, x.distance, x.face, x.faceEdge, x.connection[0], x.connection[1], x.connection[2]) <
+                   std::tie(y.b, y.distance, y.face, y.faceEdge, y.connection[0], y.connection[1], y.connection[2]);
+        };
+        for (size_t m = 0; m < space.modelCount; ++m)
+            std::sort(bucketed.begin() + start[m], bucketed.begin() + start[m + 1], less);
+        entries = std::move(bucketed);
+    }
     for (size_t i = 0; i < entries.size();) {
         size_t e = i;
         ModelPair2D pair;
@@ -409,9 +429,14 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         pair.bestFace[0] = entries[i].face;
         std::copy(entries[i].connection, entries[i].connection + 3, pair.connection);
         for (; e < entries.size() && entries[e].a == pair.a && entries[e].b == pair.b; ++e) {
-            if (entries[e].length >= 0) pair.lengths.push_back(entries[e].length);
+            if (entries[e].length >= 0 && !graphOnly) pair.lengths.push_back(entries[e].length);
             if (pair.bestFace[1] < 0 && entries[e].distance == pair.minDistance && entries[e].face != pair.bestFace[0])
                 pair.bestFace[1] = entries[e].face;
+        }
+        if (graphOnly) {
+            space.pairs.push_back(std::move(pair));
+            i = e;
+            continue;
         }
         std::sort(pair.lengths.begin(), pair.lengths.end());
         pair.prefixSum.assign(pair.lengths.size() + 1, 0);
@@ -425,7 +450,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         space.pairs.push_back(std::move(pair));
         i = e;
     }
-    for (size_t f = 0; f < faceCount; ++f)
+    for (size_t f = 0; f < faceCount && !graphOnly; ++f)
         for (int j = 0; j < 3; ++j) {
             const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
             if (space.vertexModel[u] < 0 || space.vertexModel[w] < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
@@ -592,7 +617,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     ConstrainedTriangulation2D triangulation;
     if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
     endStage("triangulate");
-    buildFreeSpace(in, checked, space, models);
+    buildFreeSpace(in, checked, space, models, /*graphOnly=*/true);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
     // the edges GEOS's ConcaveHullOfPolygons takes for its length ratio.
     out.freeEdgeMin = INFINITY;
@@ -623,24 +648,30 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     if (!requests.empty()) {
         // The new vertices go into the live triangulation with their constraints split
         // exactly; segments that cannot be split that way keep no new vertex.
-        const std::vector<double> allPoints = inputVertices(checked, splits).points;
+        InputVertices split = inputVertices(checked, splits);
         std::vector<char> applied;
         space = FreeSpace2D{};
-        if (!triangulation.splitConstraints(requests, applied, allPoints, space.tri, error)) return fail(error);
+        if (!triangulation.splitConstraints(requests, applied, split.points, space.tri, error)) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
             if (!applied[k]) {
                 splits[requestSegment[k]].clear();
                 allApplied = false;
             }
-        in = inputVertices(checked, splits);
+        in = allApplied ? std::move(split) : inputVertices(checked, splits);
         if (!allApplied) {
             // Numbering must follow the final input points: export again without the skipped ones.
             if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error)) return fail(error);
         }
         endStage("triangulate with Steiner points");
-        buildFreeSpace(in, checked, space, models);
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+        endStage("free space and graph again");
+    } else {
+        Triangulation2D tri = std::move(space.tri);
+        space = FreeSpace2D{};
+        space.tri = std::move(tri);  // no Steiner point: complete the graph-only pass
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false);
         endStage("free space and graph again");
     }
     out.vertexCount = space.tri.vertexCount();
