@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 namespace aggrelod::detail {
 namespace {
@@ -251,30 +250,37 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
         if (a.from != b.from) return a.from < b.from;
         return a.to < b.to;
     });
-    // Face components (edge-connected kept faces of one group): holes join the exterior of theirs.
-    std::vector<uint32_t> parent(faceCount);
-    std::iota(parent.begin(), parent.end(), 0u);
-    for (size_t f = 0; f < faceCount; ++f) {
-        if (faceLabel[f] < 0) continue;
-        for (int j = 0; j < 3; ++j) {
-            const int n = tri.neighbors[3 * f + j];
-            if (n < 0 || faceLabel[n] != faceLabel[f]) continue;
-            uint32_t a = findRoot(parent, static_cast<uint32_t>(f)), b = findRoot(parent, static_cast<uint32_t>(n));
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    // Face components (edge-connected kept faces of one group): holes join the exterior of
+    // theirs. Built only when a level has a hole.
+    std::vector<uint32_t> parent;
+    auto componentOf = [&](int face) {
+        if (parent.empty()) {
+            parent.resize(faceCount);
+            std::iota(parent.begin(), parent.end(), 0u);
+            for (size_t f = 0; f < faceCount; ++f) {
+                if (faceLabel[f] < 0) continue;
+                for (int j = 0; j < 3; ++j) {
+                    const int n = tri.neighbors[3 * f + j];
+                    if (n < 0 || faceLabel[n] != faceLabel[f]) continue;
+                    uint32_t a = findRoot(parent, static_cast<uint32_t>(f)), b = findRoot(parent, static_cast<uint32_t>(n));
+                    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+                }
+            }
         }
-    }
+        return findRoot(parent, static_cast<uint32_t>(face));
+    };
     auto px = [&](int v) { return tri.points[2 * static_cast<size_t>(v)]; };
     auto py = [&](int v) { return tri.points[2 * static_cast<size_t>(v) + 1]; };
     std::vector<char> used(edges.size(), 0);
     struct Loop {
         std::vector<double> ring;
         double area;
-        uint32_t component;
+        int face;  // a face on the loop's left: its component
     };
     std::vector<Loop> loops;
     size_t groupBegin = 0;
     std::vector<size_t> trace, stack;
-    std::unordered_map<int, size_t> stackPos;  // lookup only, never iterated
+    std::vector<size_t> stackPos(tri.vertexCount(), SIZE_MAX);  // per vertex: its place on the stack
     while (groupBegin < edges.size()) {
         const int g = edges[groupBegin].group;
         size_t groupEnd = groupBegin;
@@ -297,6 +303,14 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
                 trace.push_back(cur);
                 const HalfEdge& e = edges[cur];
                 auto [lo, hi] = outgoing(e.to);
+                if (hi - lo == 1) {  // the usual case: a single way on
+                    if (lo == start || !used[lo]) {
+                        if (lo == start) break;
+                        cur = lo;
+                        continue;
+                    }
+                    break;
+                }
                 const double backAngle = std::atan2(py(e.from) - py(e.to), px(e.from) - px(e.to));
                 size_t next = SIZE_MAX;
                 double bestTurn = INFINITY;
@@ -316,7 +330,6 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             }
             // Split at repeated vertices so every ring is simple.
             stack.clear();
-            stackPos.clear();
             auto emit = [&](size_t fromIndex) {
                 Loop loop;
                 for (size_t i = fromIndex; i < stack.size(); ++i) {
@@ -324,14 +337,13 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
                     loop.ring.push_back(py(edges[stack[i]].from));
                 }
                 loop.area = ringSignedArea(loop.ring);
-                loop.component = findRoot(parent, static_cast<uint32_t>(edges[stack[fromIndex]].face));
-                for (size_t i = fromIndex; i < stack.size(); ++i) stackPos.erase(edges[stack[i]].from);
+                loop.face = edges[stack[fromIndex]].face;
+                for (size_t i = fromIndex; i < stack.size(); ++i) stackPos[edges[stack[i]].from] = SIZE_MAX;
                 stack.resize(fromIndex);
                 if (loop.ring.size() >= 6 && loop.area != 0) loops.push_back(std::move(loop));
             };
             for (size_t h : trace) {
-                auto it = stackPos.find(edges[h].from);
-                if (it != stackPos.end()) emit(it->second);
+                if (stackPos[edges[h].from] != SIZE_MAX) emit(stackPos[edges[h].from]);
                 stackPos[edges[h].from] = stack.size();
                 stack.push_back(h);
             }
@@ -339,13 +351,12 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
         }
         // Exteriors (counter-clockwise) and holes (clockwise), holes to the exterior of their component.
         Aggregate2D& agg = aggregates[g];
-        std::vector<size_t> exteriorOfLoop(loops.size(), SIZE_MAX);
-        std::vector<uint32_t> polygonComponent;
+        std::vector<size_t> polygonComponent, exteriorLoop;
         for (size_t i = 0; i < loops.size(); ++i) {
             if (loops[i].area <= 0) continue;
-            exteriorOfLoop[i] = agg.polygons.size();
+            exteriorLoop.push_back(i);
             agg.polygons.push_back(Polygon2D{loops[i].ring, {}});
-            polygonComponent.push_back(loops[i].component);
+            polygonComponent.push_back(SIZE_MAX);  // filled when a hole needs it
         }
         for (size_t i = 0; i < loops.size(); ++i) {
             if (loops[i].area > 0) continue;
@@ -353,8 +364,10 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             double bestArea = INFINITY;
             const double mx = 0.5 * (loops[i].ring[0] + loops[i].ring[2]);
             const double my = 0.5 * (loops[i].ring[1] + loops[i].ring[3]);
+            const uint32_t holeComponent = componentOf(loops[i].face);
             for (size_t p = 0; p < agg.polygons.size(); ++p) {
-                if (polygonComponent[p] != loops[i].component) continue;
+                if (polygonComponent[p] == SIZE_MAX) polygonComponent[p] = componentOf(loops[exteriorLoop[p]].face);
+                if (polygonComponent[p] != holeComponent) continue;
                 const std::vector<double>& ring = agg.polygons[p].exterior;
                 const double a = ringSignedArea(ring);
                 if (a >= bestArea) continue;
