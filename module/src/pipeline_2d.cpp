@@ -706,10 +706,12 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
     std::vector<int> mergePair;  // per merge: its index in space.pairs
     for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
-    // F of every pair at every level, on the calling thread (a custom function is user code).
+    // F of every pair at every level: a custom function (user code) on the calling thread, the
+    // built-in ones inside the parallel level loop below.
     const size_t levelCount = deltas.size();
     std::vector<EdgeLimits2D> primaryLimits(levelCount), constantLimits(levelCount), adaptiveLimits(levelCount);
-    for (size_t li = 0; li < levelCount; ++li) {
+    const bool limitsInLevels = !settings.customFunction;
+    for (size_t li = 0; li < levelCount && !limitsInLevels; ++li) {
         if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
         if (settings.computeBaselines) {
             constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
@@ -719,6 +721,13 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     // Levels are independent: sculpted in parallel, each writing only its own slot.
     out.levels.resize(levelCount);
     auto buildLevel = [&](size_t li) {
+        if (limitsInLevels) {
+            if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
+            if (settings.computeBaselines) {
+                constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
+                adaptiveLimits[li] = computeEdgeLimits2D(space, deltas[li], adaptive);
+            }
+        }
         Level2D& level = out.levels[li];
         std::vector<int> label;
         level.delta = deltas[li];

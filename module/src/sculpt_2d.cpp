@@ -76,6 +76,7 @@ struct Sculptor2D {
     const EdgeLimits2D& limits;
     std::vector<int>& label;
     std::vector<char> isProtected;
+    std::vector<int> bestFan, fanPath;  // scratch of protectFanTo, reused
 
     const Triangulation2D& tri() const { return space.tri; }
     int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>(modelGroup[m]); }
@@ -117,7 +118,9 @@ struct Sculptor2D {
             if (n >= 0 && space.faceModel[n] == model) return;  // already shares an edge
         }
         // The fan of least total area: the one hugging the corner, not a sliver along a side.
-        std::vector<int> best, path;
+        std::vector<int>& best = bestFan;
+        std::vector<int>& path = fanPath;
+        best.clear();
         bool found = false;
         double bestArea = INFINITY;
         for (int k = 0; k < 3; ++k) {
@@ -207,7 +210,7 @@ struct HalfEdge {
 
 void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
                    const std::vector<int>& joinedPairs, std::vector<int>& faceLabel) {
-    Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
+    Sculptor2D s{space, modelGroup, limits, faceLabel, {}, {}, {}};
     s.initialLabels();
     for (int p : joinedPairs)
         if (p >= 0) s.protectConnection(p);
