@@ -38,16 +38,21 @@ namespace {
 // after, in CGAL's order, which is deterministic for a given input); faces by their sorted
 // vertex triple. Neither depends on CGAL's storage order.
 void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
-                         std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
+                         const std::vector<size_t>* pointOrder, std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
-    std::vector<size_t> order(n);
-    std::iota(order.begin(), order.end(), size_t{0});
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-        if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
-        if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
-        return a < b;
-    });
+    std::vector<size_t> ownOrder;
+    if (!pointOrder || pointOrder->size() != n) {
+        ownOrder.resize(n);
+        std::iota(ownOrder.begin(), ownOrder.end(), size_t{0});
+        std::sort(ownOrder.begin(), ownOrder.end(), [&](size_t a, size_t b) {
+            if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
+            if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
+            return a < b;
+        });
+        pointOrder = &ownOrder;
+    }
+    const std::vector<size_t>& order = *pointOrder;
     std::vector<std::pair<long long, Cdt::Vertex_handle>> keyed;
     keyed.reserve(cdt.number_of_vertices());
     long long steinerKey = static_cast<long long>(n);
@@ -113,7 +118,7 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
 
 bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
                                        const std::vector<std::pair<size_t, size_t>>& segments, Triangulation2D& out,
-                                       std::string& error) {
+                                       std::string& error, const std::vector<size_t>* pointOrder) {
     const size_t n = points.size() / 2;
     try {
         impl_->cdt.clear();
@@ -122,7 +127,7 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
         impl_->inputHandle.assign(n, Cdt::Vertex_handle());
-        exportTriangulation(impl_->cdt, points, out, &impl_->inputHandle);
+        exportTriangulation(impl_->cdt, points, out, pointOrder, &impl_->inputHandle);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -132,7 +137,8 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
 
 bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSplit>& splits,
                                                   std::vector<char>& applied, const std::vector<double>& allPoints,
-                                                  Triangulation2D& out, std::string& error) {
+                                                  Triangulation2D& out, std::string& error,
+                                                  const std::vector<size_t>* allPointOrder) {
     applied.assign(splits.size(), 0);
     try {
         Cdt& cdt = impl_->cdt;
@@ -157,7 +163,7 @@ bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSp
             cdt.insert_constraint(previous, vb);
             applied[k] = 1;
         }
-        exportTriangulation(cdt, allPoints, out);
+        exportTriangulation(cdt, allPoints, out, allPointOrder);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;

@@ -615,7 +615,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    if (!triangulation.build(in.points, in.segments, space.tri, error, &in.sorted)) return fail(error);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
@@ -651,7 +651,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         InputVertices split = inputVertices(checked, splits);
         std::vector<char> applied;
         space = FreeSpace2D{};
-        if (!triangulation.splitConstraints(requests, applied, split.points, space.tri, error)) return fail(error);
+        if (!triangulation.splitConstraints(requests, applied, split.points, space.tri, error, &split.sorted))
+            return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
             if (!applied[k]) {
@@ -661,7 +662,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         in = allApplied ? std::move(split) : inputVertices(checked, splits);
         if (!allApplied) {
             // Numbering must follow the final input points: export again without the skipped ones.
-            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error)) return fail(error);
+            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error, &in.sorted)) return fail(error);
         }
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models, /*graphOnly=*/false);
