@@ -52,20 +52,27 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
         });
         pointOrder = &ownOrder;
     }
-    const std::vector<size_t>& order = *pointOrder;
+    // The sorted points as one contiguous array: binary searches without indirection.
+    struct SortedPoint {
+        double x, y;
+        size_t index;
+    };
+    std::vector<SortedPoint> sorted;
+    sorted.reserve(n);
+    for (size_t i : *pointOrder) sorted.push_back({points[2 * i], points[2 * i + 1], i});
     std::vector<std::pair<long long, Cdt::Vertex_handle>> keyed;
     keyed.reserve(cdt.number_of_vertices());
     long long steinerKey = static_cast<long long>(n);
     for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
         const double x = v->point().x(), y = v->point().y();
-        auto it = std::lower_bound(order.begin(), order.end(), size_t{0}, [&](size_t a, size_t) {
-            return points[2 * a] < x || (points[2 * a] == x && points[2 * a + 1] < y);
+        auto it = std::lower_bound(sorted.begin(), sorted.end(), 0, [&](const SortedPoint& a, int) {
+            return a.x < x || (a.x == x && a.y < y);
         });
-        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y) {
-            keyed.emplace_back(static_cast<long long>(*it), v);
+        if (it != sorted.end() && it->x == x && it->y == y) {
+            keyed.emplace_back(static_cast<long long>(it->index), v);
             if (inputHandle)
-                for (auto same = it; same != order.end() && points[2 * *same] == x && points[2 * *same + 1] == y; ++same)
-                    (*inputHandle)[*same] = v;
+                for (auto same = it; same != sorted.end() && same->x == x && same->y == y; ++same)
+                    (*inputHandle)[same->index] = v;
         } else {
             keyed.emplace_back(steinerKey++, v);
         }

@@ -29,6 +29,7 @@ struct FreeSpace2D {
     size_t modelCount = 0;
     std::vector<int> vertexModel;    ///< per vertex: owning model, -1 for Steiner points
     std::vector<int> faceModel;      ///< per face: model whose interior it is, -1 for free space
+    std::vector<int> cornerModel;    ///< 3 * faceCount: vertexModel of each corner (read by every level)
     std::vector<char> faceVoid;      ///< per face: free, enclosed by one model (an input hole): never filled
     std::vector<double> faceArea;    ///< per face
     std::vector<double> edgeLength;  ///< 3 * faceCount: edge opposite corner i

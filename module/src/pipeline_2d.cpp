@@ -309,6 +309,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     space.vertexModel.assign(vertexCount, -1);
     for (size_t v = 0; v < vertexCount; ++v)
         if (vertexPart[v] >= 0) space.vertexModel[v] = partModel[vertexPart[v]];
+    space.cornerModel.resize(3 * faceCount);
+    for (size_t c = 0; c < 3 * faceCount; ++c) space.cornerModel[c] = space.vertexModel[tri.faces[c]];
     space.faceModel.assign(faceCount, -1);
     for (size_t f = 0; f < faceCount; ++f)
         if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;

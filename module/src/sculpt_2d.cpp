@@ -94,7 +94,7 @@ struct Sculptor2D {
             int group = -1;
             bool mixed = false;
             for (int k = 0; k < 3; ++k) {
-                const int g = groupOfModel(space.vertexModel[tri().faces[3 * f + k]]);
+                const int g = groupOfModel(space.cornerModel[3 * f + k]);
                 if (g < 0) continue;
                 if (group < 0) group = g;
                 else if (g != group) mixed = true;
