@@ -190,7 +190,7 @@ struct FreeSpaceModels {
 /// shortest connection, edge lengths); no voids, per-pair length statistics, edge pairs or
 /// model points (the pass before the Steiner points, whose result is replaced).
 void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
-                    FreeSpaceModels& models, bool graphOnly) {
+                    FreeSpaceModels& models, bool graphOnly, int threadCount) {
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
 
@@ -372,9 +372,14 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         int connection[3];  // see ModelPair2D::connection
         long long faceEdge; // 3 * face + edge for an edge entry, -1 for a distance-only entry
     };
-    std::vector<PairEntry> entries;
     auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
-    for (size_t f = 0; f < faceCount; ++f) {
+    // Faces in blocks on all threads; each block writes its own faces and entry list (the
+    // entries are then sorted by a total order, so the block order does not matter).
+    const size_t blockCount = std::clamp<size_t>(faceCount / 8192, 1, 64);
+    std::vector<std::vector<PairEntry>> blockEntries(blockCount);
+    parallelFor(blockCount, threadCount, [&](size_t block) {
+    std::vector<PairEntry>& entries = blockEntries[block];
+    for (size_t f = faceCount * block / blockCount; f < faceCount * (block + 1) / blockCount; ++f) {
         const int* v = &tri.faces[3 * f];
         space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
                                    (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
@@ -405,6 +410,17 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                                static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
         }
     }
+    });
+    std::vector<PairEntry> entries;
+    {
+        size_t total = 0;
+        for (const auto& b : blockEntries) total += b.size();
+        entries.reserve(total);
+        for (auto& b : blockEntries) {
+            entries.insert(entries.end(), b.begin(), b.end());
+            std::vector<PairEntry>().swap(b);
+        }
+    }
     // Sorted by (a, b, distance, face, edge, connection): a counting sort on a, then small
     // sorts per model (much cheaper than one sort of the whole array; same total order).
     {
@@ -418,8 +434,11 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
             return std::tie(x.b, x.distance, x.face, x.faceEdge, x.connection[0], x.connection[1], x.connection[2]) <
                    std::tie(y.b, y.distance, y.face, y.faceEdge, y.connection[0], y.connection[1], y.connection[2]);
         };
-        for (size_t m = 0; m < space.modelCount; ++m)
-            std::sort(bucketed.begin() + start[m], bucketed.begin() + start[m + 1], less);
+        const size_t modelBlocks = std::clamp<size_t>(space.modelCount / 1024, 1, 64);
+        parallelFor(modelBlocks, threadCount, [&](size_t block) {
+            for (size_t m = space.modelCount * block / modelBlocks; m < space.modelCount * (block + 1) / modelBlocks; ++m)
+                std::sort(bucketed.begin() + start[m], bucketed.begin() + start[m + 1], less);
+        });
         entries = std::move(bucketed);
     }
     for (size_t i = 0; i < entries.size();) {
@@ -619,7 +638,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     ConstrainedTriangulation2D triangulation;
     if (!triangulation.build(in.points, in.segments, space.tri, error, &in.sorted)) return fail(error);
     endStage("triangulate");
-    buildFreeSpace(in, checked, space, models, /*graphOnly=*/true);
+    buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
     // the edges GEOS's ConcaveHullOfPolygons takes for its length ratio.
     out.freeEdgeMin = INFINITY;
@@ -667,14 +686,14 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error, &in.sorted)) return fail(error);
         }
         endStage("triangulate with Steiner points");
-        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false);
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
         endStage("free space and graph again");
     } else {
         Triangulation2D tri = std::move(space.tri);
         space = FreeSpace2D{};
         space.tri = std::move(tri);  // no Steiner point: complete the graph-only pass
-        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false);
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
         endStage("free space and graph again");
     }
     out.vertexCount = space.tri.vertexCount();
