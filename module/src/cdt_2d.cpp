@@ -4,6 +4,8 @@
 // done by the caller (CGAL 5.5 has no mark_domain_in_triangulation).
 #include "cdt_2d.h"
 
+#include "parallel_for.h"
+
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
@@ -37,7 +39,7 @@ namespace {
 // Flat export. Vertices are numbered in the order of their input point (Steiner points
 // after, in CGAL's order, which is deterministic for a given input); faces by their sorted
 // vertex triple. Neither depends on CGAL's storage order.
-void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
+void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out, int threadCount,
                          const std::vector<size_t>* pointOrder, std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
@@ -106,19 +108,27 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
     for (size_t v = 0; v < keyed.size(); ++v)
         std::sort(faces.begin() + bucketStart[v], faces.begin() + bucketStart[v + 1],
                   [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
+    // Infinite faces (around the infinite vertex) are -1; every finite one gets its number.
+    {
+        auto first = cdt.incident_faces(cdt.infinite_vertex()), f = first;
+        if (f != nullptr) do f->info() = -1; while (++f != first);
+    }
     for (size_t i = 0; i < faces.size(); ++i) faces[i].second->info() = static_cast<int>(i);
     out.faces.resize(3 * faces.size());
     out.neighbors.resize(3 * faces.size());
     out.constrained.resize(3 * faces.size());
-    for (size_t i = 0; i < faces.size(); ++i) {
-        Cdt::Face_handle f = faces[i].second;
-        for (int k = 0; k < 3; ++k) {
-            out.faces[3 * i + k] = f->vertex(k)->info();
-            out.neighbors[3 * i + k] = f->neighbor(k)->info();
-            out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
+    // Read-only from here: blocks of faces on all threads, each writing its own slots.
+    const size_t blockCount = std::clamp<size_t>(faces.size() / 8192, 1, 64);
+    parallelFor(blockCount, threadCount, [&](size_t block) {
+        for (size_t i = faces.size() * block / blockCount; i < faces.size() * (block + 1) / blockCount; ++i) {
+            Cdt::Face_handle f = faces[i].second;
+            for (int k = 0; k < 3; ++k) {
+                out.faces[3 * i + k] = f->vertex(k)->info();
+                out.neighbors[3 * i + k] = f->neighbor(k)->info();
+                out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
+            }
         }
-    }
+    });
 }
 
 }  // namespace
@@ -134,7 +144,7 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
         impl_->inputHandle.assign(n, Cdt::Vertex_handle());
-        exportTriangulation(impl_->cdt, points, out, pointOrder, &impl_->inputHandle);
+        exportTriangulation(impl_->cdt, points, out, threadCount_, pointOrder, &impl_->inputHandle);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -170,7 +180,7 @@ bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSp
             cdt.insert_constraint(previous, vb);
             applied[k] = 1;
         }
-        exportTriangulation(cdt, allPoints, out, allPointOrder);
+        exportTriangulation(cdt, allPoints, out, threadCount_, allPointOrder);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;

@@ -515,11 +515,20 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
             }
         }
     }
-    in.sorted.resize(in.part.size());
-    std::iota(in.sorted.begin(), in.sorted.end(), size_t{0});
-    std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
-        return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
-    });
+    {
+        // Sorted as contiguous (x, y, index) triples: no indirection in the comparisons.
+        struct Key {
+            double x, y;
+            size_t index;
+        };
+        std::vector<Key> keys(in.part.size());
+        for (size_t i = 0; i < keys.size(); ++i) keys[i] = {in.x(i), in.y(i), i};
+        std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+            return std::tie(a.x, a.y, a.index) < std::tie(b.x, b.y, b.index);
+        });
+        in.sorted.resize(keys.size());
+        for (size_t i = 0; i < keys.size(); ++i) in.sorted[i] = keys[i].index;
+    }
     in.shared.assign(in.part.size(), 0);
     for (size_t k = 1; k < in.sorted.size(); ++k) {
         const size_t a = in.sorted[k - 1], b = in.sorted[k];
@@ -636,6 +645,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
+    triangulation.setThreadCount(settings.threadCount);
     if (!triangulation.build(in.points, in.segments, space.tri, error, &in.sorted)) return fail(error);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
