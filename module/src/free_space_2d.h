@@ -35,6 +35,7 @@ struct FreeSpace2D {
     std::vector<double> edgeLength;  ///< 3 * faceCount: edge opposite corner i
     std::vector<int> edgePair;       ///< 3 * faceCount: index into pairs, or kSameModelEdge2D / kUnpairedEdge2D
     std::vector<ModelPair2D> pairs;  ///< sorted by (a, b)
+    std::vector<uint64_t> pairKeys;  ///< per pair: a << 32 | b (compact, for pairIndex)
     std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs)
 
     /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.

@@ -455,6 +455,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                 pair.bestFace[1] = entries[e].face;
         }
         if (graphOnly) {
+            space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
             space.pairs.push_back(std::move(pair));
             i = e;
             continue;
@@ -468,6 +469,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         }
         for (size_t k = i; k < e; ++k)
             if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
+        space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
         space.pairs.push_back(std::move(pair));
         i = e;
     }

@@ -30,12 +30,10 @@ uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
 
 int FreeSpace2D::pairIndex(uint32_t a, uint32_t b) const {
     if (a > b) std::swap(a, b);
-    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(a, b),
-                               [](const ModelPair2D& p, const std::pair<uint32_t, uint32_t>& k) {
-                                   return p.a < k.first || (p.a == k.first && p.b < k.second);
-                               });
-    if (it == pairs.end() || it->a != a || it->b != b) return -1;
-    return static_cast<int>(it - pairs.begin());
+    const uint64_t key = static_cast<uint64_t>(a) << 32 | b;
+    auto it = std::lower_bound(pairKeys.begin(), pairKeys.end(), key);
+    if (it == pairKeys.end() || *it != key) return -1;
+    return static_cast<int>(it - pairKeys.begin());
 }
 
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function) {
@@ -239,6 +237,7 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
     aggregates.resize(groupCount);
     // Boundary half-edges, the kept face on their left.
     std::vector<HalfEdge> edges;
+    edges.reserve(faceCount);
     for (size_t f = 0; f < faceCount; ++f) {
         const int g = faceLabel[f];
         if (g < 0) continue;
@@ -248,11 +247,21 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             edges.push_back({g, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3], static_cast<int>(f)});
         }
     }
-    std::sort(edges.begin(), edges.end(), [](const HalfEdge& a, const HalfEdge& b) {
-        if (a.group != b.group) return a.group < b.group;
-        if (a.from != b.from) return a.from < b.from;
-        return a.to < b.to;
-    });
+    // Sorted by (group, from, to): a counting sort on the group, then small sorts per group.
+    {
+        std::vector<uint32_t> start(groupCount + 1, 0);
+        for (const HalfEdge& e : edges) ++start[e.group + 1];
+        for (size_t g = 0; g < groupCount; ++g) start[g + 1] += start[g];
+        std::vector<HalfEdge> bucketed(edges.size());
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+        for (const HalfEdge& e : edges) bucketed[fill[e.group]++] = e;
+        for (size_t g = 0; g < groupCount; ++g)
+            std::sort(bucketed.begin() + start[g], bucketed.begin() + start[g + 1], [](const HalfEdge& a, const HalfEdge& b) {
+                if (a.from != b.from) return a.from < b.from;
+                return a.to < b.to;
+            });
+        edges = std::move(bucketed);
+    }
     // Face components (edge-connected kept faces of one group): holes join the exterior of
     // theirs. Built only when a level has a hole.
     std::vector<uint32_t> parent;
