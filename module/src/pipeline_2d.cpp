@@ -213,17 +213,20 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // (coincident rings crossed by another ring give two nearly equal Steiner points): the
     // flood neither enters nor leaves it, since each copy would count the rings again.
     std::vector<char> sliver(faceCount, 0);
-    for (size_t f = 0; f < faceCount; ++f) {
-        const int* v = &tri.faces[3 * f];
-        auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
-        const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
-        double longest2 = 0;  // squared
-        for (int k = 0; k < 3; ++k) {
-            const double dx = P((k + 1) % 3)[0] - P(k)[0], dy = P((k + 1) % 3)[1] - P(k)[1];
-            longest2 = std::max(longest2, dx * dx + dy * dy);
+    const size_t faceBlocks = std::clamp<size_t>(faceCount / 8192, 1, 64);
+    parallelFor(faceBlocks, threadCount, [&](size_t block) {
+        for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
+            const int* v = &tri.faces[3 * f];
+            auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
+            const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
+            double longest2 = 0;  // squared
+            for (int k = 0; k < 3; ++k) {
+                const double dx = P((k + 1) % 3)[0] - P(k)[0], dy = P((k + 1) % 3)[1] - P(k)[1];
+                longest2 = std::max(longest2, dx * dx + dy * dy);
+            }
+            sliver[f] = area2 <= 1e-12 * longest2;
         }
-        sliver[f] = area2 <= 1e-12 * longest2;
-    }
+    });
     auto unreliable = [&](int f, int j) {
         const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
         const int n = tri.neighbors[3 * f + j];
@@ -375,41 +378,40 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
     // Faces in blocks on all threads; each block writes its own faces and entry list (the
     // entries are then sorted by a total order, so the block order does not matter).
-    const size_t blockCount = std::clamp<size_t>(faceCount / 8192, 1, 64);
-    std::vector<std::vector<PairEntry>> blockEntries(blockCount);
-    parallelFor(blockCount, threadCount, [&](size_t block) {
-    std::vector<PairEntry>& entries = blockEntries[block];
-    for (size_t f = faceCount * block / blockCount; f < faceCount * (block + 1) / blockCount; ++f) {
-        const int* v = &tri.faces[3 * f];
-        space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
-                                   (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
-        for (int j = 0; j < 3; ++j) {
-            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
-            const double dx = P(w)[0] - P(u)[0], dy = P(w)[1] - P(u)[1];
-            space.edgeLength[3 * f + j] = std::sqrt(dx * dx + dy * dy);  // not hypot: 5x slower, no overflow risk here
+    std::vector<std::vector<PairEntry>> blockEntries(faceBlocks);
+    parallelFor(faceBlocks, threadCount, [&](size_t block) {
+        std::vector<PairEntry>& entries = blockEntries[block];
+        for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
+            const int* v = &tri.faces[3 * f];
+            space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
+                                       (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
+            for (int j = 0; j < 3; ++j) {
+                const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+                const double dx = P(w)[0] - P(u)[0], dy = P(w)[1] - P(u)[1];
+                space.edgeLength[3 * f + j] = std::sqrt(dx * dx + dy * dy);  // not hypot: 5x slower, no overflow risk here
+            }
+            if (space.faceModel[f] >= 0) continue;
+            for (int j = 0; j < 3; ++j) {
+                const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+                const int mu = space.vertexModel[u], mw = space.vertexModel[w];
+                if (mu < 0 || mw < 0 || mu == mw) continue;
+                const int n = tri.neighbors[3 * f + j];
+                const uint32_t a = std::min(mu, mw), b = std::max(mu, mw);
+                const double len = space.edgeLength[3 * f + j];
+                // Count each undirected edge once (from its smaller free face, or its only one).
+                const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
+                entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
+            }
+            // Vertex to the opposite edge when that edge is another model's boundary.
+            for (int k = 0; k < 3; ++k) {
+                const int j1 = (k + 1) % 3, j2 = (k + 2) % 3;
+                const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
+                if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
+                const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
+                entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
+                                   static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
+            }
         }
-        if (space.faceModel[f] >= 0) continue;
-        for (int j = 0; j < 3; ++j) {
-            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
-            const int mu = space.vertexModel[u], mw = space.vertexModel[w];
-            if (mu < 0 || mw < 0 || mu == mw) continue;
-            const int n = tri.neighbors[3 * f + j];
-            const uint32_t a = std::min(mu, mw), b = std::max(mu, mw);
-            const double len = space.edgeLength[3 * f + j];
-            // Count each undirected edge once (from its smaller free face, or its only one).
-            const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
-            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
-        }
-        // Vertex to the opposite edge when that edge is another model's boundary.
-        for (int k = 0; k < 3; ++k) {
-            const int j1 = (k + 1) % 3, j2 = (k + 2) % 3;
-            const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
-            if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
-            const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
-            entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
-                               static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
-        }
-    }
     });
     std::vector<PairEntry> entries;
     {
