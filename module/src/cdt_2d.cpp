@@ -156,6 +156,22 @@ bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSp
                                                   std::vector<char>& applied, const std::vector<double>& allPoints,
                                                   Triangulation2D& out, std::string& error,
                                                   const std::vector<size_t>* allPointOrder) {
+    return insertSplits(splits, applied, error) && exportTo(allPoints, out, error, allPointOrder);
+}
+
+bool ConstrainedTriangulation2D::exportTo(const std::vector<double>& allPoints, Triangulation2D& out,
+                                          std::string& error, const std::vector<size_t>* allPointOrder) {
+    try {
+        exportTriangulation(impl_->cdt, allPoints, out, threadCount_, allPointOrder);
+    } catch (const std::exception& e) {
+        error = std::string("2D triangulation failed while adding points: ") + e.what();
+        return false;
+    }
+    return true;
+}
+
+bool ConstrainedTriangulation2D::insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
+                                              std::string& error) {
     applied.assign(splits.size(), 0);
     try {
         Cdt& cdt = impl_->cdt;
@@ -180,7 +196,6 @@ bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSp
             cdt.insert_constraint(previous, vb);
             applied[k] = 1;
         }
-        exportTriangulation(cdt, allPoints, out, threadCount_, allPointOrder);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;

@@ -53,6 +53,12 @@ public:
                           const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
                           const std::vector<size_t>* allPointOrder = nullptr);
 
+    /// splitConstraints() in two steps, so the caller can prepare `allPoints` meanwhile:
+    /// first the insertion (applied[k] as above), then the export.
+    bool insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied, std::string& error);
+    bool exportTo(const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
+                  const std::vector<size_t>* allPointOrder = nullptr);
+
     /// Threads for the export after build() and splitConstraints() (0 = hardware concurrency).
     void setThreadCount(int threadCount) { threadCount_ = threadCount; }
 

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <numeric>
 #include <string>
 #include <tuple>
@@ -683,11 +684,16 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     if (!requests.empty()) {
         // The new vertices go into the live triangulation with their constraints split
         // exactly; segments that cannot be split that way keep no new vertex.
-        InputVertices split = inputVertices(checked, splits);
+        // The input with the new vertices is prepared on another thread while CGAL inserts them.
         std::vector<char> applied;
         space = FreeSpace2D{};
-        if (!triangulation.splitConstraints(requests, applied, split.points, space.tri, error, &split.sorted))
-            return fail(error);
+        InputVertices split;
+        std::future<InputVertices> splitLater;
+        if (settings.threadCount != 1)
+            splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits); });
+        const bool inserted = triangulation.insertSplits(requests, applied, error);
+        split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits);
+        if (!inserted || !triangulation.exportTo(split.points, space.tri, error, &split.sorted)) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
             if (!applied[k]) {
