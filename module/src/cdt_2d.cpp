@@ -4,8 +4,6 @@
 // done by the caller (CGAL 5.5 has no mark_domain_in_triangulation).
 #include "cdt_2d.h"
 
-#include "parallel_for.h"
-
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
@@ -39,7 +37,7 @@ namespace {
 // Flat export. Vertices are numbered in the order of their input point (Steiner points
 // after, in CGAL's order, which is deterministic for a given input); faces by their sorted
 // vertex triple. Neither depends on CGAL's storage order.
-void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out, int threadCount,
+void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
                          const std::vector<size_t>* pointOrder, std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
@@ -117,18 +115,15 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
     out.faces.resize(3 * faces.size());
     out.neighbors.resize(3 * faces.size());
     out.constrained.resize(3 * faces.size());
-    // Read-only from here: blocks of faces on all threads, each writing its own slots.
-    const size_t blockCount = std::clamp<size_t>(faces.size() / 8192, 1, 64);
-    parallelFor(blockCount, threadCount, [&](size_t block) {
-        for (size_t i = faces.size() * block / blockCount; i < faces.size() * (block + 1) / blockCount; ++i) {
-            Cdt::Face_handle f = faces[i].second;
-            for (int k = 0; k < 3; ++k) {
-                out.faces[3 * i + k] = f->vertex(k)->info();
-                out.neighbors[3 * i + k] = f->neighbor(k)->info();
-                out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
-            }
+    // In CGAL's storage order (sequential reads), each face writing its own slots.
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+        const size_t i = static_cast<size_t>(f->info());
+        for (int k = 0; k < 3; ++k) {
+            out.faces[3 * i + k] = f->vertex(k)->info();
+            out.neighbors[3 * i + k] = f->neighbor(k)->info();
+            out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
         }
-    });
+    }
 }
 
 }  // namespace
@@ -144,7 +139,7 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
         impl_->inputHandle.assign(n, Cdt::Vertex_handle());
-        exportTriangulation(impl_->cdt, points, out, threadCount_, pointOrder, &impl_->inputHandle);
+        exportTriangulation(impl_->cdt, points, out, pointOrder, &impl_->inputHandle);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -162,7 +157,7 @@ bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSp
 bool ConstrainedTriangulation2D::exportTo(const std::vector<double>& allPoints, Triangulation2D& out,
                                           std::string& error, const std::vector<size_t>* allPointOrder) {
     try {
-        exportTriangulation(impl_->cdt, allPoints, out, threadCount_, allPointOrder);
+        exportTriangulation(impl_->cdt, allPoints, out, allPointOrder);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;

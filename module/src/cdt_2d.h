@@ -59,13 +59,9 @@ public:
     bool exportTo(const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
                   const std::vector<size_t>* allPointOrder = nullptr);
 
-    /// Threads for the export after build() and splitConstraints() (0 = hardware concurrency).
-    void setThreadCount(int threadCount) { threadCount_ = threadCount; }
-
 private:
     struct Impl;
     Impl* impl_;
-    int threadCount_ = 1;
 };
 
 }  // namespace aggrelod::detail

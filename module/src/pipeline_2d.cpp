@@ -650,7 +650,6 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    triangulation.setThreadCount(settings.threadCount);
     if (!triangulation.build(in.points, in.segments, space.tri, error, &in.sorted)) return fail(error);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
