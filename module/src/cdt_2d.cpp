@@ -38,29 +38,41 @@ namespace {
 // after, in CGAL's order, which is deterministic for a given input); faces by their sorted
 // vertex triple. Neither depends on CGAL's storage order.
 void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
-                         std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
+                         const std::vector<size_t>* pointOrder, std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
     out = Triangulation2D{};
     const size_t n = points.size() / 2;
-    std::vector<size_t> order(n);
-    std::iota(order.begin(), order.end(), size_t{0});
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-        if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
-        if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
-        return a < b;
-    });
+    std::vector<size_t> ownOrder;
+    if (!pointOrder || pointOrder->size() != n) {
+        ownOrder.resize(n);
+        std::iota(ownOrder.begin(), ownOrder.end(), size_t{0});
+        std::sort(ownOrder.begin(), ownOrder.end(), [&](size_t a, size_t b) {
+            if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
+            if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
+            return a < b;
+        });
+        pointOrder = &ownOrder;
+    }
+    // The sorted points as one contiguous array: binary searches without indirection.
+    struct SortedPoint {
+        double x, y;
+        size_t index;
+    };
+    std::vector<SortedPoint> sorted;
+    sorted.reserve(n);
+    for (size_t i : *pointOrder) sorted.push_back({points[2 * i], points[2 * i + 1], i});
     std::vector<std::pair<long long, Cdt::Vertex_handle>> keyed;
     keyed.reserve(cdt.number_of_vertices());
     long long steinerKey = static_cast<long long>(n);
     for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
         const double x = v->point().x(), y = v->point().y();
-        auto it = std::lower_bound(order.begin(), order.end(), size_t{0}, [&](size_t a, size_t) {
-            return points[2 * a] < x || (points[2 * a] == x && points[2 * a + 1] < y);
+        auto it = std::lower_bound(sorted.begin(), sorted.end(), 0, [&](const SortedPoint& a, int) {
+            return a.x < x || (a.x == x && a.y < y);
         });
-        if (it != order.end() && points[2 * *it] == x && points[2 * *it + 1] == y) {
-            keyed.emplace_back(static_cast<long long>(*it), v);
+        if (it != sorted.end() && it->x == x && it->y == y) {
+            keyed.emplace_back(static_cast<long long>(it->index), v);
             if (inputHandle)
-                for (auto same = it; same != order.end() && points[2 * *same] == x && points[2 * *same + 1] == y; ++same)
-                    (*inputHandle)[*same] = v;
+                for (auto same = it; same != sorted.end() && same->x == x && same->y == y; ++same)
+                    (*inputHandle)[same->index] = v;
         } else {
             keyed.emplace_back(steinerKey++, v);
         }
@@ -75,21 +87,37 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
         out.points.push_back(v->point().y());
         out.vertexInput.push_back(keyed[i].first < static_cast<long long>(n) ? static_cast<int>(keyed[i].first) : -1);
     }
-    std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> faces;
-    faces.reserve(cdt.number_of_faces());
+    // Faces by sorted vertex triple: a counting sort on the smallest vertex, then tiny sorts.
+    std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> unsortedFaces, faces;
+    unsortedFaces.reserve(cdt.number_of_faces());
+    std::vector<uint32_t> bucketStart(keyed.size() + 1, 0);
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
         std::array<int, 3> key{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
         std::sort(key.begin(), key.end());
-        faces.emplace_back(key, f);
+        ++bucketStart[key[0] + 1];
+        unsortedFaces.emplace_back(key, f);
     }
-    std::sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
+    for (size_t v = 0; v < keyed.size(); ++v) bucketStart[v + 1] += bucketStart[v];
+    faces.resize(unsortedFaces.size());
+    {
+        std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
+        for (const auto& f : unsortedFaces) faces[fill[f.first[0]]++] = f;
+    }
+    for (size_t v = 0; v < keyed.size(); ++v)
+        std::sort(faces.begin() + bucketStart[v], faces.begin() + bucketStart[v + 1],
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+    // Infinite faces (around the infinite vertex) are -1; every finite one gets its number.
+    {
+        auto first = cdt.incident_faces(cdt.infinite_vertex()), f = first;
+        if (f != nullptr) do f->info() = -1; while (++f != first);
+    }
     for (size_t i = 0; i < faces.size(); ++i) faces[i].second->info() = static_cast<int>(i);
     out.faces.resize(3 * faces.size());
     out.neighbors.resize(3 * faces.size());
     out.constrained.resize(3 * faces.size());
-    for (size_t i = 0; i < faces.size(); ++i) {
-        Cdt::Face_handle f = faces[i].second;
+    // In CGAL's storage order (sequential reads), each face writing its own slots.
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+        const size_t i = static_cast<size_t>(f->info());
         for (int k = 0; k < 3; ++k) {
             out.faces[3 * i + k] = f->vertex(k)->info();
             out.neighbors[3 * i + k] = f->neighbor(k)->info();
@@ -102,7 +130,7 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
 
 bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
                                        const std::vector<std::pair<size_t, size_t>>& segments, Triangulation2D& out,
-                                       std::string& error) {
+                                       std::string& error, const std::vector<size_t>* pointOrder) {
     const size_t n = points.size() / 2;
     try {
         impl_->cdt.clear();
@@ -111,7 +139,7 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
         impl_->inputHandle.assign(n, Cdt::Vertex_handle());
-        exportTriangulation(impl_->cdt, points, out, &impl_->inputHandle);
+        exportTriangulation(impl_->cdt, points, out, pointOrder, &impl_->inputHandle);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -121,7 +149,24 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
 
 bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSplit>& splits,
                                                   std::vector<char>& applied, const std::vector<double>& allPoints,
-                                                  Triangulation2D& out, std::string& error) {
+                                                  Triangulation2D& out, std::string& error,
+                                                  const std::vector<size_t>* allPointOrder) {
+    return insertSplits(splits, applied, error) && exportTo(allPoints, out, error, allPointOrder);
+}
+
+bool ConstrainedTriangulation2D::exportTo(const std::vector<double>& allPoints, Triangulation2D& out,
+                                          std::string& error, const std::vector<size_t>* allPointOrder) {
+    try {
+        exportTriangulation(impl_->cdt, allPoints, out, allPointOrder);
+    } catch (const std::exception& e) {
+        error = std::string("2D triangulation failed while adding points: ") + e.what();
+        return false;
+    }
+    return true;
+}
+
+bool ConstrainedTriangulation2D::insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
+                                              std::string& error) {
     applied.assign(splits.size(), 0);
     try {
         Cdt& cdt = impl_->cdt;
@@ -146,7 +191,6 @@ bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSp
             cdt.insert_constraint(previous, vb);
             applied[k] = 1;
         }
-        exportTriangulation(cdt, allPoints, out);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;

@@ -38,17 +38,26 @@ public:
     /// indices) as constraints, all inserted in one batch. Crossing constraints are split at
     /// their intersections (new Steiner vertices). Duplicate points become one vertex.
     /// Returns false with a message when the triangulator fails (never throws).
+    /// pointOrder: optional, the point indices sorted by (x, y, index), if the caller has them
+    /// (saves sorting them again).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
-               Triangulation2D& out, std::string& error);
+               Triangulation2D& out, std::string& error, const std::vector<size_t>* pointOrder = nullptr);
 
     /// Splits constraint segments (DESIGN 2.4 step 4, Steiner points): each segment that is
     /// still one constrained edge loses its constraint, gets its points inserted, and the
     /// chain from -> points -> to becomes constrained, so the new vertices lie exactly on
     /// constraints whatever the rounding of their coordinates. applied[k] says whether
     /// splits[k] was done. Then exports again, numbering vertices by `allPoints` (the input
-    /// points including the new ones).
+    /// points including the new ones; allPointOrder as pointOrder in build()).
     bool splitConstraints(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
-                          const std::vector<double>& allPoints, Triangulation2D& out, std::string& error);
+                          const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
+                          const std::vector<size_t>* allPointOrder = nullptr);
+
+    /// splitConstraints() in two steps, so the caller can prepare `allPoints` meanwhile:
+    /// first the insertion (applied[k] as above), then the export.
+    bool insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied, std::string& error);
+    bool exportTo(const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
+                  const std::vector<size_t>* allPointOrder = nullptr);
 
 private:
     struct Impl;

@@ -29,11 +29,13 @@ struct FreeSpace2D {
     size_t modelCount = 0;
     std::vector<int> vertexModel;    ///< per vertex: owning model, -1 for Steiner points
     std::vector<int> faceModel;      ///< per face: model whose interior it is, -1 for free space
+    std::vector<int> cornerModel;    ///< 3 * faceCount: vertexModel of each corner (read by every level)
     std::vector<char> faceVoid;      ///< per face: free, enclosed by one model (an input hole): never filled
     std::vector<double> faceArea;    ///< per face
     std::vector<double> edgeLength;  ///< 3 * faceCount: edge opposite corner i
     std::vector<int> edgePair;       ///< 3 * faceCount: index into pairs, or kSameModelEdge2D / kUnpairedEdge2D
     std::vector<ModelPair2D> pairs;  ///< sorted by (a, b)
+    std::vector<uint64_t> pairKeys;  ///< per pair: a << 32 | b (compact, for pairIndex)
     std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs)
 
     /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.

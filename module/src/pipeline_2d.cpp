@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <numeric>
 #include <string>
 #include <tuple>
@@ -186,8 +187,11 @@ struct FreeSpaceModels {
 };
 
 /// Stages 3-5 on the triangulation in space.tri: inside/outside, models, voids, model pairs.
+/// graphOnly: only what the dendrogram and the Steiner points need (models, pairs with their
+/// shortest connection, edge lengths); no voids, per-pair length statistics, edge pairs or
+/// model points (the pass before the Steiner points, whose result is replaced).
 void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
-                    FreeSpaceModels& models) {
+                    FreeSpaceModels& models, bool graphOnly, int threadCount) {
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
 
@@ -210,15 +214,20 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // (coincident rings crossed by another ring give two nearly equal Steiner points): the
     // flood neither enters nor leaves it, since each copy would count the rings again.
     std::vector<char> sliver(faceCount, 0);
-    for (size_t f = 0; f < faceCount; ++f) {
-        const int* v = &tri.faces[3 * f];
-        auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
-        const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
-        double longest = 0;
-        for (int k = 0; k < 3; ++k)
-            longest = std::max(longest, std::hypot(P((k + 1) % 3)[0] - P(k)[0], P((k + 1) % 3)[1] - P(k)[1]));
-        sliver[f] = area2 <= 1e-12 * longest * longest;
-    }
+    const size_t faceBlocks = std::clamp<size_t>(faceCount / 8192, 1, 64);
+    parallelFor(faceBlocks, threadCount, [&](size_t block) {
+        for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
+            const int* v = &tri.faces[3 * f];
+            auto P = [&](int k) { return &tri.points[2 * static_cast<size_t>(v[k])]; };
+            const double area2 = std::fabs((P(1)[0] - P(0)[0]) * (P(2)[1] - P(0)[1]) - (P(2)[0] - P(0)[0]) * (P(1)[1] - P(0)[1]));
+            double longest2 = 0;  // squared
+            for (int k = 0; k < 3; ++k) {
+                const double dx = P((k + 1) % 3)[0] - P(k)[0], dy = P((k + 1) % 3)[1] - P(k)[1];
+                longest2 = std::max(longest2, dx * dx + dy * dy);
+            }
+            sliver[f] = area2 <= 1e-12 * longest2;
+        }
+    });
     auto unreliable = [&](int f, int j) {
         const int u = tri.faces[3 * f + (j + 1) % 3], v = tri.faces[3 * f + (j + 2) % 3];
         const int n = tri.neighbors[3 * f + j];
@@ -304,11 +313,13 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     space.vertexModel.assign(vertexCount, -1);
     for (size_t v = 0; v < vertexCount; ++v)
         if (vertexPart[v] >= 0) space.vertexModel[v] = partModel[vertexPart[v]];
+    space.cornerModel.resize(3 * faceCount);
+    for (size_t c = 0; c < 3 * faceCount; ++c) space.cornerModel[c] = space.vertexModel[tri.faces[c]];
     space.faceModel.assign(faceCount, -1);
     for (size_t f = 0; f < faceCount; ++f)
         if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;
-    space.modelPoints.resize(space.modelCount);
-    for (size_t v = 0; v < in.part.size(); ++v) {
+    if (!graphOnly) space.modelPoints.resize(space.modelCount);
+    for (size_t v = 0; v < in.part.size() && !graphOnly; ++v) {
         auto& pts = space.modelPoints[partModel[in.part[v]]];
         pts.push_back(in.x(v));
         pts.push_back(in.y(v));
@@ -317,7 +328,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // Voids: free faces not reachable from the hull through free faces (input holes, or
     // gaps enclosed by touching polygons) and owned by one model only: never filled.
     space.faceVoid.assign(faceCount, 0);
-    {
+    if (!graphOnly) {
         std::vector<char> reached(faceCount, 0);
         std::vector<int> stack;
         for (size_t f = 0; f < faceCount; ++f)
@@ -356,7 +367,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // shortest connection seen in a free triangle (edge, or vertex to a model's boundary edge).
     space.faceArea.resize(faceCount);
     space.edgeLength.resize(3 * faceCount);
-    space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
+    if (!graphOnly) space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
     struct PairEntry {
         uint32_t a, b;
         double length;   // free edge length, or -1 for a distance-only entry
@@ -365,41 +376,74 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         int connection[3];  // see ModelPair2D::connection
         long long faceEdge; // 3 * face + edge for an edge entry, -1 for a distance-only entry
     };
-    std::vector<PairEntry> entries;
     auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
-    for (size_t f = 0; f < faceCount; ++f) {
-        const int* v = &tri.faces[3 * f];
-        space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
-                                   (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
-        for (int j = 0; j < 3; ++j) {
-            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
-            space.edgeLength[3 * f + j] = std::hypot(P(w)[0] - P(u)[0], P(w)[1] - P(u)[1]);
+    // Faces in blocks on all threads; each block writes its own faces and entry list (the
+    // entries are then sorted by a total order, so the block order does not matter).
+    std::vector<std::vector<PairEntry>> blockEntries(faceBlocks);
+    parallelFor(faceBlocks, threadCount, [&](size_t block) {
+        std::vector<PairEntry>& entries = blockEntries[block];
+        for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
+            const int* v = &tri.faces[3 * f];
+            space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
+                                       (P(v[2])[0] - P(v[0])[0]) * (P(v[1])[1] - P(v[0])[1]));
+            for (int j = 0; j < 3; ++j) {
+                const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+                const double dx = P(w)[0] - P(u)[0], dy = P(w)[1] - P(u)[1];
+                space.edgeLength[3 * f + j] = std::sqrt(dx * dx + dy * dy);  // not hypot: 5x slower, no overflow risk here
+            }
+            if (space.faceModel[f] >= 0) continue;
+            for (int j = 0; j < 3; ++j) {
+                const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
+                const int mu = space.vertexModel[u], mw = space.vertexModel[w];
+                if (mu < 0 || mw < 0 || mu == mw) continue;
+                const int n = tri.neighbors[3 * f + j];
+                const uint32_t a = std::min(mu, mw), b = std::max(mu, mw);
+                const double len = space.edgeLength[3 * f + j];
+                // Count each undirected edge once (from its smaller free face, or its only one).
+                const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
+                entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
+            }
+            // Vertex to the opposite edge when that edge is another model's boundary.
+            for (int k = 0; k < 3; ++k) {
+                const int j1 = (k + 1) % 3, j2 = (k + 2) % 3;
+                const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
+                if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
+                const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
+                entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
+                                   static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
+            }
         }
-        if (space.faceModel[f] >= 0) continue;
-        for (int j = 0; j < 3; ++j) {
-            const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
-            const int mu = space.vertexModel[u], mw = space.vertexModel[w];
-            if (mu < 0 || mw < 0 || mu == mw) continue;
-            const int n = tri.neighbors[3 * f + j];
-            const uint32_t a = std::min(mu, mw), b = std::max(mu, mw);
-            const double len = space.edgeLength[3 * f + j];
-            // Count each undirected edge once (from its smaller free face, or its only one).
-            const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
-            entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
-        }
-        // Vertex to the opposite edge when that edge is another model's boundary.
-        for (int k = 0; k < 3; ++k) {
-            const int j1 = (k + 1) % 3, j2 = (k + 2) % 3;
-            const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
-            if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
-            const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
-            entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
-                               static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
+    });
+    std::vector<PairEntry> entries;
+    {
+        size_t total = 0;
+        for (const auto& b : blockEntries) total += b.size();
+        entries.reserve(total);
+        for (auto& b : blockEntries) {
+            entries.insert(entries.end(), b.begin(), b.end());
+            std::vector<PairEntry>().swap(b);
         }
     }
-    std::sort(entries.begin(), entries.end(), [](const PairEntry& x, const PairEntry& y) {
-        return std::tie(x.a, x.b, x.distance, x.face) < std::tie(y.a, y.b, y.distance, y.face);
-    });
+    // Sorted by (a, b, distance, face, edge, connection): a counting sort on a, then small
+    // sorts per model (much cheaper than one sort of the whole array; same total order).
+    {
+        std::vector<uint32_t> start(space.modelCount + 1, 0);
+        for (const PairEntry& e : entries) ++start[e.a + 1];
+        for (size_t m = 0; m < space.modelCount; ++m) start[m + 1] += start[m];
+        std::vector<PairEntry> bucketed(entries.size());
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+        for (const PairEntry& e : entries) bucketed[fill[e.a]++] = e;
+        auto less = [](const PairEntry& x, const PairEntry& y) {
+            return std::tie(x.b, x.distance, x.face, x.faceEdge, x.connection[0], x.connection[1], x.connection[2]) <
+                   std::tie(y.b, y.distance, y.face, y.faceEdge, y.connection[0], y.connection[1], y.connection[2]);
+        };
+        const size_t modelBlocks = std::clamp<size_t>(space.modelCount / 1024, 1, 64);
+        parallelFor(modelBlocks, threadCount, [&](size_t block) {
+            for (size_t m = space.modelCount * block / modelBlocks; m < space.modelCount * (block + 1) / modelBlocks; ++m)
+                std::sort(bucketed.begin() + start[m], bucketed.begin() + start[m + 1], less);
+        });
+        entries = std::move(bucketed);
+    }
     for (size_t i = 0; i < entries.size();) {
         size_t e = i;
         ModelPair2D pair;
@@ -409,9 +453,15 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         pair.bestFace[0] = entries[i].face;
         std::copy(entries[i].connection, entries[i].connection + 3, pair.connection);
         for (; e < entries.size() && entries[e].a == pair.a && entries[e].b == pair.b; ++e) {
-            if (entries[e].length >= 0) pair.lengths.push_back(entries[e].length);
+            if (entries[e].length >= 0 && !graphOnly) pair.lengths.push_back(entries[e].length);
             if (pair.bestFace[1] < 0 && entries[e].distance == pair.minDistance && entries[e].face != pair.bestFace[0])
                 pair.bestFace[1] = entries[e].face;
+        }
+        if (graphOnly) {
+            space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
+            space.pairs.push_back(std::move(pair));
+            i = e;
+            continue;
         }
         std::sort(pair.lengths.begin(), pair.lengths.end());
         pair.prefixSum.assign(pair.lengths.size() + 1, 0);
@@ -422,10 +472,11 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         }
         for (size_t k = i; k < e; ++k)
             if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
+        space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
         space.pairs.push_back(std::move(pair));
         i = e;
     }
-    for (size_t f = 0; f < faceCount; ++f)
+    for (size_t f = 0; f < faceCount && !graphOnly; ++f)
         for (int j = 0; j < 3; ++j) {
             const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
             if (space.vertexModel[u] < 0 || space.vertexModel[w] < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
@@ -469,11 +520,20 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
             }
         }
     }
-    in.sorted.resize(in.part.size());
-    std::iota(in.sorted.begin(), in.sorted.end(), size_t{0});
-    std::sort(in.sorted.begin(), in.sorted.end(), [&](size_t a, size_t b) {
-        return std::make_tuple(in.x(a), in.y(a), a) < std::make_tuple(in.x(b), in.y(b), b);
-    });
+    {
+        // Sorted as contiguous (x, y, index) triples: no indirection in the comparisons.
+        struct Key {
+            double x, y;
+            size_t index;
+        };
+        std::vector<Key> keys(in.part.size());
+        for (size_t i = 0; i < keys.size(); ++i) keys[i] = {in.x(i), in.y(i), i};
+        std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+            return std::tie(a.x, a.y, a.index) < std::tie(b.x, b.y, b.index);
+        });
+        in.sorted.resize(keys.size());
+        for (size_t i = 0; i < keys.size(); ++i) in.sorted[i] = keys[i].index;
+    }
     in.shared.assign(in.part.size(), 0);
     for (size_t k = 1; k < in.sorted.size(); ++k) {
         const size_t a = in.sorted[k - 1], b = in.sorted[k];
@@ -590,9 +650,9 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    if (!triangulation.build(in.points, in.segments, space.tri, error, &in.sorted)) return fail(error);
     endStage("triangulate");
-    buildFreeSpace(in, checked, space, models);
+    buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
     // the edges GEOS's ConcaveHullOfPolygons takes for its length ratio.
     out.freeEdgeMin = INFINITY;
@@ -623,24 +683,36 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     if (!requests.empty()) {
         // The new vertices go into the live triangulation with their constraints split
         // exactly; segments that cannot be split that way keep no new vertex.
-        const std::vector<double> allPoints = inputVertices(checked, splits).points;
+        // The input with the new vertices is prepared on another thread while CGAL inserts them.
         std::vector<char> applied;
         space = FreeSpace2D{};
-        if (!triangulation.splitConstraints(requests, applied, allPoints, space.tri, error)) return fail(error);
+        InputVertices split;
+        std::future<InputVertices> splitLater;
+        if (settings.threadCount != 1)
+            splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits); });
+        const bool inserted = triangulation.insertSplits(requests, applied, error);
+        split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits);
+        if (!inserted || !triangulation.exportTo(split.points, space.tri, error, &split.sorted)) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
             if (!applied[k]) {
                 splits[requestSegment[k]].clear();
                 allApplied = false;
             }
-        in = inputVertices(checked, splits);
+        in = allApplied ? std::move(split) : inputVertices(checked, splits);
         if (!allApplied) {
             // Numbering must follow the final input points: export again without the skipped ones.
-            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error)) return fail(error);
+            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error, &in.sorted)) return fail(error);
         }
         endStage("triangulate with Steiner points");
-        buildFreeSpace(in, checked, space, models);
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+        endStage("free space and graph again");
+    } else {
+        Triangulation2D tri = std::move(space.tri);
+        space = FreeSpace2D{};
+        space.tri = std::move(tri);  // no Steiner point: complete the graph-only pass
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
         endStage("free space and graph again");
     }
     out.vertexCount = space.tri.vertexCount();
@@ -675,10 +747,12 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
     std::vector<int> mergePair;  // per merge: its index in space.pairs
     for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
-    // F of every pair at every level, on the calling thread (a custom function is user code).
+    // F of every pair at every level: a custom function (user code) on the calling thread, the
+    // built-in ones inside the parallel level loop below.
     const size_t levelCount = deltas.size();
     std::vector<EdgeLimits2D> primaryLimits(levelCount), constantLimits(levelCount), adaptiveLimits(levelCount);
-    for (size_t li = 0; li < levelCount; ++li) {
+    const bool limitsInLevels = !settings.customFunction;
+    for (size_t li = 0; li < levelCount && !limitsInLevels; ++li) {
         if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
         if (settings.computeBaselines) {
             constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
@@ -688,6 +762,13 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     // Levels are independent: sculpted in parallel, each writing only its own slot.
     out.levels.resize(levelCount);
     auto buildLevel = [&](size_t li) {
+        if (limitsInLevels) {
+            if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
+            if (settings.computeBaselines) {
+                constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
+                adaptiveLimits[li] = computeEdgeLimits2D(space, deltas[li], adaptive);
+            }
+        }
         Level2D& level = out.levels[li];
         std::vector<int> label;
         level.delta = deltas[li];

@@ -142,7 +142,8 @@ double ringLength(const std::vector<double>& ring) {
     double len = 0;
     for (size_t i = 0; i < n; ++i) {
         const size_t j = (i + 1) % n;
-        len += std::hypot(ring[2 * j] - ring[2 * i], ring[2 * j + 1] - ring[2 * i + 1]);
+        const double dx = ring[2 * j] - ring[2 * i], dy = ring[2 * j + 1] - ring[2 * i + 1];
+        len += std::sqrt(dx * dx + dy * dy);
     }
     return len;
 }

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 namespace aggrelod::detail {
 namespace {
@@ -31,12 +30,10 @@ uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
 
 int FreeSpace2D::pairIndex(uint32_t a, uint32_t b) const {
     if (a > b) std::swap(a, b);
-    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(a, b),
-                               [](const ModelPair2D& p, const std::pair<uint32_t, uint32_t>& k) {
-                                   return p.a < k.first || (p.a == k.first && p.b < k.second);
-                               });
-    if (it == pairs.end() || it->a != a || it->b != b) return -1;
-    return static_cast<int>(it - pairs.begin());
+    const uint64_t key = static_cast<uint64_t>(a) << 32 | b;
+    auto it = std::lower_bound(pairKeys.begin(), pairKeys.end(), key);
+    if (it == pairKeys.end() || *it != key) return -1;
+    return static_cast<int>(it - pairKeys.begin());
 }
 
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function) {
@@ -77,6 +74,7 @@ struct Sculptor2D {
     const EdgeLimits2D& limits;
     std::vector<int>& label;
     std::vector<char> isProtected;
+    std::vector<int> bestFan, fanPath;  // scratch of protectFanTo, reused
 
     const Triangulation2D& tri() const { return space.tri; }
     int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>(modelGroup[m]); }
@@ -94,7 +92,7 @@ struct Sculptor2D {
             int group = -1;
             bool mixed = false;
             for (int k = 0; k < 3; ++k) {
-                const int g = groupOfModel(space.vertexModel[tri().faces[3 * f + k]]);
+                const int g = groupOfModel(space.cornerModel[3 * f + k]);
                 if (g < 0) continue;
                 if (group < 0) group = g;
                 else if (g != group) mixed = true;
@@ -118,7 +116,9 @@ struct Sculptor2D {
             if (n >= 0 && space.faceModel[n] == model) return;  // already shares an edge
         }
         // The fan of least total area: the one hugging the corner, not a sliver along a side.
-        std::vector<int> best, path;
+        std::vector<int>& best = bestFan;
+        std::vector<int>& path = fanPath;
+        best.clear();
         bool found = false;
         double bestArea = INFINITY;
         for (int k = 0; k < 3; ++k) {
@@ -208,7 +208,7 @@ struct HalfEdge {
 
 void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
                    const std::vector<int>& joinedPairs, std::vector<int>& faceLabel) {
-    Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
+    Sculptor2D s{space, modelGroup, limits, faceLabel, {}, {}, {}};
     s.initialLabels();
     for (int p : joinedPairs)
         if (p >= 0) s.protectConnection(p);
@@ -237,6 +237,7 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
     aggregates.resize(groupCount);
     // Boundary half-edges, the kept face on their left.
     std::vector<HalfEdge> edges;
+    edges.reserve(faceCount);
     for (size_t f = 0; f < faceCount; ++f) {
         const int g = faceLabel[f];
         if (g < 0) continue;
@@ -246,35 +247,52 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             edges.push_back({g, tri.faces[3 * f + (j + 1) % 3], tri.faces[3 * f + (j + 2) % 3], static_cast<int>(f)});
         }
     }
-    std::sort(edges.begin(), edges.end(), [](const HalfEdge& a, const HalfEdge& b) {
-        if (a.group != b.group) return a.group < b.group;
-        if (a.from != b.from) return a.from < b.from;
-        return a.to < b.to;
-    });
-    // Face components (edge-connected kept faces of one group): holes join the exterior of theirs.
-    std::vector<uint32_t> parent(faceCount);
-    std::iota(parent.begin(), parent.end(), 0u);
-    for (size_t f = 0; f < faceCount; ++f) {
-        if (faceLabel[f] < 0) continue;
-        for (int j = 0; j < 3; ++j) {
-            const int n = tri.neighbors[3 * f + j];
-            if (n < 0 || faceLabel[n] != faceLabel[f]) continue;
-            uint32_t a = findRoot(parent, static_cast<uint32_t>(f)), b = findRoot(parent, static_cast<uint32_t>(n));
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
-        }
+    // Sorted by (group, from, to): a counting sort on the group, then small sorts per group.
+    {
+        std::vector<uint32_t> start(groupCount + 1, 0);
+        for (const HalfEdge& e : edges) ++start[e.group + 1];
+        for (size_t g = 0; g < groupCount; ++g) start[g + 1] += start[g];
+        std::vector<HalfEdge> bucketed(edges.size());
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+        for (const HalfEdge& e : edges) bucketed[fill[e.group]++] = e;
+        for (size_t g = 0; g < groupCount; ++g)
+            std::sort(bucketed.begin() + start[g], bucketed.begin() + start[g + 1], [](const HalfEdge& a, const HalfEdge& b) {
+                if (a.from != b.from) return a.from < b.from;
+                return a.to < b.to;
+            });
+        edges = std::move(bucketed);
     }
+    // Face components (edge-connected kept faces of one group): holes join the exterior of
+    // theirs. Built only when a level has a hole.
+    std::vector<uint32_t> parent;
+    auto componentOf = [&](int face) {
+        if (parent.empty()) {
+            parent.resize(faceCount);
+            std::iota(parent.begin(), parent.end(), 0u);
+            for (size_t f = 0; f < faceCount; ++f) {
+                if (faceLabel[f] < 0) continue;
+                for (int j = 0; j < 3; ++j) {
+                    const int n = tri.neighbors[3 * f + j];
+                    if (n < 0 || faceLabel[n] != faceLabel[f]) continue;
+                    uint32_t a = findRoot(parent, static_cast<uint32_t>(f)), b = findRoot(parent, static_cast<uint32_t>(n));
+                    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+                }
+            }
+        }
+        return findRoot(parent, static_cast<uint32_t>(face));
+    };
     auto px = [&](int v) { return tri.points[2 * static_cast<size_t>(v)]; };
     auto py = [&](int v) { return tri.points[2 * static_cast<size_t>(v) + 1]; };
     std::vector<char> used(edges.size(), 0);
     struct Loop {
         std::vector<double> ring;
         double area;
-        uint32_t component;
+        int face;  // a face on the loop's left: its component
     };
     std::vector<Loop> loops;
     size_t groupBegin = 0;
     std::vector<size_t> trace, stack;
-    std::unordered_map<int, size_t> stackPos;  // lookup only, never iterated
+    std::vector<size_t> stackPos(tri.vertexCount(), SIZE_MAX);  // per vertex: its place on the stack
     while (groupBegin < edges.size()) {
         const int g = edges[groupBegin].group;
         size_t groupEnd = groupBegin;
@@ -297,6 +315,14 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
                 trace.push_back(cur);
                 const HalfEdge& e = edges[cur];
                 auto [lo, hi] = outgoing(e.to);
+                if (hi - lo == 1) {  // the usual case: a single way on
+                    if (lo == start || !used[lo]) {
+                        if (lo == start) break;
+                        cur = lo;
+                        continue;
+                    }
+                    break;
+                }
                 const double backAngle = std::atan2(py(e.from) - py(e.to), px(e.from) - px(e.to));
                 size_t next = SIZE_MAX;
                 double bestTurn = INFINITY;
@@ -316,7 +342,6 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             }
             // Split at repeated vertices so every ring is simple.
             stack.clear();
-            stackPos.clear();
             auto emit = [&](size_t fromIndex) {
                 Loop loop;
                 for (size_t i = fromIndex; i < stack.size(); ++i) {
@@ -324,14 +349,13 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
                     loop.ring.push_back(py(edges[stack[i]].from));
                 }
                 loop.area = ringSignedArea(loop.ring);
-                loop.component = findRoot(parent, static_cast<uint32_t>(edges[stack[fromIndex]].face));
-                for (size_t i = fromIndex; i < stack.size(); ++i) stackPos.erase(edges[stack[i]].from);
+                loop.face = edges[stack[fromIndex]].face;
+                for (size_t i = fromIndex; i < stack.size(); ++i) stackPos[edges[stack[i]].from] = SIZE_MAX;
                 stack.resize(fromIndex);
                 if (loop.ring.size() >= 6 && loop.area != 0) loops.push_back(std::move(loop));
             };
             for (size_t h : trace) {
-                auto it = stackPos.find(edges[h].from);
-                if (it != stackPos.end()) emit(it->second);
+                if (stackPos[edges[h].from] != SIZE_MAX) emit(stackPos[edges[h].from]);
                 stackPos[edges[h].from] = stack.size();
                 stack.push_back(h);
             }
@@ -339,13 +363,12 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
         }
         // Exteriors (counter-clockwise) and holes (clockwise), holes to the exterior of their component.
         Aggregate2D& agg = aggregates[g];
-        std::vector<size_t> exteriorOfLoop(loops.size(), SIZE_MAX);
-        std::vector<uint32_t> polygonComponent;
+        std::vector<size_t> polygonComponent, exteriorLoop;
         for (size_t i = 0; i < loops.size(); ++i) {
             if (loops[i].area <= 0) continue;
-            exteriorOfLoop[i] = agg.polygons.size();
+            exteriorLoop.push_back(i);
             agg.polygons.push_back(Polygon2D{loops[i].ring, {}});
-            polygonComponent.push_back(loops[i].component);
+            polygonComponent.push_back(SIZE_MAX);  // filled when a hole needs it
         }
         for (size_t i = 0; i < loops.size(); ++i) {
             if (loops[i].area > 0) continue;
@@ -353,8 +376,10 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             double bestArea = INFINITY;
             const double mx = 0.5 * (loops[i].ring[0] + loops[i].ring[2]);
             const double my = 0.5 * (loops[i].ring[1] + loops[i].ring[3]);
+            const uint32_t holeComponent = componentOf(loops[i].face);
             for (size_t p = 0; p < agg.polygons.size(); ++p) {
-                if (polygonComponent[p] != loops[i].component) continue;
+                if (polygonComponent[p] == SIZE_MAX) polygonComponent[p] = componentOf(loops[exteriorLoop[p]].face);
+                if (polygonComponent[p] != holeComponent) continue;
                 const std::vector<double>& ring = agg.polygons[p].exterior;
                 const double a = ringSignedArea(ring);
                 if (a >= bestArea) continue;
