@@ -20,6 +20,39 @@ std::string numbered(const char* prefix, int i) {
     return buffer;
 }
 
+// Base colours (linear RGBA, as glTF's baseColorFactor), so bakes show proxies that carry
+// the look of what they replace (issue 5, materials).
+constexpr float kTrunk[4] = {0.20f, 0.09f, 0.03f, 1.0f};
+constexpr float kLeaves[4] = {0.05f, 0.30f, 0.04f, 1.0f};
+constexpr float kNeedles[4] = {0.02f, 0.16f, 0.06f, 1.0f};
+constexpr float kWall[4] = {0.70f, 0.58f, 0.40f, 1.0f};
+constexpr float kRoof[4] = {0.50f, 0.08f, 0.04f, 1.0f};
+constexpr float kFence[4] = {0.45f, 0.32f, 0.18f, 1.0f};
+constexpr float kBarrel[4] = {0.25f, 0.12f, 0.05f, 1.0f};
+
+void paint(InputObject& o, const float colour[4]) {
+    const size_t triangles = o.indices.size() / 3;
+    o.triangleColors.resize(4 * triangles);
+    for (size_t t = 0; t < triangles; ++t)
+        for (int k = 0; k < 4; ++k) o.triangleColors[4 * t + k] = colour[k];
+}
+
+// Faces looking up (normal z > 0.2) take the roof colour, the others the wall colour.
+void paintHouse(InputObject& o) {
+    paint(o, kWall);
+    for (size_t t = 0; t + 2 < o.indices.size(); t += 3) {
+        const double* a = &o.positions[3 * size_t(o.indices[t])];
+        const double* b = &o.positions[3 * size_t(o.indices[t + 1])];
+        const double* c = &o.positions[3 * size_t(o.indices[t + 2])];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (len > 0 && n[2] / len > 0.2)
+            for (int k = 0; k < 4; ++k) o.triangleColors[4 * (t / 3) + k] = kRoof[k];
+    }
+}
+
 void renumberObjects(std::vector<InputObject>& objects) {
     for (size_t i = 0; i < objects.size(); ++i) objects[i].id = uint32_t(i);
 }
@@ -122,13 +155,16 @@ std::vector<InputObject> makeForest(uint32_t seed) {
         const double trunkRadius = random.uniform(0.12, 0.2);
         const double trunkHeight = t.conifer ? random.uniform(0.7, 1.2) : random.uniform(1.3, 2.2);
         objects.push_back(makeCylinder(name + "_trunk", {f.x, f.y, 0}, trunkRadius, trunkHeight, 8));
+        paint(objects.back(), kTrunk);
         const double base = trunkHeight + 0.05;
         if (t.conifer) {
             const double height = random.uniform(2.2, 3.4) * f.radius;
             objects.push_back(makeLathe(name + "_canopy", {f.x, f.y, base},
                                         {{f.radius, 0}, {0.62 * f.radius, 0.45 * height}, {0.05, height}}, 12));
+            paint(objects.back(), kNeedles);
         } else {
             objects.push_back(makeUvSphere(name + "_canopy", {f.x, f.y, base + f.radius}, f.radius, 12, 7));
+            paint(objects.back(), kLeaves);
         }
     }
     renumberObjects(objects);
@@ -148,6 +184,7 @@ std::vector<InputObject> makeVillage(uint32_t seed) {
         placed.push_back(r);
         objects.push_back(makeLathe(numbered("barrel", barrels++), {x, y, 0},
                                     {{0.3, 0}, {0.35, 0.2}, {0.38, 0.45}, {0.35, 0.7}, {0.3, 0.9}}, 12));
+        paint(objects.back(), kBarrel);
         return true;
     };
     // A fence segment along x: pickets with pointed tops on a bottom rail, 0.06 thick.
@@ -168,6 +205,7 @@ std::vector<InputObject> makeVillage(uint32_t seed) {
             if (i != 0) outline.push_back({a, 0.3});
         }
         objects.push_back(makeExtrusion(numbered("fence", fences++), outline, thick, 0, {x0, y, 0}));
+        paint(objects.back(), kFence);
         return true;
     };
     // A house: walls and a pitched roof in one prism (gable ends facing +-y), w along x,
@@ -183,6 +221,7 @@ std::vector<InputObject> makeVillage(uint32_t seed) {
             {o, 0}, {w - o, 0}, {w - o, wall - 0.1}, {w, wall - 0.2}, {w, wall}, {w / 2, wall + ridge}, {0, wall},
             {0, wall - 0.2}, {o, wall - 0.1}};
         objects.push_back(makeExtrusion(numbered("house", houses++), outline, d, 0, {x0, y0 + d / 2, 0}));
+        paintHouse(objects.back());
         return true;
     };
 
