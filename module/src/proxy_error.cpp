@@ -31,8 +31,7 @@
 #include <array>
 #include <cmath>
 #include <queue>
-#include <cstdio>
-#include <cstdlib>
+#include <stdexcept>
 
 namespace aggrelod {
 
@@ -336,6 +335,38 @@ double patchBound(const TargetMesh& m, uint32_t t, const double* points, int n) 
     return worst + P.slack;
 }
 
+/// True when triangle `tri` (9 doubles) comes within `margin` of a triangle of `bvh`.
+bool touchesMesh(const TriangleBvh& bvh, const double* tri, double margin) {
+    const auto& nodes = bvh.nodes();
+    if (nodes.empty()) return false;
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(tri[k], std::min(tri[3 + k], tri[6 + k])) - margin;
+        hi[k] = std::max(tri[k], std::max(tri[3 + k], tri[6 + k])) + margin;
+    }
+    uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const TriangleBvh::Node& N = nodes[stack[--top]];
+        bool overlap = true;
+        for (int k = 0; k < 3; ++k) overlap = overlap && N.lo[k] <= hi[k] && N.hi[k] >= lo[k];
+        if (!overlap) continue;
+        if (N.count == 0) {
+            if (top + 2 > 128) return true;  // too deep to tell: assume it touches
+            stack[top++] = N.first;
+            stack[top++] = N.first + 1;
+            continue;
+        }
+        for (uint32_t i = 0; i < N.count; ++i) {
+            const double* c = bvh.slotCorners(N.first + i);
+            if (detail::triangleTriangleDistance(tri, tri + 3, tri + 6, c, c + 3, c + 6, nullptr, nullptr, nullptr) <= margin)
+                return true;
+        }
+    }
+    return false;
+}
+
 /// The proxy as a target: its surface (closest point) and its solid (ray parity).
 struct ProxyTarget {
     const TriangleBvh& bvh;
@@ -351,6 +382,8 @@ struct ProxyTarget {
         return r;
     }
     bool inside(const double p[3]) const { return insideSolid(bvh, p); }
+    /// A region triangle that does not meet the surface lies on one side of it.
+    bool touches(const double* tri) const { return touchesMesh(bvh, tri, 1e-9 * bvh.maxAbsCoordinate()); }
 };
 
 double pointBoxDistance(const double p[3], const double lo[3], const double hi[3]) {
@@ -363,50 +396,104 @@ double pointBoxDistance(const double p[3], const double lo[3], const double hi[3
 }
 
 /// The original objects as a target: their surfaces, one prepared BVH per object (shared by
-/// every node holding the object). The object nearest by box first, then every object whose
-/// box is nearer than the best so far, in index order (deterministic; ties keep the first).
+/// every node holding the object), under a small tree of the objects' boxes built per node.
+/// Nearest child box first, boxes farther than the best distance so far pruned; the
+/// traversal order is fixed, so ties are resolved the same way on every run.
 struct OriginalsTarget {
+    struct Node {
+        double lo[3], hi[3];
+        uint32_t first, count;  ///< leaf: objects order[first, first + count); inner: children first, first + 1
+    };
     const std::vector<const detail::PreparedOriginal*>& objects;
     std::vector<std::array<double, 6>> boxes;  // lo, hi per object
     std::vector<TargetMesh> meshes;
+    std::vector<Node> nodes;
+    std::vector<uint32_t> order;
+
     explicit OriginalsTarget(const std::vector<const detail::PreparedOriginal*>& o)
         : objects(o), boxes(o.size()), meshes(o.size()) {
         for (size_t i = 0; i < o.size(); ++i) {
             o[i]->bvh.bounds(boxes[i].data(), boxes[i].data() + 3);
             meshes[i] = TargetMesh{o[i]->object->positions.data(), o[i]->object->indices.data(), o[i]->across.data(),
                                    &o[i]->patches};
+            if (o[i]->bvh.triangleCount() > 0) order.push_back(uint32_t(i));
         }
+        if (order.empty()) return;
+        nodes.reserve(2 * order.size());
+        nodes.push_back(Node{});
+        build(0, 0, uint32_t(order.size()));
+    }
+    void build(uint32_t node, uint32_t begin, uint32_t end) {
+        Node n;
+        for (int k = 0; k < 3; ++k) {
+            n.lo[k] = INFINITY;
+            n.hi[k] = -INFINITY;
+        }
+        for (uint32_t i = begin; i < end; ++i)
+            for (int k = 0; k < 3; ++k) {
+                n.lo[k] = std::min(n.lo[k], boxes[order[i]][size_t(k)]);
+                n.hi[k] = std::max(n.hi[k], boxes[order[i]][size_t(3 + k)]);
+            }
+        if (end - begin <= 4) {
+            n.first = begin;
+            n.count = end - begin;
+            nodes[node] = n;
+            return;
+        }
+        int axis = 0;
+        for (int k = 1; k < 3; ++k)
+            if (n.hi[k] - n.lo[k] > n.hi[axis] - n.lo[axis]) axis = k;
+        auto centre = [&](uint32_t i) { return boxes[i][size_t(axis)] + boxes[i][size_t(3 + axis)]; };
+        std::sort(order.begin() + begin, order.begin() + end, [&](uint32_t x, uint32_t y) {
+            return centre(x) != centre(y) ? centre(x) < centre(y) : x < y;
+        });
+        const uint32_t mid = begin + (end - begin) / 2;
+        n.first = uint32_t(nodes.size());
+        n.count = 0;
+        nodes[node] = n;
+        nodes.push_back(Node{});
+        nodes.push_back(Node{});
+        build(n.first, begin, mid);
+        build(n.first + 1, mid, end);
     }
     Nearest closest(const double p[3]) const {
         Nearest r;
-        const size_t n = objects.size();
-        size_t first = n;
-        double firstBox = INFINITY;
-        for (size_t i = 0; i < n; ++i) {
-            if (objects[i]->bvh.triangleCount() == 0) continue;
-            const double d = pointBoxDistance(p, boxes[i].data(), boxes[i].data() + 3);
-            if (first == n || d < firstBox) {
-                firstBox = d;
-                first = i;
-            }
-        }
-        if (first == n) return r;
-        auto query = [&](size_t i) {
-            const detail::ClosestPoint cp = detail::closestPoint(objects[i]->bvh, p, r.distance);
-            if (cp.triangle == ~0u || !(cp.distance < r.distance)) return;
-            r.distance = cp.distance;
-            r.mesh = &meshes[i];
-            r.triangle = cp.triangle;
+        if (nodes.empty()) return r;
+        struct Item {
+            uint32_t node;
+            double distance;
         };
-        query(first);
-        for (size_t i = 0; i < n; ++i) {
-            if (i == first || objects[i]->bvh.triangleCount() == 0) continue;
-            if (pointBoxDistance(p, boxes[i].data(), boxes[i].data() + 3) > r.distance) continue;
-            query(i);
+        Item stack[64];
+        int top = 0;
+        stack[top++] = {0, pointBoxDistance(p, nodes[0].lo, nodes[0].hi)};
+        while (top > 0) {
+            const Item it = stack[--top];
+            if (it.distance > r.distance) continue;
+            const Node& N = nodes[it.node];
+            if (N.count > 0) {
+                for (uint32_t j = N.first; j < N.first + N.count; ++j) {
+                    const uint32_t i = order[j];
+                    if (pointBoxDistance(p, boxes[i].data(), boxes[i].data() + 3) > r.distance) continue;
+                    const detail::ClosestPoint cp = detail::closestPoint(objects[i]->bvh, p, r.distance);
+                    if (cp.triangle == ~0u || !(cp.distance < r.distance)) continue;
+                    r.distance = cp.distance;
+                    r.mesh = &meshes[i];
+                    r.triangle = cp.triangle;
+                }
+                continue;
+            }
+            Item a{N.first, pointBoxDistance(p, nodes[N.first].lo, nodes[N.first].hi)};
+            Item b{N.first + 1, pointBoxDistance(p, nodes[N.first + 1].lo, nodes[N.first + 1].hi)};
+            if (b.distance < a.distance) std::swap(a, b);
+            // Median splits: depth <= 33 for < 2^32 objects, so the stack never overflows.
+            if (top + 2 > 64) throw std::logic_error("OriginalsTarget: tree too deep");
+            stack[top++] = b;
+            stack[top++] = a;
         }
         return r;
     }
     bool inside(const double*) const { return false; }  // never asked: the originals are surfaces
+    bool touches(const double*) const { return true; }
 };
 
 /// One region of the branch and bound: a triangle (corners), or the box of a node of an
@@ -456,10 +543,13 @@ public:
         double upper = d + rho;
         if (near.mesh) upper = std::min(upper, cornerBound(*near.mesh, near.triangle, c.data(), 3));
         double h = d;
-        if (toSolid_ && (d > rho || d > r_.lower)) {
-            const bool inside = target_.inside(centroid);
-            if (inside) h = 0;
-            if (inside && d > rho) upper = 0;  // the ball lies inside the solid
+        if (toSolid_ && (d > r_.lower || upper > r_.lower + tolerance_) && target_.inside(centroid)) {
+            h = 0;
+            // The signed distance (minus d here) is 1-Lipschitz too: 0 when the ball lies
+            // inside the solid.
+            upper = std::min(upper, std::max(0.0, rho - d));
+            // Inside at the centroid and not meeting the surface: inside throughout.
+            if (upper > r_.lower + tolerance_ && !target_.touches(c.data())) upper = 0;
         }
         r_.lower = std::max(r_.lower, h);
         if (near.mesh && upper > r_.lower + tolerance_)
@@ -503,7 +593,7 @@ public:
             upper = std::min(upper, cornerBound(*near.mesh, near.triangle, corners, 8));
         }
         if (toSolid_ && upper > r_.lower + tolerance_ && target_.inside(centre))
-            upper = std::min(upper, d > rho ? 0.0 : rho);  // h(centre) = 0
+            upper = std::min(upper, std::max(0.0, rho - d));  // signed distance -d at the centre
         Region g;
         g.object = object;
         g.node = node;
@@ -847,7 +937,6 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
         if (originals[i]->bvh.triangleCount() > 0) backward.evaluateBox(uint32_t(i), 0);
     const DirectionResult b = backward.run(originalTriangles + maxRefinementsPerDirection);
 
-    if (std::getenv("PROXY_DEBUG")) std::fprintf(stderr, "DBG objs %zu origtri %zu proxytri %zu fwd %zu bwd %zu f %g/%g b %g/%g tol %g\n", originals.size(), originalTriangles, proxy.triangleCount(), f.evaluations, b.evaluations, f.lower, f.upper, b.lower, b.upper, tolerance);
     e.proxyToOriginals = f.upper;
     e.originalsToProxy = b.upper;
     e.proxyToOriginalsLower = f.lower;
