@@ -108,9 +108,10 @@ bool insideSolid(const TriangleBvh& bvh, const double p[3]) {
         {0.5773502691896258, 0.5773502691896257, 0.5773502691896259},
         {-0.2672612419124244, 0.8017837257372732, -0.5345224838248488},
         {0.8164965809277261, -0.4082482904638631, -0.4082482904638629}};
-    int inside = 0;
-    for (const auto& d : kDirections) inside += crossings(bvh, p, d) % 2 == 1;
-    return inside >= 2;
+    const bool first = crossings(bvh, p, kDirections[0]) % 2 == 1;
+    const bool second = crossings(bvh, p, kDirections[1]) % 2 == 1;
+    if (first == second) return first;  // already the majority
+    return crossings(bvh, p, kDirections[2]) % 2 == 1;
 }
 
 
