@@ -10,19 +10,35 @@
 //   covered by it, not missing), else the distance to the proxy surface. Inside = odd number
 //   of crossings of a ray, majority of three rays in fixed directions.
 //
-// Branch and bound over triangles (in the spirit of Tang et al., "Interactive Hausdorff
-// distance computation for general polygonal models", SIGGRAPH 2009): every triangle of the
-// measured mesh is a region; at its centroid c, h(c) is a lower bound of the maximum. An
-// upper bound of h over the region (ball of radius rho around c holding its corners) is the
-// smaller of
-//   - h(c) + rho, as h is 1-Lipschitz, and
+// Branch and bound (in the spirit of Tang et al., "Interactive Hausdorff distance computation
+// for general polygonal models", SIGGRAPH 2009). Regions are triangles of the measured mesh
+// (and their subdivisions) or, for originals -> proxy, boxes of the nodes of each original
+// object's BVH (built once per object, shared by every node and level holding it). At a
+// triangle region's centroid c, h(c) is a lower bound of the maximum. Upper bounds of h over
+// a region (ball of radius rho around c holding it), the smallest that applies:
+//   - h(c) + rho, as h is 1-Lipschitz; for the solid, max(0, rho - d(c)) when c is inside
+//     (the signed distance is 1-Lipschitz too), so 0 when the ball lies inside;
 //   - max over the corners v of dist(v, T), T the target triangle nearest to c: the distance
 //     to one triangle is convex, so its maximum over the region is at a corner, and the
 //     distance to the whole target is at most the distance to T;
-// and 0 for originals -> proxy when c is inside and the ball misses the proxy surface. The
-// region with the largest upper bound is split into four (edge midpoints) until it is within
-// `tolerance` of the best lower bound or the evaluation budget is spent; the result is the
-// largest remaining upper bound: never below the true Hausdorff distance.
+//   - where proxy and originals share a surface but not its triangulation (a region then
+//     straddles target edges, and the bounds above stay as large as the region):
+//     planarPatches/patchBound (a flat patch of target triangles that tiles a convex
+//     polygon), edgePairBound (T and the triangle across one of its edges forming a convex
+//     quad) and vertexFanBound (the closed ring of triangles around a vertex of T tiling a
+//     convex polygon) -- each proof at the function;
+//   - 0 for originals -> proxy when c is inside and the region does not meet the proxy
+//     surface (a connected set not crossing the surface stays inside);
+//   - for a box region: h(centre) + half its diagonal, the corners' distance to the triangle
+//     nearest the centre, or 0 / max(0, rho - d) when the centre is inside. Boxes give no
+//     lower bound (their points are not original points); a box is split into its two
+//     children, a leaf into its triangles, so originals deep inside the proxy or well within
+//     the tolerance are dismissed a box at a time instead of a triangle at a time.
+// The region with the largest upper bound is split (triangles into four at the edge
+// midpoints) until every upper bound is within `tolerance` of the best lower bound or the
+// evaluation limit (seeds + maxRefinementsPerDirection) is reached; the result is the
+// largest upper bound left: never below the true Hausdorff distance (up to double rounding;
+// the flat-patch allowance is part of the bound, not an assumption).
 #include "proxy_error.h"
 
 #include <aggrelod/hierarchy_nodes.h>
