@@ -388,8 +388,11 @@ bool touchesMesh(const TriangleBvh& bvh, const double* tri, double margin) {
 struct ProxyTarget {
     const TriangleBvh& bvh;
     TargetMesh mesh;
-    Nearest closest(const double p[3]) const {
-        const detail::ClosestPoint cp = detail::closestPoint(bvh, p);
+    /// `hint`: an upper bound of the distance (prunes the search); when rounding makes it
+    /// miss, the search runs again without it.
+    Nearest closest(const double p[3], double hint) const {
+        detail::ClosestPoint cp = detail::closestPoint(bvh, p, hint);
+        if (cp.triangle == ~0u && hint < INFINITY) cp = detail::closestPoint(bvh, p);
         Nearest r;
         r.distance = cp.distance;
         if (cp.triangle != ~0u) {
@@ -473,8 +476,14 @@ struct OriginalsTarget {
         build(n.first, begin, mid);
         build(n.first + 1, mid, end);
     }
-    Nearest closest(const double p[3]) const {
+    Nearest closest(const double p[3], double hint) const {
+        Nearest r = closestWithin(p, hint);
+        if (!r.mesh && hint < INFINITY) r = closestWithin(p, INFINITY);
+        return r;
+    }
+    Nearest closestWithin(const double p[3], double maxDistance) const {
         Nearest r;
+        r.distance = maxDistance;
         if (nodes.empty()) return r;
         struct Item {
             uint32_t node;
@@ -492,7 +501,7 @@ struct OriginalsTarget {
                     const uint32_t i = order[j];
                     if (pointBoxDistance(p, boxes[i].data(), boxes[i].data() + 3) > r.distance) continue;
                     const detail::ClosestPoint cp = detail::closestPoint(objects[i]->bvh, p, r.distance);
-                    if (cp.triangle == ~0u || !(cp.distance < r.distance)) continue;
+                    if (cp.triangle == ~0u || !(cp.distance < r.distance || (!r.mesh && cp.distance == r.distance))) continue;
                     r.distance = cp.distance;
                     r.mesh = &meshes[i];
                     r.triangle = cp.triangle;
@@ -520,6 +529,7 @@ struct Region {
     uint32_t object = ~0u;          ///< box regions: index in the originals ...
     uint32_t node = 0;              ///< ... and node of its BVH
     double upper;
+    double surfaceUpper;  ///< upper bound of the distance to the target surface (search hint for the parts)
     uint64_t order;  ///< creation order: a full tie-break, so the refinement is deterministic
 };
 struct LowerUpperFirst {
@@ -547,7 +557,7 @@ public:
 
     /// Triangle region: h at its centroid is a lower bound; upper bound in the file comment
     /// (plus edgePairBound where the one-triangle bound does not settle the region).
-    void evaluateTriangle(const std::array<double, 9>& c) {
+    void evaluateTriangle(const std::array<double, 9>& c, double hint = INFINITY) {
         ++r_.evaluations;
         double centroid[3], rho = 0;
         for (int k = 0; k < 3; ++k) centroid[k] = (c[k] + c[3 + k] + c[6 + k]) / 3;
@@ -555,10 +565,11 @@ public:
             const double dx = c[3 * v] - centroid[0], dy = c[3 * v + 1] - centroid[1], dz = c[3 * v + 2] - centroid[2];
             rho = std::max(rho, std::sqrt(dx * dx + dy * dy + dz * dz));
         }
-        const Nearest near = target_.closest(centroid);
+        const Nearest near = target_.closest(centroid, hint);
         const double d = near.distance;
         double upper = d + rho;
         if (near.mesh) upper = std::min(upper, cornerBound(*near.mesh, near.triangle, c.data(), 3));
+        double surfaceUpper = upper;
         double h = d;
         if (toSolid_ && (d > r_.lower || upper > r_.lower + tolerance_) && target_.inside(centroid)) {
             h = 0;
@@ -569,15 +580,23 @@ public:
             if (upper > r_.lower + tolerance_ && !target_.touches(c.data())) upper = 0;
         }
         r_.lower = std::max(r_.lower, h);
-        if (near.mesh && upper > r_.lower + tolerance_)
-            upper = std::min(upper, patchBound(*near.mesh, near.triangle, c.data(), 3));
-        if (near.mesh && upper > r_.lower + tolerance_)
-            upper = std::min(upper, edgePairBound(*near.mesh, near.triangle, c.data(), 3));
-        if (near.mesh && upper > r_.lower + tolerance_)
-            upper = std::min(upper, vertexFanBound(*near.mesh, near.triangle, c.data(), 3));
+        // Bounds of the distance to the surface, so of the distance to the solid as well.
+        if (near.mesh && upper > r_.lower + tolerance_) {
+            surfaceUpper = std::min(surfaceUpper, patchBound(*near.mesh, near.triangle, c.data(), 3));
+            upper = std::min(upper, surfaceUpper);
+        }
+        if (near.mesh && upper > r_.lower + tolerance_) {
+            surfaceUpper = std::min(surfaceUpper, edgePairBound(*near.mesh, near.triangle, c.data(), 3));
+            upper = std::min(upper, surfaceUpper);
+        }
+        if (near.mesh && upper > r_.lower + tolerance_) {
+            surfaceUpper = std::min(surfaceUpper, vertexFanBound(*near.mesh, near.triangle, c.data(), 3));
+            upper = std::min(upper, surfaceUpper);
+        }
         Region g;
         g.corners = c;
         g.upper = upper;
+        g.surfaceUpper = surfaceUpper;
         keepOrDismiss(g);
     }
 
@@ -587,7 +606,7 @@ public:
     /// largest distance from its eight corners to the target triangle nearest the centre
     /// (convexity, as for triangles); or 0 when the centre is inside the solid and the ball
     /// misses its surface.
-    void evaluateBox(uint32_t object, uint32_t node) {
+    void evaluateBox(uint32_t object, uint32_t node, double hint = INFINITY) {
         ++r_.evaluations;
         const TriangleBvh::Node& N = (*boxSources_)[object]->bvh.nodes()[node];
         double centre[3], rho2 = 0;
@@ -597,7 +616,7 @@ public:
             rho2 += half * half;
         }
         const double rho = std::sqrt(rho2);
-        const Nearest near = target_.closest(centre);
+        const Nearest near = target_.closest(centre, hint);
         const double d = near.distance;
         double upper = d + rho;
         if (near.mesh && upper > r_.lower + tolerance_) {
@@ -609,12 +628,14 @@ public:
             }
             upper = std::min(upper, cornerBound(*near.mesh, near.triangle, corners, 8));
         }
+        const double surfaceUpper = upper;
         if (toSolid_ && upper > r_.lower + tolerance_ && target_.inside(centre))
             upper = std::min(upper, std::max(0.0, rho - d));  // signed distance -d at the centre
         Region g;
         g.object = object;
         g.node = node;
         g.upper = upper;
+        g.surfaceUpper = surfaceUpper;
         keepOrDismiss(g);
     }
 
@@ -622,17 +643,20 @@ public:
         while (!open_.empty() && open_.top().upper > r_.lower + tolerance_ && r_.evaluations + 4 <= evaluationLimit) {
             const Region g = open_.top();
             open_.pop();
+            // Every part lies in the region: its distance to the surface is below the region's
+            // bound (a margin for rounding; a miss only costs a second search).
+            const double hint = g.surfaceUpper * (1 + 1e-9) + 1e-300;
             if (g.object != ~0u) {
                 const TriangleBvh& bvh = (*boxSources_)[g.object]->bvh;
                 const TriangleBvh::Node& N = bvh.nodes()[g.node];
                 if (N.count == 0) {
-                    evaluateBox(g.object, N.first);
-                    evaluateBox(g.object, N.first + 1);
+                    evaluateBox(g.object, N.first, hint);
+                    evaluateBox(g.object, N.first + 1, hint);
                 } else {
                     for (uint32_t i = 0; i < N.count; ++i) {
                         std::array<double, 9> c;
                         std::copy(bvh.slotCorners(N.first + i), bvh.slotCorners(N.first + i) + 9, c.begin());
-                        evaluateTriangle(c);
+                        evaluateTriangle(c, hint);
                     }
                 }
                 continue;
@@ -647,10 +671,10 @@ public:
             auto tri = [](const double* p, const double* q, const double* s) {
                 return std::array<double, 9>{p[0], p[1], p[2], q[0], q[1], q[2], s[0], s[1], s[2]};
             };
-            evaluateTriangle(tri(c, m[0], m[2]));
-            evaluateTriangle(tri(m[0], c + 3, m[1]));
-            evaluateTriangle(tri(m[2], m[1], c + 6));
-            evaluateTriangle(tri(m[0], m[1], m[2]));
+            evaluateTriangle(tri(c, m[0], m[2]), hint);
+            evaluateTriangle(tri(m[0], c + 3, m[1]), hint);
+            evaluateTriangle(tri(m[2], m[1], c + 6), hint);
+            evaluateTriangle(tri(m[0], m[1], m[2]), hint);
         }
         // What is left open keeps its upper bound.
         while (!open_.empty()) {
