@@ -6,6 +6,7 @@
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
 #include "mesh_simplify.h"
 #include "parallel_for.h"
+#include "proxy_error.h"
 #include "surface_colors.h"
 
 #include <aggrelod/hierarchy_nodes.h>
@@ -232,16 +233,26 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     auto aggregateOf = [&](const HierarchyNode& n) -> const Aggregate& {
         return hierarchy.levels[size_t(n.firstLevel)].aggregates[n.aggregateIndex];
     };
+    // One BVH per original object, shared by every node holding it at every level (an
+    // object recurs at each level; merging the originals into one BVH per node would
+    // rebuild the coarse nodes' BVHs over nearly every triangle of the scene).
+    std::vector<detail::PreparedOriginal> prepared(objectCount);
+    detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
+        if (levelCount > 0 && groupOf[0][o] != kNoNode) detail::prepareOriginal(objects[o], prepared[o]);
+    });
     detail::parallelFor(nodes.size() - objectCount, settings.threadCount, [&](size_t j) {
         HierarchyNode& n = nodes[objectCount + j];
         const Aggregate& agg = aggregateOf(n);
         const std::vector<float> exact(agg.positions.begin(), agg.positions.end());
         detail::simplifyMesh(exact, agg.indices, settings.simplifyFraction * n.delta, n.positions, n.indices);
-        std::vector<const InputObject*> originals;
-        for (uint32_t o : n.sources) originals.push_back(&objects[o]);
-        detail::nearestSurfaceColors(n.positions, n.indices, originals, n.faceColors);
-        n.error = measureProxyError(n.positions, n.indices, originals, settings.toleranceFraction * n.delta,
-                                    settings.maxRefinementsPerDirection);
+        std::vector<const InputObject*> sourceObjects;
+        for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
+        detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
+        std::vector<const detail::PreparedOriginal*> originals;
+        for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
+        n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals,
+                                                    settings.toleranceFraction * n.delta,
+                                                    settings.maxRefinementsPerDirection);
     }, [&](size_t done) {
         if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
     });

@@ -736,8 +736,10 @@ ClosestPoint closestPoint(const TriangleBvh& bvh, const double p[3], double maxD
         uint32_t node;
         double d2;
     };
-    std::vector<Item> stack;
-    stack.reserve(64);
+    // Reused per thread: this query runs millions of times (proxy errors), an allocation each
+    // time would cost as much as the search.
+    static thread_local std::vector<Item> stack;
+    stack.clear();
     stack.push_back({0, pointBoxDist2(p, nodes[0].lo, nodes[0].hi)});
     while (!stack.empty()) {
         Item it = stack.back();

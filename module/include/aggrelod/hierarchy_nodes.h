@@ -31,8 +31,9 @@ struct ProxySettings {
     /// How far (world units, as a fraction of delta_k) the certified upper bound of the
     /// error may exceed the largest distance actually found; the refinement stops there ...
     double toleranceFraction = 0.02;
-    /// ... or after this many region evaluations per direction beyond one per triangle (the
-    /// bound stays certified, only looser).
+    /// ... or when a direction has evaluated this many regions beyond one per triangle of
+    /// the measured side (proxy triangles one way, original triangles the other; boxes of
+    /// the originals count too). The bound stays certified, only looser.
     size_t maxRefinementsPerDirection = 20000;
     int threadCount = 0;  ///< 0 = hardware concurrency; results identical for every count
     ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
@@ -102,9 +103,10 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
                          const ProxySettings& settings, HierarchyNodes& out, std::string& error);
 
 /// Measures the error of a proxy (float positions, 3 * vertexCount; indices 3 * triangleCount,
-/// closed) against `originals` (world units) by branch and bound over triangles: refines
-/// until the bounds are within `tolerance` (world units) or after maxRefinementsPerDirection
-/// evaluations per direction beyond one per triangle. An empty proxy (nothing drawn) gets
+/// closed) against `originals` (world units) by branch and bound over triangles and, for
+/// originals -> proxy, boxes of per-object BVHs: refines until the bounds are within
+/// `tolerance` (world units) or when a direction has spent maxRefinementsPerDirection
+/// evaluations beyond one per triangle of its measured side. An empty proxy (nothing drawn) gets
 /// originalsToProxy = the diagonal of the originals' box. Deterministic, single thread.
 ProxyError measureProxyError(const std::vector<float>& proxyPositions,
                              const std::vector<uint32_t>& proxyIndices,

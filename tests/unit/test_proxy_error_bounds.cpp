@@ -1,0 +1,209 @@
+// Tests of the certified proxy error bounds (module/src/proxy_error.cpp, DESIGN 2.5) against
+// a brute-force measurement on small cases: a dense barycentric grid on every triangle, exact
+// closest points, inside-ness by the generalized winding number (independent of the ray
+// parity used by the bound). Each case exercises one of the region bounds: boxes of the
+// originals' BVHs dismissed inside the proxy, flat patches and vertex fans where proxy and
+// originals share a surface but not a triangulation, inside regions that do not meet the
+// proxy surface.
+#include <aggrelod/hierarchy_nodes.h>
+#include <aggrelod/samples.h>
+
+#include "mesh_distance.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace aggrelod;
+
+namespace {
+
+/// A generic rotation (about a tilted axis), so that flat faces are flat only up to rounding.
+void rotate(std::vector<double>& positions) {
+    const double a = 0.7, b = 0.4;
+    for (size_t i = 0; i + 2 < positions.size(); i += 3) {
+        double x = positions[i], y = positions[i + 1], z = positions[i + 2];
+        const double x1 = std::cos(a) * x - std::sin(a) * y, y1 = std::sin(a) * x + std::cos(a) * y;
+        const double y2 = std::cos(b) * y1 - std::sin(b) * z, z2 = std::sin(b) * y1 + std::cos(b) * z;
+        positions[i] = x1 + 3;
+        positions[i + 1] = y2 - 2;
+        positions[i + 2] = z2 + 1;
+    }
+}
+
+std::vector<float> toFloat(const std::vector<double>& p) { return std::vector<float>(p.begin(), p.end()); }
+
+double windingNumber(const std::vector<double>& pos, const std::vector<uint32_t>& idx, const double* q) {
+    double total = 0;
+    for (size_t t = 0; t < idx.size(); t += 3) {
+        double r[3][3], len[3];
+        for (int k = 0; k < 3; ++k) {
+            for (int d = 0; d < 3; ++d) r[k][d] = pos[3 * idx[t + k] + d] - q[d];
+            len[k] = std::sqrt(r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2]);
+        }
+        const double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+                           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+        auto dot = [&](int i, int j) { return r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2]; };
+        const double den = len[0] * len[1] * len[2] + dot(0, 1) * len[2] + dot(1, 2) * len[0] + dot(2, 0) * len[1];
+        total += 2 * std::atan2(det, den);
+    }
+    return total / (4 * M_PI);
+}
+
+/// visit(point) on a barycentric grid of step 1/n on every triangle.
+template <class Visit>
+void forEachGridPoint(const std::vector<double>& pos, const std::vector<uint32_t>& idx, int n, Visit&& visit) {
+    for (size_t t = 0; t < idx.size(); t += 3)
+        for (int i = 0; i <= n; ++i)
+            for (int j = 0; i + j <= n; ++j) {
+                double p[3];
+                for (int k = 0; k < 3; ++k) {
+                    const double a = pos[3 * idx[t] + k], b = pos[3 * idx[t + 1] + k], c = pos[3 * idx[t + 2] + k];
+                    p[k] = a + (b - a) * i / n + (c - a) * j / n;
+                }
+                visit(p);
+            }
+}
+
+struct Measured {
+    double proxyToOriginals = 0, originalsToProxy = 0;
+};
+
+/// Brute-force one-sided distances on a grid of step 1/n.
+Measured gridMeasure(const std::vector<float>& proxyPositions, const std::vector<uint32_t>& proxyIndices,
+                     const std::vector<const InputObject*>& originals, int n) {
+    std::vector<double> op, pp(proxyPositions.begin(), proxyPositions.end());
+    std::vector<uint32_t> oi;
+    for (const InputObject* o : originals) {
+        const uint32_t base = uint32_t(op.size() / 3);
+        op.insert(op.end(), o->positions.begin(), o->positions.end());
+        for (uint32_t i : o->indices) oi.push_back(base + i);
+    }
+    detail::TriangleBvh origBvh, proxyBvh;
+    origBvh.build(op.data(), op.size() / 3, oi.data(), oi.size() / 3);
+    proxyBvh.build(pp.data(), pp.size() / 3, proxyIndices.data(), proxyIndices.size() / 3);
+    Measured m;
+    forEachGridPoint(pp, proxyIndices, n, [&](const double* p) {
+        m.proxyToOriginals = std::max(m.proxyToOriginals, detail::closestPoint(origBvh, p).distance);
+    });
+    forEachGridPoint(op, oi, n, [&](const double* p) {
+        const double d = detail::closestPoint(proxyBvh, p).distance;
+        if (d > m.originalsToProxy && windingNumber(pp, proxyIndices, p) < 0.5) m.originalsToProxy = d;
+    });
+    return m;
+}
+
+/// The bound is certified (never below the grid measurement) and converged (within the
+/// tolerance of the largest distance it found, which it found at a real point).
+void expectCertifiedAndConverged(const ProxyError& e, const Measured& m) {
+    const double rounding = 1e-9;
+    EXPECT_GE(e.proxyToOriginals + rounding, m.proxyToOriginals);
+    EXPECT_GE(e.originalsToProxy + rounding, m.originalsToProxy);
+    EXPECT_LE(e.proxyToOriginalsLower, e.proxyToOriginals);
+    EXPECT_LE(e.originalsToProxyLower, e.originalsToProxy);
+    EXPECT_LE(e.proxyToOriginals - e.proxyToOriginalsLower, e.tolerance * (1 + 1e-9));
+    EXPECT_LE(e.originalsToProxy - e.originalsToProxyLower, e.tolerance * (1 + 1e-9));
+}
+
+/// A prism over a regular n-gon (radius r, z in [z0, z1]) with its caps triangulated as fans
+/// from rim vertex 0 (no centre vertex): the same solid as samples::makeCylinder's, another
+/// triangulation.
+void prismWithRimFans(int n, double r, double z0, double z1, std::vector<double>& pos, std::vector<uint32_t>& idx) {
+    pos.clear();
+    idx.clear();
+    for (int level = 0; level < 2; ++level)
+        for (int i = 0; i < n; ++i) {
+            const double a = 2 * M_PI * i / n;
+            pos.insert(pos.end(), {r * std::cos(a), r * std::sin(a), level ? z1 : z0});
+        }
+    for (int i = 0; i < n; ++i) {
+        const uint32_t a = uint32_t(i), b = uint32_t((i + 1) % n), c = uint32_t(n + (i + 1) % n), d = uint32_t(n + i);
+        idx.insert(idx.end(), {a, b, c, a, c, d});
+    }
+    for (int i = 1; i + 1 < n; ++i) {
+        idx.insert(idx.end(), {uint32_t(n), uint32_t(n + i), uint32_t(n + i + 1)});  // top, counter-clockwise from +z
+        idx.insert(idx.end(), {0u, uint32_t(i + 1), uint32_t(i)});                 // bottom, seen from -z
+    }
+}
+
+}  // namespace
+
+TEST(ProxyErrorBounds, SameSurfaceOtherTriangulationConvergesWithinTolerance) {
+    // A box with gridded faces against the plain 12-triangle box, both turned by a generic
+    // rotation: every original triangle lies on a proxy face, but proxy regions straddle many
+    // original edges and vertices (flat-patch bound) and vice versa. Without the patch bounds
+    // the branch and bound stops at its budget far above the tolerance.
+    InputObject original = samples::makeBox("grid box", {0, 0, 0}, {1.0, 0.7, 0.45}, 0.1);
+    InputObject plain = samples::makeBox("plain box", {0, 0, 0}, {1.0, 0.7, 0.45});
+    rotate(original.positions);
+    rotate(plain.positions);
+    const std::vector<float> proxy = toFloat(plain.positions);
+    const double tolerance = 1e-3;
+    const ProxyError e = measureProxyError(proxy, plain.indices, {&original}, tolerance, 20000);
+    EXPECT_LE(e.bound(), tolerance);
+    EXPECT_LT(e.evaluationCount, 20000u);  // converged long before the budget
+    expectCertifiedAndConverged(e, gridMeasure(proxy, plain.indices, {&original}, 8));
+}
+
+TEST(ProxyErrorBounds, CapFansAgainstRimFansConvergeWithinTolerance) {
+    // Cylinder caps as fans around a centre vertex (originals) against caps fanned from a rim
+    // vertex (proxy): regions around the originals' centre vertex straddle all its triangles
+    // (vertex-fan / flat-patch bounds).
+    const int n = 12;
+    InputObject original = samples::makeCylinder("cylinder", {0, 0, 0}, 0.5, 0.8, n, 3);
+    std::vector<double> prism;
+    std::vector<uint32_t> prismIndices;
+    prismWithRimFans(n, 0.5, 0, 0.8, prism, prismIndices);
+    rotate(original.positions);
+    rotate(prism);
+    const std::vector<float> proxy = toFloat(prism);
+    const double tolerance = 1e-3;
+    const ProxyError e = measureProxyError(proxy, prismIndices, {&original}, tolerance, 20000);
+    EXPECT_LE(e.bound(), tolerance);
+    EXPECT_LT(e.evaluationCount, 20000u);
+    expectCertifiedAndConverged(e, gridMeasure(proxy, prismIndices, {&original}, 8));
+}
+
+TEST(ProxyErrorBounds, BumpySphereProxyMatchesBruteForce) {
+    // A proxy crossing the original surface back and forth: vertices of the same UV sphere
+    // pushed in and out by up to 6 %. Original points inside the proxy count 0 (solid), the
+    // rest their distance; the bound must cover the dense grid and be tight.
+    const InputObject sphere = samples::makeUvSphere("sphere", {0.2, -0.1, 0.3}, 1.0, 16, 9);
+    std::vector<double> bumpy = sphere.positions;
+    for (size_t i = 0; i + 2 < bumpy.size(); i += 3) {
+        const double s = 1 + 0.06 * std::sin(1.7 * double(i / 3) + 0.3);
+        for (int k = 0; k < 3; ++k) {
+            const double c = k == 0 ? 0.2 : (k == 1 ? -0.1 : 0.3);
+            bumpy[i + k] = c + s * (bumpy[i + k] - c);
+        }
+    }
+    const std::vector<float> proxy = toFloat(bumpy);
+    const double tolerance = 2e-3;
+    const ProxyError e = measureProxyError(proxy, sphere.indices, {&sphere}, tolerance, 200000);
+    const Measured m = gridMeasure(proxy, sphere.indices, {&sphere}, 12);
+    expectCertifiedAndConverged(e, m);
+    EXPECT_GT(m.originalsToProxy, 0.01);  // the case really has originals outside the proxy
+    EXPECT_GT(m.proxyToOriginals, 0.01);
+}
+
+TEST(ProxyErrorBounds, OriginalsInsideABoxProxyAreDismissedByBoxes) {
+    // Three objects inside one box proxy, one of them touching its floor: originals -> proxy
+    // is 0 (boxes of the originals' BVHs inside the solid, clear of its surface, are
+    // dismissed whole; the touching one down to its triangles); proxy -> originals is the
+    // farthest box point from them.
+    const InputObject a = samples::makeUvSphere("a", {0.3, 0.3, 0.3}, 0.2, 12, 7);
+    const InputObject b = samples::makeBox("b", {0.6, 0.1, 0.0}, {0.9, 0.4, 0.3}, 0.1);
+    const InputObject c = samples::makeCylinder("c", {0.5, 0.7, 0.2}, 0.15, 0.4, 10, 2);
+    const InputObject box = samples::makeBox("proxy", {0, 0, 0}, {1, 1, 1});
+    const std::vector<float> proxy = toFloat(box.positions);
+    const double tolerance = 2e-3;
+    const ProxyError e = measureProxyError(proxy, box.indices, {&a, &b, &c}, tolerance, 200000);
+    EXPECT_LE(e.originalsToProxy, tolerance);
+    expectCertifiedAndConverged(e, gridMeasure(proxy, box.indices, {&a, &b, &c}, 8));
+    EXPECT_GT(e.proxyToOriginals, 0.5);  // the far top corners
+    // Fewer evaluations than original triangles: whole objects dismissed at once.
+    const size_t originalTriangles = (a.indices.size() + b.indices.size() + c.indices.size()) / 3;
+    const ProxyError shrunk = measureProxyError(proxy, box.indices, {&a, &c}, tolerance, 200000);
+    EXPECT_LT(shrunk.evaluationCount, originalTriangles);
+}
