@@ -339,7 +339,7 @@ TEST(CliSamples, MakeSampleToolWritesValidGlb) {
     std::vector<fs::path> files;
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"two_cubes", "--gap", "0.25"}, {"slabs"}, {"spheres15", "--seed", "3"},
-          {"chess", "--board"}, {"random", "--objects", "40", "--triangles", "4000"}}) {
+          {"chess", "--board"}, {"random", "--objects", "40", "--triangles", "4000"}, {"forest"}, {"village"}}) {
         std::vector<std::string> argv = {AGGRELOD_MAKE_SAMPLE};
         argv.insert(argv.end(), args.begin(), args.end());
         const fs::path out = dir / (args[0] + ".glb");
