@@ -218,7 +218,10 @@ private:
         uint32_t model, triangle;
         double point[3];
     };
-    size_t insertSurfacePoints(std::vector<Insertion>& insertions);
+    /// nearVertex: what to do with a point close to a triangle corner: skip it (the corner
+    /// is close already) or insert it inside the triangle all the same.
+    enum class NearVertex { Skip, Insert };
+    size_t insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex nearVertex);
     void buildLevels();
 };
 
@@ -719,27 +722,64 @@ void Baker::prerefineClosePairs() {
         const auto [i, j] = candidates[c];
         distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = CachedDistance{measured[c], false};
     }
-    insertSurfacePoints(insertions);
+    insertSurfacePoints(insertions, NearVertex::Skip);
 }
 
-// Splits surface triangles 1 -> 3 at the given points (moved slightly inside the triangle
-// so no sliver or degenerate triangle appears). Returns how many points were inserted.
-size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
+// Splits surface triangles at the given points. A point well inside its triangle splits it
+// 1 -> 3; a point near an edge splits that edge (the triangle and its neighbour across the
+// edge, 2 -> 4, the new vertex on the edge), because a 1 -> 3 split there makes thin sliver
+// triangles that slow the triangulation's exact predicates down; a point near a corner is
+// skipped or, with NearVertex::Insert, moved inside (no degenerate triangle). Surfaces stay
+// closed, manifold and outward. Returns how many points were inserted.
+size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex nearVertex) {
     modelsPrepared_ = false;  // surfaces change (not their shape: distances stay valid)
     for (auto& entry : distanceCache_) entry.second.trianglesCurrent = false;
     std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
         return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
     });
+    constexpr double kNearEdge = 0.1;  // smallest barycentric coordinate below this: near an edge
     size_t inserted = 0;
     for (size_t i = 0; i < insertions.size();) {
         size_t j = i;
         while (j < insertions.size() && insertions[j].model == insertions[i].model) ++j;
         Model& model = models_[insertions[i].model];
-        // children[t]: current triangles covering original triangle t (split 1 -> 3 in place).
+        const uint32_t originalCount = static_cast<uint32_t>(model.triangles.size() / 3);
+        // children[t]: current triangles covering original triangle t; origin[t]: the original
+        // triangle a current triangle comes from (new triangles only, index - originalCount).
         std::map<uint32_t, std::vector<uint32_t>> children;
+        std::vector<uint32_t> origin;
+        auto addChild = [&](uint32_t parent, uint32_t child) {
+            const uint32_t root = parent < originalCount ? parent : origin[parent - originalCount];
+            auto& list = children[root];
+            if (list.empty()) list.push_back(root);
+            list.push_back(child);
+            origin.push_back(root);
+        };
+        // Directed edge (from, to) -> triangles holding it, for finding the neighbour across an
+        // edge; built on the first edge split (lookups only, never iterated).
+        std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> edges;
+        bool edgesBuilt = false;
+        auto edgeKey = [](uint32_t from, uint32_t to) { return std::make_pair(from, to); };
+        auto setTriangle = [&](uint32_t t, uint32_t x, uint32_t y, uint32_t z) {
+            if (edgesBuilt && 3 * static_cast<size_t>(t) + 2 < model.triangles.size()) {
+                const uint32_t* old = &model.triangles[3 * t];
+                for (int e = 0; e < 3; ++e) {
+                    auto& list = edges[edgeKey(old[e], old[(e + 1) % 3])];
+                    list.erase(std::remove(list.begin(), list.end(), t), list.end());
+                }
+            }
+            if (3 * static_cast<size_t>(t) + 2 >= model.triangles.size()) model.triangles.resize(3 * static_cast<size_t>(t) + 3);
+            model.triangles[3 * t] = x;
+            model.triangles[3 * t + 1] = y;
+            model.triangles[3 * t + 2] = z;
+            if (edgesBuilt) {
+                const uint32_t v[3] = {x, y, z};
+                for (int e = 0; e < 3; ++e) edges[edgeKey(v[e], v[(e + 1) % 3])].push_back(t);
+            }
+        };
         for (size_t k = i; k < j; ++k) {
             const Insertion& ins = insertions[k];
-            if (3 * static_cast<size_t>(ins.triangle) + 2 >= model.triangles.size()) continue;
+            if (ins.triangle >= originalCount) continue;
             auto& list = children[ins.triangle];
             if (list.empty()) list.push_back(ins.triangle);
             // Locate the child with the largest smallest barycentric coordinate.
@@ -774,25 +814,68 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions) {
                 }
             }
             if (bestChild < 0) continue;
+            const uint32_t t = list[bestChild];
+            const uint32_t corner[3] = {model.triangles[3 * t], model.triangles[3 * t + 1], model.triangles[3 * t + 2]};
+            const uint32_t nv = static_cast<uint32_t>(model.positions.size() / 3);
+            const uint32_t t1 = static_cast<uint32_t>(model.triangles.size() / 3);
+            // Near an edge (one small coordinate) or a corner (two).
+            int smallest = 0;
+            for (int e = 1; e < 3; ++e)
+                if (bary[e] < bary[smallest]) smallest = e;
+            const int p = (smallest + 1) % 3, q = (smallest + 2) % 3;  // the edge corner[p] -> corner[q]
+            const bool nearEdge = bary[smallest] < kNearEdge;
+            const bool nearCorner = nearEdge && std::min(bary[p], bary[q]) < kNearEdge;
+            if (nearCorner && nearVertex == NearVertex::Skip) continue;
+            if (nearEdge && !nearCorner) {
+                if (!edgesBuilt) {
+                    for (uint32_t f = 0; 3 * static_cast<size_t>(f) + 2 < model.triangles.size(); ++f)
+                        for (int e = 0; e < 3; ++e)
+                            edges[edgeKey(model.triangles[3 * f + e], model.triangles[3 * f + (e + 1) % 3])].push_back(f);
+                    edgesBuilt = true;
+                }
+                const uint32_t a = corner[p], b = corner[q], c = corner[smallest];
+                const auto forward = edges.find(edgeKey(a, b));
+                const auto backward = edges.find(edgeKey(b, a));
+                // Only on a manifold edge (one triangle each way); otherwise split 1 -> 3 below.
+                if (forward != edges.end() && forward->second.size() == 1 && backward != edges.end() && backward->second.size() == 1 &&
+                    backward->second[0] != t) {
+                    const uint32_t t2 = backward->second[0];
+                    const uint32_t* n2 = &model.triangles[3 * t2];
+                    uint32_t d = n2[0];
+                    for (int e = 0; e < 3; ++e)
+                        if (n2[e] != a && n2[e] != b) d = n2[e];
+                    // The point projected on the edge, kept away from the corners.
+                    const double s = std::min(std::max(bary[q] / (bary[p] + bary[q]), kNearEdge), 1 - kNearEdge);
+                    for (int dim = 0; dim < 3; ++dim)
+                        model.positions.push_back((1 - s) * model.positions[3 * a + dim] + s * model.positions[3 * b + dim]);
+                    // (a, b, c) -> (a, nv, c) + (nv, b, c); neighbour (b, a, d) -> (b, nv, d) + (nv, a, d).
+                    setTriangle(t, a, nv, c);
+                    setTriangle(t1, nv, b, c);
+                    addChild(t, t1);
+                    setTriangle(t2, b, nv, d);
+                    setTriangle(t1 + 1, nv, a, d);
+                    addChild(t2, t1 + 1);
+                    ++inserted;
+                    continue;
+                }
+            }
             // Keep the new vertex strictly inside (no sliver, no degenerate triangle).
             const double floorBary = 0.02;
             double sum = 0;
-            for (double& b : bary) {
-                b = std::max(b, floorBary);
-                sum += b;
+            for (double& w : bary) {
+                w = std::max(w, floorBary);
+                sum += w;
             }
-            for (double& b : bary) b /= sum;
-            const uint32_t t = list[bestChild];
-            const uint32_t a = model.triangles[3 * t], b = model.triangles[3 * t + 1], c = model.triangles[3 * t + 2];
-            const uint32_t nv = static_cast<uint32_t>(model.positions.size() / 3);
+            for (double& w : bary) w /= sum;
+            const uint32_t a = corner[0], b = corner[1], c = corner[2];
             for (int d = 0; d < 3; ++d)
                 model.positions.push_back(bary[0] * model.positions[3 * a + d] + bary[1] * model.positions[3 * b + d] +
                                           bary[2] * model.positions[3 * c + d]);
-            model.triangles[3 * t + 2] = nv;  // (a, b, nv)
-            const uint32_t t1 = static_cast<uint32_t>(model.triangles.size() / 3);
-            model.triangles.insert(model.triangles.end(), {b, c, nv, c, a, nv});
-            list.push_back(t1);
-            list.push_back(t1 + 1);
+            setTriangle(t, a, b, nv);
+            setTriangle(t1, b, c, nv);
+            addChild(t, t1);
+            setTriangle(t1 + 1, c, a, nv);
+            addChild(t, t1 + 1);
             ++inserted;
         }
         i = j;
@@ -866,7 +949,7 @@ bool Baker::refineCoarseConnections() {
     }
     if (insertions.empty()) return false;
     timer_.begin("refine");
-    const size_t inserted = insertSurfacePoints(insertions);
+    const size_t inserted = insertSurfacePoints(insertions, NearVertex::Insert);
     diag(out_, Diagnostic::Severity::Note, "",
          "refined " + std::to_string(inserted) + " surface point(s) where the triangulation had no short connection "
          "between joined models; triangulating again");
