@@ -267,89 +267,36 @@ int runBake(BakeOptions o) {
         return kFileError;
     }
     const fs::path levelsPath = outDir / "levels.glb";
-    const fs::path levelsTmp = outDir / "levels.glb.tmp";
-    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes)) {
-        removeQuietly(levelsTmp);
-        printError(error);
-        return kFileError;
-    }
     const fs::path proxiesPath = outDir / "proxies.glb";
-    const fs::path proxiesTmp = outDir / "proxies.glb.tmp";
-    if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) {
-        removeQuietly(levelsTmp);
-        removeQuietly(proxiesTmp);
-        printError(error);
-        return kFileError;
-    }
     const fs::path runtimePath = outDir / "scene.aglod";
-    const fs::path runtimeTmp = outDir / "scene.aglod.tmp";
-    if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
-                               runtimeTmp.string(), error)) {
-        removeQuietly(levelsTmp);
-        removeQuietly(proxiesTmp);
-        removeQuietly(runtimeTmp);
-        printError(error);
-        return kFileError;
-    }
-    io::TilesetSummary tiles;
-    if (o.tiles && !writeTilesTmp(nodes, scene.objects, outDir, tiles, error)) {
-        removeQuietly(levelsTmp);
-        removeQuietly(proxiesTmp);
-        removeQuietly(runtimeTmp);
-        printError(error);
-        return kFileError;
-    }
-    // A leftover tiles.tmp would only be replaced by the next bake; remove it on failure.
-    const auto removeTilesTmp = [&outDir, &o] {
+    const fs::path statsPath = o.statsPath.empty() ? fs::path() : fs::path(o.statsPath);
+    // Every output as (temporary, final); on any failure all temporaries are removed (a
+    // temporary already renamed into place no longer exists, so removing it is a no-op).
+    std::vector<std::pair<fs::path, fs::path>> outputs = {{outDir / "levels.glb.tmp", levelsPath},
+                                                          {outDir / "proxies.glb.tmp", proxiesPath},
+                                                          {outDir / "scene.aglod.tmp", runtimePath}};
+    if (!statsPath.empty()) outputs.emplace_back(fs::path(o.statsPath + ".tmp"), statsPath);
+    const auto fail = [&](const std::string& message) {
+        for (const auto& output : outputs) removeQuietly(output.first);
         std::error_code removeError;
         if (o.tiles) fs::remove_all(outDir / "tiles.tmp", removeError);
+        printError(message);
+        return kFileError;
     };
-    fs::path statsPath, statsTmp;
-    if (!o.statsPath.empty()) {
-        statsPath = fs::path(o.statsPath);
-        statsTmp = fs::path(o.statsPath + ".tmp");
+    if (!io::writeLevelsGlb(hierarchy, scene.objects, outputs[0].first.string(), error, &nodes)) return fail(error);
+    if (!io::writeProxiesGlb(nodes, scene.objects, outputs[1].first.string(), error)) return fail(error);
+    if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
+                               outputs[2].first.string(), error))
+        return fail(error);
+    io::TilesetSummary tiles;
+    if (o.tiles && !writeTilesTmp(nodes, scene.objects, outDir, tiles, error)) return fail(error);
+    if (!statsPath.empty()) {
         if (statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
-        if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, statsTmp.string(),
-                                error)) {
-            removeQuietly(levelsTmp);
-            removeQuietly(proxiesTmp);
-            removeQuietly(runtimeTmp);
-            removeQuietly(statsTmp);
-            removeTilesTmp();
-            printError(error);
-            return kFileError;
-        }
+        if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, outputs[3].first.string(), error))
+            return fail(error);
     }
-    if (!renameOver(levelsTmp, levelsPath, error)) {
-        removeQuietly(levelsTmp);
-        removeQuietly(proxiesTmp);
-        removeQuietly(runtimeTmp);
-        if (!statsTmp.empty()) removeQuietly(statsTmp);
-        removeTilesTmp();
-        printError(error);
-        return kFileError;
-    }
-    if (!renameOver(proxiesTmp, proxiesPath, error)) {
-        removeQuietly(proxiesTmp);
-        removeQuietly(runtimeTmp);
-        if (!statsTmp.empty()) removeQuietly(statsTmp);
-        removeTilesTmp();
-        printError(error);
-        return kFileError;
-    }
-    if (!renameOver(runtimeTmp, runtimePath, error)) {
-        removeQuietly(runtimeTmp);
-        if (!statsTmp.empty()) removeQuietly(statsTmp);
-        removeTilesTmp();
-        printError(error);
-        return kFileError;
-    }
-    if (!statsTmp.empty() && !renameOver(statsTmp, statsPath, error)) {
-        removeQuietly(statsTmp);
-        removeTilesTmp();
-        printError(error);
-        return kFileError;
-    }
+    for (const auto& [tmp, final] : outputs)
+        if (!renameOver(tmp, final, error)) return fail(error);
     if (o.tiles && !renameTilesIntoPlace(outDir, error)) {
         printError(error);
         return kFileError;

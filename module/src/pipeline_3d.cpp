@@ -213,6 +213,8 @@ private:
     };
     std::map<std::pair<uint32_t, uint32_t>, CachedDistance> distanceCache_;
     void measureLikelyNeighbours(const std::atomic<bool>& stop);
+    std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours,
+                                                                 const std::atomic<bool>* stop = nullptr) const;
     void prerefineClosePairs();
     struct Insertion {
         uint32_t model, triangle;
@@ -667,28 +669,8 @@ void Baker::buildGraph() {
 void Baker::prerefineClosePairs() {
     timer_.begin("prerefine");
     resolveStandInOverlaps();
-    const size_t n = models_.size();
-    if (n < 2) return;
-    constexpr size_t kNeighbours = 6;
-    std::vector<std::pair<uint32_t, uint32_t>> candidates;
-    std::vector<std::pair<double, uint32_t>> near;
-    for (uint32_t i = 0; i < n; ++i) {
-        near.clear();
-        for (uint32_t j = 0; j < n; ++j) {
-            if (j == i) continue;
-            double d2 = 0;
-            for (int k = 0; k < 3; ++k) {
-                double gap = std::max({0.0, models_[j].bounds[k] - models_[i].bounds[3 + k], models_[i].bounds[k] - models_[j].bounds[3 + k]});
-                d2 += gap * gap;
-            }
-            near.emplace_back(d2, j);
-        }
-        const size_t keep = std::min(kNeighbours, near.size());
-        std::partial_sort(near.begin(), near.begin() + keep, near.end());
-        for (size_t k = 0; k < keep; ++k) candidates.emplace_back(std::min(i, near[k].second), std::max(i, near[k].second));
-    }
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    if (models_.size() < 2) return;
+    const std::vector<std::pair<uint32_t, uint32_t>> candidates = nearestPairsByBox(6);
     std::vector<Insertion> insertions;
     auto nearestVertexDistance = [&](const Model& m, uint32_t tri, const double* p) {
         double best = INFINITY;
@@ -883,14 +865,14 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex
     return inserted;
 }
 
-// Exact distances of each model's nearest models by box distance (more than the
-// near-pair refinement step measured), into distanceCache_, until `stop` is set.
-void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
-    constexpr size_t kNeighbours = 32;
+// Pairs (i < j, sorted, unique) of each model with its `neighbours` nearest models by box
+// distance. Stops early (possibly incomplete) when `stop` is set.
+std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neighbours,
+                                                                    const std::atomic<bool>* stop) const {
     const size_t n = models_.size();
     std::vector<std::pair<uint32_t, uint32_t>> candidates;
     std::vector<std::pair<double, uint32_t>> near;
-    for (uint32_t i = 0; i < n && !stop; ++i) {
+    for (uint32_t i = 0; i < n && !(stop && *stop); ++i) {
         near.clear();
         for (uint32_t j = 0; j < n; ++j) {
             if (j == i) continue;
@@ -901,12 +883,19 @@ void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
             }
             near.emplace_back(d2, j);
         }
-        const size_t keep = std::min(kNeighbours, near.size());
+        const size_t keep = std::min(neighbours, near.size());
         std::partial_sort(near.begin(), near.begin() + keep, near.end());
         for (size_t k = 0; k < keep; ++k) candidates.emplace_back(std::min(i, near[k].second), std::max(i, near[k].second));
     }
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    return candidates;
+}
+
+// Exact distances of each model's nearest models by box distance (more than the
+// near-pair refinement step measured), into distanceCache_, until `stop` is set.
+void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
+    const std::vector<std::pair<uint32_t, uint32_t>> candidates = nearestPairsByBox(32, &stop);
     for (const auto& [i, j] : candidates) {
         if (stop) return;
         const std::pair<uint32_t, uint32_t> key{models_[i].objects[0], models_[j].objects[0]};

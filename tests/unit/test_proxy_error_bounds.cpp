@@ -12,12 +12,16 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <algorithm>
 #include <cmath>
 
 using namespace aggrelod;
 
 namespace {
+
+using aggrelod::testing::windingNumber;
 
 /// A generic rotation (about a tilted axis), so that flat faces are flat only up to rounding.
 void rotate(std::vector<double>& positions) {
@@ -34,22 +38,6 @@ void rotate(std::vector<double>& positions) {
 
 std::vector<float> toFloat(const std::vector<double>& p) { return std::vector<float>(p.begin(), p.end()); }
 
-double windingNumber(const std::vector<double>& pos, const std::vector<uint32_t>& idx, const double* q) {
-    double total = 0;
-    for (size_t t = 0; t < idx.size(); t += 3) {
-        double r[3][3], len[3];
-        for (int k = 0; k < 3; ++k) {
-            for (int d = 0; d < 3; ++d) r[k][d] = pos[3 * idx[t + k] + d] - q[d];
-            len[k] = std::sqrt(r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2]);
-        }
-        const double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-                           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-        auto dot = [&](int i, int j) { return r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2]; };
-        const double den = len[0] * len[1] * len[2] + dot(0, 1) * len[2] + dot(1, 2) * len[0] + dot(2, 0) * len[1];
-        total += 2 * std::atan2(det, den);
-    }
-    return total / (4 * M_PI);
-}
 
 /// visit(point) on a barycentric grid of step 1/n on every triangle.
 template <class Visit>
