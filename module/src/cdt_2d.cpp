@@ -8,6 +8,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/Spatial_sort_traits_adapter_2.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -17,7 +20,13 @@
 namespace aggrelod::detail {
 namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
+/// Per vertex: the smallest input point index at its place (-1 for a crossing of
+/// constraints), and its number in the last export.
+struct VertexInfo {
+    int input = -1;
+    int index = -1;
+};
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, Kernel>;
 using FaceBase = CGAL::Triangulation_face_base_with_info_2<int, Kernel, CGAL::Constrained_triangulation_face_base_2<Kernel>>;
 using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
@@ -26,7 +35,8 @@ using Point = Kernel::Point_2;
 
 struct ConstrainedTriangulation2D::Impl {
     Cdt cdt;
-    std::vector<Cdt::Vertex_handle> inputHandle;  // per build() input point
+    std::vector<Cdt::Vertex_handle> inputHandle;               // per build() input point
+    std::vector<std::vector<Cdt::Vertex_handle>> splitHandle;  // per insertSplits() request: its new vertices
 };
 
 ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
@@ -34,78 +44,51 @@ ConstrainedTriangulation2D::~ConstrainedTriangulation2D() { delete impl_; }
 
 namespace {
 
-// Flat export. Vertices are numbered in the order of their input point (Steiner points
-// after, in CGAL's order, which is deterministic for a given input); faces by their sorted
-// vertex triple. Neither depends on CGAL's storage order.
-void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulation2D& out,
-                         const std::vector<size_t>* pointOrder, std::vector<Cdt::Vertex_handle>* inputHandle = nullptr) {
+// Flat export. Vertices are numbered in the order of their input point (info().input, the
+// smallest input index at the vertex's place; Steiner points after, in CGAL's order, which is
+// deterministic for a given input); faces by their sorted vertex triple. Neither depends on
+// CGAL's storage order.
+void exportTriangulation(Cdt& cdt, size_t inputCount, Triangulation2D& out) {
     out = Triangulation2D{};
-    const size_t n = points.size() / 2;
-    std::vector<size_t> ownOrder;
-    if (!pointOrder || pointOrder->size() != n) {
-        ownOrder.resize(n);
-        std::iota(ownOrder.begin(), ownOrder.end(), size_t{0});
-        std::sort(ownOrder.begin(), ownOrder.end(), [&](size_t a, size_t b) {
-            if (points[2 * a] != points[2 * b]) return points[2 * a] < points[2 * b];
-            if (points[2 * a + 1] != points[2 * b + 1]) return points[2 * a + 1] < points[2 * b + 1];
-            return a < b;
-        });
-        pointOrder = &ownOrder;
-    }
-    // The sorted points as one contiguous array: binary searches without indirection.
-    struct SortedPoint {
-        double x, y;
-        size_t index;
-    };
-    std::vector<SortedPoint> sorted;
-    sorted.reserve(n);
-    for (size_t i : *pointOrder) sorted.push_back({points[2 * i], points[2 * i + 1], i});
-    std::vector<std::pair<long long, Cdt::Vertex_handle>> keyed;
-    keyed.reserve(cdt.number_of_vertices());
-    long long steinerKey = static_cast<long long>(n);
+    // Vertices by input index (a direct table: no search, no sort), Steiner points after.
+    std::vector<Cdt::Vertex_handle> byInput(inputCount), steiner;
     for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
-        const double x = v->point().x(), y = v->point().y();
-        auto it = std::lower_bound(sorted.begin(), sorted.end(), 0, [&](const SortedPoint& a, int) {
-            return a.x < x || (a.x == x && a.y < y);
-        });
-        if (it != sorted.end() && it->x == x && it->y == y) {
-            keyed.emplace_back(static_cast<long long>(it->index), v);
-            if (inputHandle)
-                for (auto same = it; same != sorted.end() && same->x == x && same->y == y; ++same)
-                    (*inputHandle)[same->index] = v;
-        } else {
-            keyed.emplace_back(steinerKey++, v);
-        }
+        const int input = v->info().input;
+        if (input >= 0) byInput[static_cast<size_t>(input)] = v;
+        else steiner.push_back(v);
     }
-    std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    out.points.reserve(2 * keyed.size());
-    out.vertexInput.reserve(keyed.size());
-    for (size_t i = 0; i < keyed.size(); ++i) {
-        Cdt::Vertex_handle v = keyed[i].second;
-        v->info() = static_cast<int>(i);
+    const size_t vertexCount = cdt.number_of_vertices();
+    out.points.reserve(2 * vertexCount);
+    out.vertexInput.reserve(vertexCount);
+    auto add = [&](Cdt::Vertex_handle v, int input) {
+        v->info().index = static_cast<int>(out.vertexInput.size());
         out.points.push_back(v->point().x());
         out.points.push_back(v->point().y());
-        out.vertexInput.push_back(keyed[i].first < static_cast<long long>(n) ? static_cast<int>(keyed[i].first) : -1);
-    }
+        out.vertexInput.push_back(input);
+    };
+    for (size_t i = 0; i < inputCount; ++i)
+        if (byInput[i] != Cdt::Vertex_handle()) add(byInput[i], static_cast<int>(i));
+    for (Cdt::Vertex_handle v : steiner) add(v, -1);
     // Faces by sorted vertex triple: a counting sort on the smallest vertex, then tiny sorts.
     std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> unsortedFaces, faces;
     unsortedFaces.reserve(cdt.number_of_faces());
-    std::vector<uint32_t> bucketStart(keyed.size() + 1, 0);
+    std::vector<uint32_t> bucketStart(vertexCount + 1, 0);
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-        std::array<int, 3> key{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+        std::array<int, 3> key{f->vertex(0)->info().index, f->vertex(1)->info().index, f->vertex(2)->info().index};
         std::sort(key.begin(), key.end());
         ++bucketStart[key[0] + 1];
         unsortedFaces.emplace_back(key, f);
     }
-    for (size_t v = 0; v < keyed.size(); ++v) bucketStart[v + 1] += bucketStart[v];
+    for (size_t v = 0; v < vertexCount; ++v) bucketStart[v + 1] += bucketStart[v];
     faces.resize(unsortedFaces.size());
     {
         std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
         for (const auto& f : unsortedFaces) faces[fill[f.first[0]]++] = f;
     }
-    for (size_t v = 0; v < keyed.size(); ++v)
-        std::sort(faces.begin() + bucketStart[v], faces.begin() + bucketStart[v + 1],
-                  [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (size_t v = 0; v < vertexCount; ++v)
+        if (bucketStart[v + 1] - bucketStart[v] > 1)
+            std::sort(faces.begin() + bucketStart[v], faces.begin() + bucketStart[v + 1],
+                      [](const auto& a, const auto& b) { return a.first < b.first; });
     // Infinite faces (around the infinite vertex) are -1; every finite one gets its number.
     {
         auto first = cdt.incident_faces(cdt.infinite_vertex()), f = first;
@@ -119,7 +102,7 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
         const size_t i = static_cast<size_t>(f->info());
         for (int k = 0; k < 3; ++k) {
-            out.faces[3 * i + k] = f->vertex(k)->info();
+            out.faces[3 * i + k] = f->vertex(k)->info().index;
             out.neighbors[3 * i + k] = f->neighbor(k)->info();
             out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
         }
@@ -130,16 +113,36 @@ void exportTriangulation(Cdt& cdt, const std::vector<double>& points, Triangulat
 
 bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
                                        const std::vector<std::pair<size_t, size_t>>& segments, Triangulation2D& out,
-                                       std::string& error, const std::vector<size_t>* pointOrder) {
+                                       std::string& error) {
     const size_t n = points.size() / 2;
     try {
-        impl_->cdt.clear();
+        Cdt& cdt = impl_->cdt;
+        cdt.clear();
         std::vector<Point> pts;
         pts.reserve(n);
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
-        impl_->cdt.insert_constraints(pts.begin(), pts.end(), segments.begin(), segments.end());
-        impl_->inputHandle.assign(n, Cdt::Vertex_handle());
-        exportTriangulation(impl_->cdt, points, out, pointOrder, &impl_->inputHandle);
+        // CGAL's insert_constraints(points, segments) (Triangulation_2/insert_constraints.h),
+        // step by step to keep the vertex of every input point: spatially sorted insertion,
+        // then the constraints between the vertices.
+        std::vector<std::size_t> order(n);
+        std::iota(order.begin(), order.end(), std::size_t{0});
+        CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::Pointer_property_map<Point>::const_type> sortTraits(
+            CGAL::make_property_map(static_cast<const std::vector<Point>&>(pts)), cdt.geom_traits());
+        CGAL::spatial_sort(order.begin(), order.end(), sortTraits);
+        std::vector<Cdt::Vertex_handle>& handle = impl_->inputHandle;
+        handle.assign(n, Cdt::Vertex_handle());
+        Cdt::Face_handle hint;
+        for (std::size_t i : order) {
+            const Cdt::Vertex_handle v = cdt.insert(pts[i], hint);
+            handle[i] = v;
+            hint = v->face();
+            // Duplicate points share one vertex: it carries the smallest of their indices.
+            if (v->info().input < 0 || static_cast<int>(i) < v->info().input) v->info().input = static_cast<int>(i);
+        }
+        for (const auto& [a, b] : segments)
+            if (handle[a] != handle[b]) cdt.insert_constraint(handle[a], handle[b]);
+        impl_->splitHandle.clear();
+        exportTriangulation(cdt, n, out);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -147,17 +150,22 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
     return true;
 }
 
-bool ConstrainedTriangulation2D::splitConstraints(const std::vector<ConstraintSplit>& splits,
-                                                  std::vector<char>& applied, const std::vector<double>& allPoints,
-                                                  Triangulation2D& out, std::string& error,
-                                                  const std::vector<size_t>* allPointOrder) {
-    return insertSplits(splits, applied, error) && exportTo(allPoints, out, error, allPointOrder);
-}
-
-bool ConstrainedTriangulation2D::exportTo(const std::vector<double>& allPoints, Triangulation2D& out,
-                                          std::string& error, const std::vector<size_t>* allPointOrder) {
+bool ConstrainedTriangulation2D::exportTo(const std::vector<size_t>& newInputIndex, const std::vector<long long>& splitFirstIndex,
+                                          size_t inputCount, Triangulation2D& out, std::string& error) {
     try {
-        exportTriangulation(impl_->cdt, allPoints, out, allPointOrder);
+        Cdt& cdt = impl_->cdt;
+        for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
+            if (v->info().input >= 0) v->info().input = static_cast<int>(newInputIndex[static_cast<size_t>(v->info().input)]);
+        for (size_t k = 0; k < impl_->splitHandle.size() && k < splitFirstIndex.size(); ++k) {
+            if (splitFirstIndex[k] < 0) continue;
+            for (size_t j = 0; j < impl_->splitHandle[k].size(); ++j) {
+                const Cdt::Vertex_handle v = impl_->splitHandle[k][j];
+                const int input = static_cast<int>(splitFirstIndex[k] + static_cast<long long>(j));
+                if (v->info().input < 0 || input < v->info().input) v->info().input = input;
+            }
+        }
+        impl_->splitHandle.clear();
+        exportTriangulation(cdt, inputCount, out);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;
@@ -168,6 +176,7 @@ bool ConstrainedTriangulation2D::exportTo(const std::vector<double>& allPoints, 
 bool ConstrainedTriangulation2D::insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
                                               std::string& error) {
     applied.assign(splits.size(), 0);
+    impl_->splitHandle.assign(splits.size(), {});
     try {
         Cdt& cdt = impl_->cdt;
         for (size_t k = 0; k < splits.size(); ++k) {
@@ -185,6 +194,7 @@ bool ConstrainedTriangulation2D::insertSplits(const std::vector<ConstraintSplit>
             Cdt::Vertex_handle previous = va;
             for (size_t i = 0; i + 1 < split.points.size(); i += 2) {
                 const Cdt::Vertex_handle v = cdt.insert(Point(split.points[i], split.points[i + 1]), va->face());
+                impl_->splitHandle[k].push_back(v);
                 cdt.insert_constraint(previous, v);
                 previous = v;
             }

@@ -35,29 +35,25 @@ public:
     ConstrainedTriangulation2D& operator=(const ConstrainedTriangulation2D&) = delete;
 
     /// Triangulates `points` (2 * n, x y pairs) with the segments `segments` (pairs of point
-    /// indices) as constraints, all inserted in one batch. Crossing constraints are split at
-    /// their intersections (new Steiner vertices). Duplicate points become one vertex.
-    /// Returns false with a message when the triangulator fails (never throws).
-    /// pointOrder: optional, the point indices sorted by (x, y, index), if the caller has them
-    /// (saves sorting them again).
+    /// indices) as constraints, all inserted in one batch (spatially sorted). Crossing
+    /// constraints are split at their intersections (new Steiner vertices). Duplicate points
+    /// become one vertex. Returns false with a message when the triangulator fails (never throws).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
-               Triangulation2D& out, std::string& error, const std::vector<size_t>* pointOrder = nullptr);
+               Triangulation2D& out, std::string& error);
 
     /// Splits constraint segments (DESIGN 2.4 step 4, Steiner points): each segment that is
     /// still one constrained edge loses its constraint, gets its points inserted, and the
     /// chain from -> points -> to becomes constrained, so the new vertices lie exactly on
     /// constraints whatever the rounding of their coordinates. applied[k] says whether
-    /// splits[k] was done. Then exports again, numbering vertices by `allPoints` (the input
-    /// points including the new ones; allPointOrder as pointOrder in build()).
-    bool splitConstraints(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
-                          const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
-                          const std::vector<size_t>* allPointOrder = nullptr);
-
-    /// splitConstraints() in two steps, so the caller can prepare `allPoints` meanwhile:
-    /// first the insertion (applied[k] as above), then the export.
+    /// splits[k] was done.
     bool insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied, std::string& error);
-    bool exportTo(const std::vector<double>& allPoints, Triangulation2D& out, std::string& error,
-                  const std::vector<size_t>* allPointOrder = nullptr);
+
+    /// Exports again after insertSplits(), numbering vertices by the new input: build() input
+    /// point i becomes input point newInputIndex[i], and the j-th point of splits[k] input
+    /// point splitFirstIndex[k] + j (splitFirstIndex[k] < 0: the split is not kept in the
+    /// numbering). inputCount: size of the new input.
+    bool exportTo(const std::vector<size_t>& newInputIndex, const std::vector<long long>& splitFirstIndex,
+                  size_t inputCount, Triangulation2D& out, std::string& error);
 
 private:
     struct Impl;

@@ -650,7 +650,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    if (!triangulation.build(in.points, in.segments, space.tri, error, &in.sorted)) return fail(error);
+    if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
@@ -692,18 +692,25 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits); });
         const bool inserted = triangulation.insertSplits(requests, applied, error);
         split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits);
-        if (!inserted || !triangulation.exportTo(split.points, space.tri, error, &split.sorted)) return fail(error);
+        if (!inserted) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
             if (!applied[k]) {
                 splits[requestSegment[k]].clear();
                 allApplied = false;
             }
-        in = allApplied ? std::move(split) : inputVertices(checked, splits);
-        if (!allApplied) {
-            // Numbering must follow the final input points: export again without the skipped ones.
-            if (!triangulation.splitConstraints({}, applied, in.points, space.tri, error, &in.sorted)) return fail(error);
+        // The new input numbering: every original vertex followed by its segment's new points.
+        const size_t originalCount = in.part.size();
+        std::vector<size_t> newInputIndex(originalCount);
+        for (size_t v = 0, next = 0; v < originalCount; ++v) {
+            newInputIndex[v] = next;
+            next += 1 + splits[v].size();
         }
+        std::vector<long long> splitFirstIndex(requests.size(), -1);
+        for (size_t k = 0; k < requests.size(); ++k)
+            if (applied[k]) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
+        in = allApplied ? std::move(split) : inputVertices(checked, splits);
+        if (!triangulation.exportTo(newInputIndex, splitFirstIndex, in.part.size(), space.tri, error)) return fail(error);
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
