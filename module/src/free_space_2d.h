@@ -33,6 +33,7 @@ struct FreeSpace2D {
     std::vector<char> faceVoid;      ///< per face: free, enclosed by one model (an input hole): never filled
     std::vector<double> faceArea;    ///< per face
     std::vector<double> edgeLength;  ///< 3 * faceCount: edge opposite corner i
+    std::vector<double> faceLongest; ///< per face: its longest edge
     std::vector<int> edgePair;       ///< 3 * faceCount: index into pairs, or kSameModelEdge2D / kUnpairedEdge2D
     std::vector<ModelPair2D> pairs;  ///< sorted by (a, b)
     std::vector<uint64_t> pairKeys;  ///< per pair: a << 32 | b (compact, for pairIndex)

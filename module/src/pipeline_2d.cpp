@@ -367,6 +367,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // shortest connection seen in a free triangle (edge, or vertex to a model's boundary edge).
     space.faceArea.resize(faceCount);
     space.edgeLength.resize(3 * faceCount);
+    space.faceLongest.resize(faceCount);
     if (!graphOnly) space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
     struct PairEntry {
         uint32_t a, b;
@@ -391,6 +392,9 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                 const double dx = P(w)[0] - P(u)[0], dy = P(w)[1] - P(u)[1];
                 space.edgeLength[3 * f + j] = std::sqrt(dx * dx + dy * dy);  // not hypot: 5x slower, no overflow risk here
             }
+            double longest = 0;
+            for (int e = 0; e < 3; ++e) longest = std::max(longest, space.edgeLength[3 * f + e]);
+            space.faceLongest[f] = longest;
             if (space.faceModel[f] >= 0) continue;
             for (int j = 0; j < 3; ++j) {
                 const int u = v[(j + 1) % 3], w = v[(j + 2) % 3];
@@ -754,6 +758,9 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
     std::vector<int> mergePair;  // per merge: its index in space.pairs
     for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
+    const ConnectionFans2D fans = settings.shape == Shape2D::Sculpted || settings.computeBaselines
+                                      ? computeConnectionFans2D(space, mergePair, settings.threadCount)
+                                      : ConnectionFans2D{};
     // F of every pair at every level: a custom function (user code) on the calling thread, the
     // built-in ones inside the parallel level loop below.
     const size_t levelCount = deltas.size();
@@ -781,9 +788,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         level.delta = deltas[li];
         size_t groupCount = 0;
         const std::vector<uint32_t> modelGroup = groupsAtThreshold(space.modelCount, out.merges, level.delta, &groupCount);
-        std::vector<int> joined;
-        for (size_t k = 0; k < out.merges.size() && out.merges[k].height < level.delta; ++k)
-            joined.push_back(mergePair[k]);
+        size_t joined = 0;  // the merges of this level: the first ones (ascending height)
+        while (joined < out.merges.size() && out.merges[joined].height < level.delta) ++joined;
         level.aggregates.resize(groupCount);
         // Sources and hulls of every group.
         for (size_t f = 0; f < features.size(); ++f)
@@ -813,7 +819,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
                 agg.measures.circularity = circularity(agg.measures.area, agg.measures.perimeter);
             }
         } else {
-            sculptLevel2D(space, modelGroup, primaryLimits[li], joined, label);
+            sculptLevel2D(space, modelGroup, primaryLimits[li], fans, joined, label);
             extractPolygons2D(space, label, groupCount, level.aggregates);
         }
         for (const Aggregate2D& agg : level.aggregates) {
@@ -822,9 +828,9 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         }
         level.measures.circularity = circularity(level.measures.area, level.measures.perimeter);
         if (settings.computeBaselines) {
-            sculptLevel2D(space, modelGroup, constantLimits[li], joined, label);
+            sculptLevel2D(space, modelGroup, constantLimits[li], fans, joined, label);
             level.constant = measureLabels2D(space, label);
-            sculptLevel2D(space, modelGroup, adaptiveLimits[li], joined, label);
+            sculptLevel2D(space, modelGroup, adaptiveLimits[li], fans, joined, label);
             level.adaptive = measureLabels2D(space, label);
         }
     };

@@ -12,6 +12,7 @@
 // otherwise they touch at a point and come out as two polygons of one MultiPolygon.
 #include "sculpt_2d.h"
 
+#include "parallel_for.h"
 #include "polygon_check_2d.h"
 
 #include <algorithm>
@@ -74,7 +75,6 @@ struct Sculptor2D {
     const EdgeLimits2D& limits;
     std::vector<int>& label;
     std::vector<char> isProtected;
-    std::vector<int> bestFan, fanPath;  // scratch of protectFanTo, reused
 
     const Triangulation2D& tri() const { return space.tri; }
     int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>(modelGroup[m]); }
@@ -108,63 +108,39 @@ struct Sculptor2D {
         return pairIndex == kSameModelEdge2D ? limits.sameModel : limits.unpaired;
     }
 
-    // A fan of kept free faces around a vertex of `model`, from face f to a face sharing an
-    // edge with the model's interior; protects the smallest one found.
-    void protectFanTo(int f, int model, int group) {
-        for (int j = 0; j < 3; ++j) {
-            const int n = tri().neighbors[3 * f + j];
-            if (n >= 0 && space.faceModel[n] == model) return;  // already shares an edge
-        }
-        // The fan of least total area: the one hugging the corner, not a sliver along a side.
-        std::vector<int>& best = bestFan;
-        std::vector<int>& path = fanPath;
-        best.clear();
-        bool found = false;
+    // The fan of least total area among the slot's walks whose faces are all kept in the
+    // group and no longer than delta (the one hugging the corner, not a sliver along a side;
+    // a fan through a long face would fill far more than the connection).
+    void protectFan(const ConnectionFans2D& fans, size_t slot, int group) {
+        uint32_t best = UINT32_MAX;
         double bestArea = INFINITY;
-        for (int k = 0; k < 3; ++k) {
-            const int v = tri().faces[3 * f + k];
-            if (space.vertexModel[v] != model) continue;
-            for (int side = 1; side <= 2; ++side) {
-                path.clear();
-                int cur = f;
-                for (int steps = 0; steps < 256; ++steps) {
-                    int kv = 0;
-                    while (tri().faces[3 * cur + kv] != v) ++kv;
-                    const int n = tri().neighbors[3 * cur + (kv + side) % 3];
-                    if (n < 0) break;
-                    if (space.faceModel[n] == model) {
-                        double area = 0;
-                        for (int p : path) area += space.faceArea[p];
-                        if (!found || area < bestArea) {
-                            best = path;
-                            bestArea = area;
-                        }
-                        found = true;
-                        break;
-                    }
-                    if (!isKeptFree(n, group) || n == f) break;
-                    // Only small faces: a fan through a sliver spanning the gap would fill far
-                    // more than the connection (the models then touch at a point instead).
-                    double longest = 0;
-                    for (int e = 0; e < 3; ++e) longest = std::max(longest, space.edgeLength[3 * static_cast<size_t>(n) + e]);
-                    if (longest > limits.delta) break;
-                    path.push_back(n);
-                    cur = n;
-                }
+        for (uint32_t c = fans.slotBegin[slot]; c < fans.slotBegin[slot + 1]; ++c) {
+            bool usable = true;
+            for (uint32_t i = fans.pathBegin[c]; i < fans.pathBegin[c + 1] && usable; ++i) {
+                const int p = fans.faces[i];
+                usable = label[p] == group && !(space.faceLongest[p] > limits.delta);
+            }
+            if (usable && (best == UINT32_MAX || fans.pathArea[c] < bestArea)) {
+                best = c;
+                bestArea = fans.pathArea[c];
             }
         }
-        for (int p : best) isProtected[p] = 1;
+        if (best == UINT32_MAX) return;
+        for (uint32_t i = fans.pathBegin[best]; i < fans.pathBegin[best + 1]; ++i) isProtected[fans.faces[i]] = 1;
     }
 
-    void protectConnection(int pairIndex) {
+    void protectConnection(const ConnectionFans2D& fans, size_t merge) {
+        const int pairIndex = fans.pair[merge];
+        if (pairIndex < 0) return;
         const ModelPair2D& pair = space.pairs[pairIndex];
         const int group = groupOfModel(static_cast<int>(pair.a));
         if (group < 0 || group != groupOfModel(static_cast<int>(pair.b))) return;
-        for (int f : pair.bestFace) {
+        for (int i = 0; i < 2; ++i) {
+            const int f = pair.bestFace[i];
             if (!isKeptFree(f, group)) continue;
             isProtected[f] = 1;
-            protectFanTo(f, static_cast<int>(pair.a), group);
-            protectFanTo(f, static_cast<int>(pair.b), group);
+            protectFan(fans, 4 * merge + 2 * i, group);
+            protectFan(fans, 4 * merge + 2 * i + 1, group);
             return;
         }
     }
@@ -206,12 +182,83 @@ struct HalfEdge {
 
 }  // namespace
 
+ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<int>& mergePair, int threadCount) {
+    const Triangulation2D& tri = space.tri;
+    const size_t mergeCount = mergePair.size();
+    // Blocks of merges on all threads, each filling its own arrays; joined in block order.
+    const size_t blockCount = std::clamp<size_t>(mergeCount / 512, 1, 64);
+    std::vector<ConnectionFans2D> blocks(blockCount);
+    parallelFor(blockCount, threadCount, [&](size_t block) {
+        ConnectionFans2D& out = blocks[block];
+        std::vector<int> path;
+        const size_t first = mergeCount * block / blockCount, last = mergeCount * (block + 1) / blockCount;
+        for (size_t k = first; k < last; ++k) {
+            const int pairIndex = mergePair[k];
+            for (int slot = 0; slot < 4; ++slot) {
+                out.slotBegin.push_back(static_cast<uint32_t>(out.pathArea.size()));
+                if (pairIndex < 0) continue;
+                const ModelPair2D& pair = space.pairs[pairIndex];
+                const int f = pair.bestFace[slot / 2];
+                const int model = static_cast<int>(slot % 2 == 0 ? pair.a : pair.b);
+                if (f < 0 || space.faceModel[f] >= 0) continue;
+                bool sharesEdge = false;  // f already shares an edge with the model: no fan
+                for (int j = 0; j < 3; ++j) {
+                    const int n = tri.neighbors[3 * f + j];
+                    if (n >= 0 && space.faceModel[n] == model) sharesEdge = true;
+                }
+                if (sharesEdge) continue;
+                // Walks around each vertex of the model, both ways, to a face of its interior;
+                // the level-dependent tests (kept in the group, no longer than delta) are left
+                // to protectFan.
+                for (int kf = 0; kf < 3; ++kf) {
+                    const int v = tri.faces[3 * f + kf];
+                    if (space.vertexModel[v] != model) continue;
+                    for (int side = 1; side <= 2; ++side) {
+                        path.clear();
+                        int cur = f;
+                        for (int steps = 0; steps < 256; ++steps) {
+                            int kv = 0;
+                            while (tri.faces[3 * cur + kv] != v) ++kv;
+                            const int n = tri.neighbors[3 * cur + (kv + side) % 3];
+                            if (n < 0) break;
+                            if (space.faceModel[n] == model) {
+                                double area = 0;
+                                for (int p : path) area += space.faceArea[p];
+                                out.pathBegin.push_back(static_cast<uint32_t>(out.faces.size()));
+                                out.faces.insert(out.faces.end(), path.begin(), path.end());
+                                out.pathArea.push_back(area);
+                                break;
+                            }
+                            if (space.faceModel[n] >= 0 || n == f) break;
+                            path.push_back(n);
+                            cur = n;
+                        }
+                    }
+                }
+            }
+        }
+    });
+    ConnectionFans2D fans;
+    fans.pair = mergePair;
+    fans.slotBegin.reserve(4 * mergeCount + 1);
+    for (const ConnectionFans2D& b : blocks) {
+        const uint32_t candidateOffset = static_cast<uint32_t>(fans.pathArea.size());
+        const uint32_t faceOffset = static_cast<uint32_t>(fans.faces.size());
+        for (uint32_t s : b.slotBegin) fans.slotBegin.push_back(s + candidateOffset);
+        for (uint32_t p : b.pathBegin) fans.pathBegin.push_back(p + faceOffset);
+        fans.pathArea.insert(fans.pathArea.end(), b.pathArea.begin(), b.pathArea.end());
+        fans.faces.insert(fans.faces.end(), b.faces.begin(), b.faces.end());
+    }
+    fans.slotBegin.push_back(static_cast<uint32_t>(fans.pathArea.size()));
+    fans.pathBegin.push_back(static_cast<uint32_t>(fans.faces.size()));
+    return fans;
+}
+
 void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
-                   const std::vector<int>& joinedPairs, std::vector<int>& faceLabel) {
-    Sculptor2D s{space, modelGroup, limits, faceLabel, {}, {}, {}};
+                   const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel) {
+    Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
     s.initialLabels();
-    for (int p : joinedPairs)
-        if (p >= 0) s.protectConnection(p);
+    for (size_t k = 0; k < joinedMerges && k < fans.pair.size(); ++k) s.protectConnection(fans, k);
     s.carve();
 }
 

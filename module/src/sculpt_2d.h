@@ -18,11 +18,27 @@ struct EdgeLimits2D {
 
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function);
 
+/// The fans of free faces that can carry each merge's shortest connection to its two models
+/// (DESIGN 2.4 step 4), walked once for all levels. Per merge k, best face i (of the pair's
+/// two) and model s (0: pair.a, 1: pair.b), slot 4k + 2i + s lists the walks around the
+/// model's vertices from that face that reach the model's interior, in walk order. A level
+/// keeps the least-area one whose faces are all kept in the group and no longer than delta.
+struct ConnectionFans2D {
+    std::vector<int> pair;            ///< per merge: index into space.pairs, -1 if none
+    std::vector<uint32_t> slotBegin;  ///< 4 * mergeCount + 1: candidates of each slot
+    std::vector<uint32_t> pathBegin;  ///< per candidate, + 1: its faces are faces[pathBegin[c], pathBegin[c + 1])
+    std::vector<double> pathArea;     ///< per candidate: total area of its faces
+    std::vector<int> faces;
+};
+
+/// mergePair: per merge of the dendrogram (ascending height), its index into space.pairs.
+ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<int>& mergePair, int threadCount);
+
 /// Labels every face with the group whose aggregate contains it (-1: in none).
-/// `joinedPairs`: indices into space.pairs of the merges of this level, whose shortest
-/// connection is kept (DESIGN 2.4 step 4).
+/// The first `joinedMerges` merges (those of this level) keep their shortest connection
+/// (DESIGN 2.4 step 4), through `fans`.
 void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
-                   const std::vector<int>& joinedPairs, std::vector<int>& faceLabel);
+                   const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel);
 
 /// Total area and boundary length of the labelled faces (all groups).
 Measures2D measureLabels2D(const FreeSpace2D& space, const std::vector<int>& faceLabel);
