@@ -20,8 +20,8 @@ struct ModelPair2D {
     double minDistance = 0;            ///< shortest connection (graph weight), world units
     int bestFace[2] = {-1, -1};        ///< free faces holding the shortest connection
     int connection[3] = {-1, -1, -1};  ///< its ends: vertices (c0, c1), or vertex c0 to the edge (c1, c2)
-    std::vector<double> lengths;       ///< lengths of the free edges joining a and b, ascending
-    std::vector<double> prefixSum, prefixSumSquares;  ///< size lengths.size() + 1
+    uint32_t firstLength = 0, lengthCount = 0;  ///< FreeSpace2D::pairLengths[firstLength, + lengthCount)
+    uint32_t firstPrefix = 0;          ///< FreeSpace2D::pairPrefixSum(Squares)[firstPrefix, + lengthCount + 1)
 };
 
 struct FreeSpace2D {
@@ -37,6 +37,9 @@ struct FreeSpace2D {
     std::vector<int> edgePair;       ///< 3 * faceCount: index into pairs, or kSameModelEdge2D / kUnpairedEdge2D
     std::vector<ModelPair2D> pairs;  ///< sorted by (a, b)
     std::vector<uint64_t> pairKeys;  ///< per pair: a << 32 | b (compact, for pairIndex)
+    std::vector<double> pairLengths;           ///< per pair: lengths of the free edges joining a and b, ascending
+    std::vector<double> pairPrefixSum;         ///< per pair: running sums of its lengths, from 0
+    std::vector<double> pairPrefixSumSquares;  ///< per pair: running sums of its squared lengths, from 0
     std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs)
 
     /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <future>
 #include <numeric>
 #include <string>
@@ -198,7 +197,9 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     // 3. Inside / outside by winding count, flooding from the outside of the hull.
     std::vector<int> winding(faceCount, INT32_MIN);
     std::vector<std::tuple<size_t, int>> found;
-    std::deque<int> queue;
+    std::vector<int> queue;  // first in, first out: each face enters once
+    queue.reserve(faceCount);
+    size_t queueHead = 0;
     for (size_t f = 0; f < faceCount; ++f)
         for (int j = 0; j < 3; ++j)
             if (tri.neighbors[3 * f + j] < 0 && winding[f] == INT32_MIN) {
@@ -236,9 +237,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         return tri.vertexInput[u] < 0 && tri.vertexInput[v] < 0 &&
                std::hypot(tri.points[2 * v] - tri.points[2 * u], tri.points[2 * v + 1] - tri.points[2 * u + 1]) <= tiny;
     };
-    while (!queue.empty()) {
-        const int f = queue.front();
-        queue.pop_front();
+    while (queueHead < queue.size()) {
+        const int f = queue[queueHead++];
         for (int j = 0; j < 3; ++j) {
             const int n = tri.neighbors[3 * f + j];
             if (n < 0 || winding[n] != INT32_MIN || unreliable(f, j)) continue;
@@ -418,66 +418,73 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
             }
         }
     });
+    // Entries grouped by pair: a counting sort on a straight from the blocks (within a model,
+    // face order), then a stable sort on b per model. Each pair's entries form one run; its
+    // shortest connection is the least entry of the run by (distance, face, edge, connection).
     std::vector<PairEntry> entries;
+    std::vector<uint32_t> start(space.modelCount + 1, 0);
     {
-        size_t total = 0;
-        for (const auto& b : blockEntries) total += b.size();
-        entries.reserve(total);
+        for (const auto& b : blockEntries)
+            for (const PairEntry& e : b) ++start[e.a + 1];
+        for (size_t m = 0; m < space.modelCount; ++m) start[m + 1] += start[m];
+        entries.resize(start[space.modelCount]);
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
         for (auto& b : blockEntries) {
-            entries.insert(entries.end(), b.begin(), b.end());
+            for (const PairEntry& e : b) entries[fill[e.a]++] = e;
             std::vector<PairEntry>().swap(b);
         }
-    }
-    // Sorted by (a, b, distance, face, edge, connection): a counting sort on a, then small
-    // sorts per model (much cheaper than one sort of the whole array; same total order).
-    {
-        std::vector<uint32_t> start(space.modelCount + 1, 0);
-        for (const PairEntry& e : entries) ++start[e.a + 1];
-        for (size_t m = 0; m < space.modelCount; ++m) start[m + 1] += start[m];
-        std::vector<PairEntry> bucketed(entries.size());
-        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-        for (const PairEntry& e : entries) bucketed[fill[e.a]++] = e;
-        auto less = [](const PairEntry& x, const PairEntry& y) {
-            return std::tie(x.b, x.distance, x.face, x.faceEdge, x.connection[0], x.connection[1], x.connection[2]) <
-                   std::tie(y.b, y.distance, y.face, y.faceEdge, y.connection[0], y.connection[1], y.connection[2]);
-        };
         const size_t modelBlocks = std::clamp<size_t>(space.modelCount / 1024, 1, 64);
         parallelFor(modelBlocks, threadCount, [&](size_t block) {
-            for (size_t m = space.modelCount * block / modelBlocks; m < space.modelCount * (block + 1) / modelBlocks; ++m)
-                std::sort(bucketed.begin() + start[m], bucketed.begin() + start[m + 1], less);
+            for (size_t m = space.modelCount * block / modelBlocks; m < space.modelCount * (block + 1) / modelBlocks; ++m) {
+                const auto first = entries.begin() + start[m], last = entries.begin() + start[m + 1];
+                if (last - first <= 32) {  // the usual case: an insertion sort (stable)
+                    for (auto i = first + (first != last); i < last; ++i)
+                        for (auto j = i; j > first && (j - 1)->b > j->b; --j) std::iter_swap(j - 1, j);
+                } else {
+                    std::stable_sort(first, last, [](const PairEntry& x, const PairEntry& y) { return x.b < y.b; });
+                }
+            }
         });
-        entries = std::move(bucketed);
     }
+    auto less = [](const PairEntry& x, const PairEntry& y) {
+        return std::tie(x.distance, x.face, x.faceEdge, x.connection[0], x.connection[1], x.connection[2]) <
+               std::tie(y.distance, y.face, y.faceEdge, y.connection[0], y.connection[1], y.connection[2]);
+    };
     for (size_t i = 0; i < entries.size();) {
-        size_t e = i;
+        size_t e = i, best = i;
+        for (; e < entries.size() && entries[e].a == entries[i].a && entries[e].b == entries[i].b; ++e)
+            if (less(entries[e], entries[best])) best = e;
         ModelPair2D pair;
         pair.a = entries[i].a;
         pair.b = entries[i].b;
-        pair.minDistance = entries[i].distance;
-        pair.bestFace[0] = entries[i].face;
-        std::copy(entries[i].connection, entries[i].connection + 3, pair.connection);
-        for (; e < entries.size() && entries[e].a == pair.a && entries[e].b == pair.b; ++e) {
-            if (entries[e].length >= 0 && !graphOnly) pair.lengths.push_back(entries[e].length);
-            if (pair.bestFace[1] < 0 && entries[e].distance == pair.minDistance && entries[e].face != pair.bestFace[0])
-                pair.bestFace[1] = entries[e].face;
-        }
-        if (graphOnly) {
-            space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
-            space.pairs.push_back(std::move(pair));
-            i = e;
-            continue;
-        }
-        std::sort(pair.lengths.begin(), pair.lengths.end());
-        pair.prefixSum.assign(pair.lengths.size() + 1, 0);
-        pair.prefixSumSquares.assign(pair.lengths.size() + 1, 0);
-        for (size_t k = 0; k < pair.lengths.size(); ++k) {
-            pair.prefixSum[k + 1] = pair.prefixSum[k] + pair.lengths[k];
-            pair.prefixSumSquares[k + 1] = pair.prefixSumSquares[k] + pair.lengths[k] * pair.lengths[k];
-        }
+        pair.minDistance = entries[best].distance;
+        pair.bestFace[0] = entries[best].face;
+        std::copy(entries[best].connection, entries[best].connection + 3, pair.connection);
+        // The second face: the smallest other face holding a connection as short.
         for (size_t k = i; k < e; ++k)
-            if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
+            if (entries[k].distance == pair.minDistance && entries[k].face != pair.bestFace[0] &&
+                (pair.bestFace[1] < 0 || entries[k].face < pair.bestFace[1]))
+                pair.bestFace[1] = entries[k].face;
+        if (!graphOnly) {
+            pair.firstLength = static_cast<uint32_t>(space.pairLengths.size());
+            for (size_t k = i; k < e; ++k)
+                if (entries[k].length >= 0) space.pairLengths.push_back(entries[k].length);
+            pair.lengthCount = static_cast<uint32_t>(space.pairLengths.size() - pair.firstLength);
+            const auto lengths = space.pairLengths.begin() + pair.firstLength;
+            std::sort(lengths, lengths + pair.lengthCount);
+            pair.firstPrefix = static_cast<uint32_t>(space.pairPrefixSum.size());
+            space.pairPrefixSum.push_back(0);
+            space.pairPrefixSumSquares.push_back(0);
+            for (size_t k = 0; k < pair.lengthCount; ++k) {
+                const double length = space.pairLengths[pair.firstLength + k];
+                space.pairPrefixSum.push_back(space.pairPrefixSum.back() + length);
+                space.pairPrefixSumSquares.push_back(space.pairPrefixSumSquares.back() + length * length);
+            }
+            for (size_t k = i; k < e; ++k)
+                if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
+        }
         space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
-        space.pairs.push_back(std::move(pair));
+        space.pairs.push_back(pair);
         i = e;
     }
     for (size_t f = 0; f < faceCount && !graphOnly; ++f)

@@ -52,16 +52,18 @@ EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const A
         in.delta = delta;
         in.minDistance = pair.minDistance;
         // sigma over the joining edges shorter than delta (see aggregate_function.cpp).
-        const size_t k = static_cast<size_t>(std::lower_bound(pair.lengths.begin(), pair.lengths.end(), delta) -
-                                             pair.lengths.begin());
+        const double* lengths = space.pairLengths.data() + pair.firstLength;
+        const double* prefixSum = space.pairPrefixSum.data() + pair.firstPrefix;
+        const double* prefixSumSquares = space.pairPrefixSumSquares.data() + pair.firstPrefix;
+        const size_t k = static_cast<size_t>(std::lower_bound(lengths, lengths + pair.lengthCount, delta) - lengths);
         auto stats = [&](size_t count, double& mean, double& sigma) {
             if (count == 0) { mean = sigma = 0; return; }
-            mean = pair.prefixSum[count] / static_cast<double>(count);
-            sigma = std::sqrt(std::max(0.0, pair.prefixSumSquares[count] / static_cast<double>(count) - mean * mean));
+            mean = prefixSum[count] / static_cast<double>(count);
+            sigma = std::sqrt(std::max(0.0, prefixSumSquares[count] / static_cast<double>(count) - mean * mean));
         };
         double meanAll = 0;
         stats(k, in.meanEdgeLength, in.sigma);
-        stats(pair.lengths.size(), meanAll, in.sigmaAllEdges);
+        stats(pair.lengthCount, meanAll, in.sigmaAllEdges);
         limits.pair[p] = function(in);
     }
     return limits;
