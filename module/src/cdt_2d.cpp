@@ -48,8 +48,9 @@ namespace {
 // smallest input index at the vertex's place; Steiner points after, in CGAL's order, which is
 // deterministic for a given input); faces by their sorted vertex triple. Neither depends on
 // CGAL's storage order.
-void exportTriangulation(Cdt& cdt, size_t inputCount, Triangulation2D& out) {
+void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputVertex, Triangulation2D& out) {
     out = Triangulation2D{};
+    const size_t inputCount = inputVertex.size();
     // Vertices by input index (a direct table: no search, no sort), Steiner points after.
     std::vector<Cdt::Vertex_handle> byInput(inputCount), steiner;
     for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
@@ -69,6 +70,8 @@ void exportTriangulation(Cdt& cdt, size_t inputCount, Triangulation2D& out) {
     for (size_t i = 0; i < inputCount; ++i)
         if (byInput[i] != Cdt::Vertex_handle()) add(byInput[i], static_cast<int>(i));
     for (Cdt::Vertex_handle v : steiner) add(v, -1);
+    out.inputVertex.resize(inputCount);
+    for (size_t i = 0; i < inputCount; ++i) out.inputVertex[i] = inputVertex[i]->info().index;
     // Faces by sorted vertex triple: a counting sort on the smallest vertex, then tiny sorts.
     std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> unsortedFaces, faces;
     unsortedFaces.reserve(cdt.number_of_faces());
@@ -142,7 +145,7 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         for (const auto& [a, b] : segments)
             if (handle[a] != handle[b]) cdt.insert_constraint(handle[a], handle[b]);
         impl_->splitHandle.clear();
-        exportTriangulation(cdt, n, out);
+        exportTriangulation(cdt, handle, out);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -164,8 +167,13 @@ bool ConstrainedTriangulation2D::exportTo(const std::vector<size_t>& newInputInd
                 if (v->info().input < 0 || input < v->info().input) v->info().input = input;
             }
         }
+        std::vector<Cdt::Vertex_handle> inputVertex(inputCount);
+        for (size_t i = 0; i < impl_->inputHandle.size(); ++i) inputVertex.at(newInputIndex[i]) = impl_->inputHandle[i];
+        for (size_t k = 0; k < impl_->splitHandle.size() && k < splitFirstIndex.size(); ++k)
+            for (size_t j = 0; j < impl_->splitHandle[k].size() && splitFirstIndex[k] >= 0; ++j)
+                inputVertex.at(static_cast<size_t>(splitFirstIndex[k]) + j) = impl_->splitHandle[k][j];
         impl_->splitHandle.clear();
-        exportTriangulation(cdt, inputCount, out);
+        exportTriangulation(cdt, inputVertex, out);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;

@@ -12,7 +12,8 @@ namespace aggrelod::detail {
 /// Flat triangulation of the convex hull of the input points.
 struct Triangulation2D {
     std::vector<double> points;     ///< 2 * vertexCount, x y pairs
-    std::vector<int> vertexInput;   ///< per vertex: index of an input point at the same place, -1 for a Steiner point
+    std::vector<int> vertexInput;   ///< per vertex: index of an input point at the same place (the smallest), -1 for a Steiner point
+    std::vector<int> inputVertex;   ///< per input point: its vertex
     std::vector<int> faces;         ///< 3 * faceCount vertex indices, counter-clockwise
     std::vector<int> neighbors;     ///< 3 * faceCount: face across the edge opposite corner i, -1 outside the hull
     std::vector<char> constrained;  ///< 3 * faceCount: edge opposite corner i lies on a constraint

@@ -52,8 +52,7 @@ struct InputVertices {
     std::vector<uint32_t> part;            // per vertex
     std::vector<uint32_t> ringStart, ringSize;  // per vertex: its ring's first vertex and size
     std::vector<std::pair<size_t, size_t>> segments;
-    std::vector<size_t> sorted;            // by (x, y, index)
-    std::vector<char> shared;              // per vertex: another input vertex lies at the same place
+    std::vector<char> shared;              // per vertex: another input vertex lies at the same place (setShared)
     std::vector<char> partTouches;         // per part: its boundary meets another part's
     // Uniform grid of the ring segments (segment i starts at vertex i), for finding the input
     // segments under a triangulation edge; segments spanning many cells go to `longSegments`.
@@ -106,7 +105,19 @@ void buildSegmentGrid(InputVertices& in) {
         for (long long cy = y0; cy <= y1; ++cy)
             for (long long cx = x0; cx <= x1; ++cx) in.gridEntries.emplace_back(cy * in.gridNx + cx, static_cast<uint32_t>(i));
     }
-    std::sort(in.gridEntries.begin(), in.gridEntries.end());
+    // Sorted by (cell, segment): a counting sort on the cell when the grid is not much larger
+    // than the entry list (entries come in segment order), else a sort.
+    const size_t cellCount = static_cast<size_t>(in.gridNx * in.gridNy);
+    if (cellCount <= 4 * in.gridEntries.size() + 4096) {
+        std::vector<uint32_t> start(cellCount + 1, 0);
+        for (const auto& e : in.gridEntries) ++start[e.first + 1];
+        for (size_t c = 0; c < cellCount; ++c) start[c + 1] += start[c];
+        std::vector<std::pair<long long, uint32_t>> sorted(in.gridEntries.size());
+        for (const auto& e : in.gridEntries) sorted[start[e.first]++] = e;
+        in.gridEntries = std::move(sorted);
+    } else {
+        std::sort(in.gridEntries.begin(), in.gridEntries.end());
+    }
 }
 
 // Winding number of all input rings around (px, py) (exteriors counter-clockwise, holes
@@ -501,7 +512,15 @@ std::vector<GraphEdge> graphEdges(const FreeSpace2D& space) {
     return graph;
 }
 
-/// Input vertices of the checked polygons; splits[s] lists parameters in (0, 1) at which the
+/// in.shared from the triangulation of `in`: input points sharing a vertex lie at the same place.
+void setShared(InputVertices& in, const Triangulation2D& tri) {
+    std::vector<uint8_t> count(tri.vertexCount(), 0);
+    for (int v : tri.inputVertex) count[v] = static_cast<uint8_t>(std::min(count[v] + 1, 2));
+    in.shared.resize(in.part.size());
+    for (size_t i = 0; i < in.shared.size(); ++i) in.shared[i] = count[tri.inputVertex[i]] > 1;
+}
+
+/// Input vertices of the checked polygons (in.shared is set by setShared); splits[s] lists parameters in (0, 1) at which the
 /// ring segment starting at original vertex s gets an extra (collinear) vertex.
 InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<std::vector<double>>& splits) {
     InputVertices in;
@@ -530,25 +549,6 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
                 in.segments.emplace_back(start + i, start + (i + 1) % size);
             }
         }
-    }
-    {
-        // Sorted as contiguous (x, y, index) triples: no indirection in the comparisons.
-        struct Key {
-            double x, y;
-            size_t index;
-        };
-        std::vector<Key> keys(in.part.size());
-        for (size_t i = 0; i < keys.size(); ++i) keys[i] = {in.x(i), in.y(i), i};
-        std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-            return std::tie(a.x, a.y, a.index) < std::tie(b.x, b.y, b.index);
-        });
-        in.sorted.resize(keys.size());
-        for (size_t i = 0; i < keys.size(); ++i) in.sorted[i] = keys[i].index;
-    }
-    in.shared.assign(in.part.size(), 0);
-    for (size_t k = 1; k < in.sorted.size(); ++k) {
-        const size_t a = in.sorted[k - 1], b = in.sorted[k];
-        if (in.x(a) == in.x(b) && in.y(a) == in.y(b)) in.shared[a] = in.shared[b] = 1;
     }
     in.partTouches.assign(checked.parts.size(), 0);
     for (auto [a, b] : checked.touchingParts) in.partTouches[a] = in.partTouches[b] = 1;
@@ -662,6 +662,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     std::string error;
     ConstrainedTriangulation2D triangulation;
     if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    setShared(in, space.tri);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
@@ -722,6 +723,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             if (applied[k]) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
         in = allApplied ? std::move(split) : inputVertices(checked, splits);
         if (!triangulation.exportTo(newInputIndex, splitFirstIndex, in.part.size(), space.tri, error)) return fail(error);
+        setShared(in, space.tri);
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
