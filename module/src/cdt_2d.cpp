@@ -4,6 +4,8 @@
 // done by the caller (CGAL 5.5 has no mark_domain_in_triangulation).
 #include "cdt_2d.h"
 
+#include "parallel_for.h"
+
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
@@ -40,6 +42,24 @@ struct ConstrainedTriangulation2D::Impl {
 };
 
 ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
+
+namespace {
+
+// cdt.insert_constraint(a, b), with a shortcut for the usual case where a-b is already an edge:
+// it is marked as CGAL's mark_constraint() does (insert_constraint would find the same edge
+// after collinearity tests and a heap-allocated stack).
+void insertConstraint(Cdt& cdt, Cdt::Vertex_handle a, Cdt::Vertex_handle b) {
+    Cdt::Face_handle face;
+    int index = 0;
+    if (cdt.dimension() == 2 && cdt.is_edge(a, b, face, index)) {
+        face->set_constraint(index, true);
+        face->neighbor(index)->set_constraint(cdt.mirror_index(face, index), true);
+        return;
+    }
+    cdt.insert_constraint(a, b);
+}
+
+}  // namespace
 ConstrainedTriangulation2D::~ConstrainedTriangulation2D() { delete impl_; }
 
 namespace {
@@ -48,7 +68,7 @@ namespace {
 // smallest input index at the vertex's place; Steiner points after, in CGAL's order, which is
 // deterministic for a given input); faces by their sorted vertex triple. Neither depends on
 // CGAL's storage order.
-void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputVertex, Triangulation2D& out) {
+void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputVertex, Triangulation2D& out, int threadCount) {
     out = Triangulation2D{};
     const size_t inputCount = inputVertex.size();
     // Vertices by input index (a direct table: no search, no sort), Steiner points after.
@@ -73,50 +93,68 @@ void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputV
     out.inputVertex.resize(inputCount);
     for (size_t i = 0; i < inputCount; ++i) out.inputVertex[i] = inputVertex[i]->info().index;
     // Faces by sorted vertex triple: a counting sort on the smallest vertex, then tiny sorts.
-    std::vector<std::pair<std::array<int, 3>, Cdt::Face_handle>> unsortedFaces, faces;
-    unsortedFaces.reserve(cdt.number_of_faces());
+    // Keys and sorts in parallel blocks (each writing its own slots; same result for any
+    // thread count).
+    std::vector<Cdt::Face_handle> handles;
+    handles.reserve(cdt.number_of_faces());
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) handles.push_back(f);
+    const size_t faceCount = handles.size();
+    std::vector<std::array<int, 3>> keys(faceCount);
+    const size_t blocks = std::clamp<size_t>(faceCount / 16384, 1, 64);
+    parallelFor(blocks, threadCount, [&](size_t block) {
+        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i) {
+            const Cdt::Face_handle f = handles[i];
+            std::array<int, 3> key{f->vertex(0)->info().index, f->vertex(1)->info().index, f->vertex(2)->info().index};
+            std::sort(key.begin(), key.end());
+            keys[i] = key;
+        }
+    });
     std::vector<uint32_t> bucketStart(vertexCount + 1, 0);
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-        std::array<int, 3> key{f->vertex(0)->info().index, f->vertex(1)->info().index, f->vertex(2)->info().index};
-        std::sort(key.begin(), key.end());
-        ++bucketStart[key[0] + 1];
-        unsortedFaces.emplace_back(key, f);
-    }
+    for (const auto& key : keys) ++bucketStart[key[0] + 1];
     for (size_t v = 0; v < vertexCount; ++v) bucketStart[v + 1] += bucketStart[v];
-    faces.resize(unsortedFaces.size());
+    std::vector<uint32_t> sorted(faceCount);  // storage positions, by key
     {
         std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
-        for (const auto& f : unsortedFaces) faces[fill[f.first[0]]++] = f;
+        for (size_t i = 0; i < faceCount; ++i) sorted[fill[keys[i][0]]++] = static_cast<uint32_t>(i);
     }
-    for (size_t v = 0; v < vertexCount; ++v)
-        if (bucketStart[v + 1] - bucketStart[v] > 1)
-            std::sort(faces.begin() + bucketStart[v], faces.begin() + bucketStart[v + 1],
-                      [](const auto& a, const auto& b) { return a.first < b.first; });
+    const size_t vertexBlocks = std::clamp<size_t>(vertexCount / 8192, 1, 64);
+    parallelFor(vertexBlocks, threadCount, [&](size_t block) {
+        for (size_t v = vertexCount * block / vertexBlocks; v < vertexCount * (block + 1) / vertexBlocks; ++v)
+            if (bucketStart[v + 1] - bucketStart[v] > 1)
+                std::sort(sorted.begin() + bucketStart[v], sorted.begin() + bucketStart[v + 1],
+                          [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+    });
     // Infinite faces (around the infinite vertex) are -1; every finite one gets its number.
     {
         auto first = cdt.incident_faces(cdt.infinite_vertex()), f = first;
         if (f != nullptr) do f->info() = -1; while (++f != first);
     }
-    for (size_t i = 0; i < faces.size(); ++i) faces[i].second->info() = static_cast<int>(i);
-    out.faces.resize(3 * faces.size());
-    out.neighbors.resize(3 * faces.size());
-    out.constrained.resize(3 * faces.size());
+    parallelFor(blocks, threadCount, [&](size_t block) {
+        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i)
+            handles[sorted[i]]->info() = static_cast<int>(i);
+    });
+    out.faces.resize(3 * faceCount);
+    out.neighbors.resize(3 * faceCount);
+    out.constrained.resize(3 * faceCount);
     // In CGAL's storage order (sequential reads), each face writing its own slots.
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-        const size_t i = static_cast<size_t>(f->info());
-        for (int k = 0; k < 3; ++k) {
-            out.faces[3 * i + k] = f->vertex(k)->info().index;
-            out.neighbors[3 * i + k] = f->neighbor(k)->info();
-            out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
+    parallelFor(blocks, threadCount, [&](size_t block) {
+        for (size_t h = faceCount * block / blocks; h < faceCount * (block + 1) / blocks; ++h) {
+            const Cdt::Face_handle f = handles[h];
+            const size_t i = static_cast<size_t>(f->info());
+            for (int k = 0; k < 3; ++k) {
+                out.faces[3 * i + k] = f->vertex(k)->info().index;
+                out.neighbors[3 * i + k] = f->neighbor(k)->info();
+                out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
+            }
         }
-    }
+    });
 }
 
 }  // namespace
 
 bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
                                        const std::vector<std::pair<size_t, size_t>>& segments, Triangulation2D& out,
-                                       std::string& error) {
+                                       std::string& error, int threadCount) {
     const size_t n = points.size() / 2;
     try {
         Cdt& cdt = impl_->cdt;
@@ -143,9 +181,9 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
             if (v->info().input < 0 || static_cast<int>(i) < v->info().input) v->info().input = static_cast<int>(i);
         }
         for (const auto& [a, b] : segments)
-            if (handle[a] != handle[b]) cdt.insert_constraint(handle[a], handle[b]);
+            if (handle[a] != handle[b]) insertConstraint(cdt, handle[a], handle[b]);
         impl_->splitHandle.clear();
-        exportTriangulation(cdt, handle, out);
+        exportTriangulation(cdt, handle, out, threadCount);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
         return false;
@@ -154,7 +192,8 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
 }
 
 bool ConstrainedTriangulation2D::exportTo(const std::vector<size_t>& newInputIndex, const std::vector<long long>& splitFirstIndex,
-                                          size_t inputCount, Triangulation2D& out, std::string& error) {
+                                          size_t inputCount, Triangulation2D& out, std::string& error,
+                                          int threadCount) {
     try {
         Cdt& cdt = impl_->cdt;
         for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
@@ -173,7 +212,7 @@ bool ConstrainedTriangulation2D::exportTo(const std::vector<size_t>& newInputInd
             for (size_t j = 0; j < impl_->splitHandle[k].size() && splitFirstIndex[k] >= 0; ++j)
                 inputVertex.at(static_cast<size_t>(splitFirstIndex[k]) + j) = impl_->splitHandle[k][j];
         impl_->splitHandle.clear();
-        exportTriangulation(cdt, inputVertex, out);
+        exportTriangulation(cdt, inputVertex, out, threadCount);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed while adding points: ") + e.what();
         return false;
@@ -203,10 +242,10 @@ bool ConstrainedTriangulation2D::insertSplits(const std::vector<ConstraintSplit>
             for (size_t i = 0; i + 1 < split.points.size(); i += 2) {
                 const Cdt::Vertex_handle v = cdt.insert(Point(split.points[i], split.points[i + 1]), va->face());
                 impl_->splitHandle[k].push_back(v);
-                cdt.insert_constraint(previous, v);
+                insertConstraint(cdt, previous, v);
                 previous = v;
             }
-            cdt.insert_constraint(previous, vb);
+            insertConstraint(cdt, previous, vb);
             applied[k] = 1;
         }
     } catch (const std::exception& e) {

@@ -39,8 +39,9 @@ public:
     /// indices) as constraints, all inserted in one batch (spatially sorted). Crossing
     /// constraints are split at their intersections (new Steiner vertices). Duplicate points
     /// become one vertex. Returns false with a message when the triangulator fails (never throws).
+    /// threadCount: threads for the export (0 = all cores; same result for any count).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
-               Triangulation2D& out, std::string& error);
+               Triangulation2D& out, std::string& error, int threadCount = 0);
 
     /// Splits constraint segments (DESIGN 2.4 step 4, Steiner points): each segment that is
     /// still one constrained edge loses its constraint, gets its points inserted, and the
@@ -54,7 +55,7 @@ public:
     /// point splitFirstIndex[k] + j (splitFirstIndex[k] < 0: the split is not kept in the
     /// numbering). inputCount: size of the new input.
     bool exportTo(const std::vector<size_t>& newInputIndex, const std::vector<long long>& splitFirstIndex,
-                  size_t inputCount, Triangulation2D& out, std::string& error);
+                  size_t inputCount, Triangulation2D& out, std::string& error, int threadCount = 0);
 
 private:
     struct Impl;

@@ -605,12 +605,13 @@ std::vector<std::vector<double>> connectionSplits(const InputVertices& in, const
             if (u > margin && u < 1 - margin) addAt(s, u);
     }
     for (auto& list : splits) {
+        if (list.size() < 2) continue;
         std::sort(list.begin(), list.end());
-        // Drop near-duplicates (two connections at one place).
-        std::vector<double> kept;
-        for (double t : list)
-            if (kept.empty() || t - kept.back() > 1e-6) kept.push_back(t);
-        list = std::move(kept);
+        // Drop near-duplicates (two connections at one place), in place.
+        size_t kept = 1;
+        for (size_t i = 1; i < list.size(); ++i)
+            if (list[i] - list[kept - 1] > 1e-6) list[kept++] = list[i];
+        list.resize(kept);
     }
     return splits;
 }
@@ -661,7 +662,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    if (!triangulation.build(in.points, in.segments, space.tri, error)) return fail(error);
+    if (!triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount)) return fail(error);
     setShared(in, space.tri);
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
@@ -722,7 +723,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         for (size_t k = 0; k < requests.size(); ++k)
             if (applied[k]) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
         in = allApplied ? std::move(split) : inputVertices(checked, splits);
-        if (!triangulation.exportTo(newInputIndex, splitFirstIndex, in.part.size(), space.tri, error)) return fail(error);
+        if (!triangulation.exportTo(newInputIndex, splitFirstIndex, in.part.size(), space.tri, error, settings.threadCount)) return fail(error);
         setShared(in, space.tri);
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
