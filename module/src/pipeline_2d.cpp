@@ -105,19 +105,7 @@ void buildSegmentGrid(InputVertices& in) {
         for (long long cy = y0; cy <= y1; ++cy)
             for (long long cx = x0; cx <= x1; ++cx) in.gridEntries.emplace_back(cy * in.gridNx + cx, static_cast<uint32_t>(i));
     }
-    // Sorted by (cell, segment): a counting sort on the cell when the grid is not much larger
-    // than the entry list (entries come in segment order), else a sort.
-    const size_t cellCount = static_cast<size_t>(in.gridNx * in.gridNy);
-    if (cellCount <= 4 * in.gridEntries.size() + 4096) {
-        std::vector<uint32_t> start(cellCount + 1, 0);
-        for (const auto& e : in.gridEntries) ++start[e.first + 1];
-        for (size_t c = 0; c < cellCount; ++c) start[c + 1] += start[c];
-        std::vector<std::pair<long long, uint32_t>> sorted(in.gridEntries.size());
-        for (const auto& e : in.gridEntries) sorted[start[e.first]++] = e;
-        in.gridEntries = std::move(sorted);
-    } else {
-        std::sort(in.gridEntries.begin(), in.gridEntries.end());
-    }
+    sortGridEntries(in.gridEntries, static_cast<size_t>(in.gridNx * in.gridNy));
 }
 
 // Winding number of all input rings around (px, py) (exteriors counter-clockwise, holes
@@ -522,7 +510,8 @@ void setShared(InputVertices& in, const Triangulation2D& tri) {
 
 /// Input vertices of the checked polygons (in.shared is set by setShared); splits[s] lists parameters in (0, 1) at which the
 /// ring segment starting at original vertex s gets an extra (collinear) vertex.
-InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<std::vector<double>>& splits) {
+InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<std::vector<double>>& splits,
+                            bool withGrid = true) {
     InputVertices in;
     size_t original = 0;
     for (uint32_t p = 0; p < checked.parts.size(); ++p) {
@@ -552,7 +541,7 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
     }
     in.partTouches.assign(checked.parts.size(), 0);
     for (auto [a, b] : checked.touchingParts) in.partTouches[a] = in.partTouches[b] = 1;
-    buildSegmentGrid(in);
+    if (withGrid) buildSegmentGrid(in);
     return in;
 }
 
@@ -651,7 +640,12 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         }
     }
     out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
-    InputVertices in = inputVertices(checked, {});
+    // The segment grid (read by the free-space pass only) is built on another thread while
+    // CGAL triangulates; they touch different members.
+    InputVertices in = inputVertices(checked, {}, /*withGrid=*/false);
+    std::future<void> gridLater;
+    if (settings.threadCount != 1) gridLater = std::async(std::launch::async, [&] { buildSegmentGrid(in); });
+    else buildSegmentGrid(in);
     endStage("check input");
 
     // 2.-5. Triangulation, free space, models and graph; then once more with Steiner points
@@ -664,6 +658,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     ConstrainedTriangulation2D triangulation;
     if (!triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount)) return fail(error);
     setShared(in, space.tri);
+    if (gridLater.valid()) gridLater.get();
     endStage("triangulate");
     buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:

@@ -137,6 +137,19 @@ double ringSignedArea(const std::vector<double>& ring) {
     return 0.5 * sum;
 }
 
+void sortGridEntries(std::vector<std::pair<long long, uint32_t>>& entries, size_t cellCount) {
+    if (cellCount > 4 * entries.size() + 4096) {
+        std::sort(entries.begin(), entries.end());
+        return;
+    }
+    std::vector<uint32_t> start(cellCount + 1, 0);
+    for (const auto& e : entries) ++start[static_cast<size_t>(e.first) + 1];
+    for (size_t c = 0; c < cellCount; ++c) start[c + 1] += start[c];
+    std::vector<std::pair<long long, uint32_t>> sorted(entries.size());
+    for (const auto& e : entries) sorted[start[static_cast<size_t>(e.first)]++] = e;
+    entries = std::move(sorted);
+}
+
 double ringLength(const std::vector<double>& ring) {
     const size_t n = ring.size() / 2;
     double len = 0;
@@ -249,7 +262,7 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
             for (long long cy = y0; cy <= y1; ++cy)
                 for (long long cx = x0; cx <= x1; ++cx) entries.emplace_back(cy * nx + cx, i);
         }
-        std::sort(entries.begin(), entries.end());
+        sortGridEntries(entries, static_cast<size_t>(nx * ny));
 
         for (size_t b = 0; b < entries.size();) {
             size_t e = b;

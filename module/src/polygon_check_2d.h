@@ -27,4 +27,9 @@ double ringSignedArea(const std::vector<double>& ring);
 /// Length of a closed ring.
 double ringLength(const std::vector<double>& ring);
 
+/// Sorts (cell, item) entries of a uniform grid with cells in [0, cellCount): a counting sort
+/// on the cell when the grid is not much larger than the list, else a plain sort. Same order
+/// as std::sort when the entries come in ascending item order (as grid builders make them).
+void sortGridEntries(std::vector<std::pair<long long, uint32_t>>& entries, size_t cellCount);
+
 }  // namespace aggrelod::detail

@@ -416,7 +416,7 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
         for (size_t i = 0; i < loops.size(); ++i) {
             if (loops[i].area <= 0) continue;
             exteriorLoop.push_back(i);
-            agg.polygons.push_back(Polygon2D{loops[i].ring, {}});
+            agg.polygons.push_back(Polygon2D{std::move(loops[i].ring), {}});
             polygonComponent.push_back(SIZE_MAX);  // filled when a hole needs it
         }
         for (size_t i = 0; i < loops.size(); ++i) {
