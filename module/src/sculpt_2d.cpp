@@ -340,7 +340,7 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
     };
     std::vector<Loop> loops;
     size_t groupBegin = 0;
-    std::vector<size_t> trace, stack;
+    std::vector<size_t> trace, stack, polygonComponent, exteriorLoop;
     std::vector<size_t> stackPos(tri.vertexCount(), SIZE_MAX);  // per vertex: its place on the stack
     while (groupBegin < edges.size()) {
         const int g = edges[groupBegin].group;
@@ -393,6 +393,7 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
             stack.clear();
             auto emit = [&](size_t fromIndex) {
                 Loop loop;
+                loop.ring.reserve(2 * (stack.size() - fromIndex));
                 for (size_t i = fromIndex; i < stack.size(); ++i) {
                     loop.ring.push_back(px(edges[stack[i]].from));
                     loop.ring.push_back(py(edges[stack[i]].from));
@@ -412,7 +413,8 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
         }
         // Exteriors (counter-clockwise) and holes (clockwise), holes to the exterior of their component.
         Aggregate2D& agg = aggregates[g];
-        std::vector<size_t> polygonComponent, exteriorLoop;
+        polygonComponent.clear();
+        exteriorLoop.clear();
         for (size_t i = 0; i < loops.size(); ++i) {
             if (loops[i].area <= 0) continue;
             exteriorLoop.push_back(i);
