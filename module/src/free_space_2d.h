@@ -40,7 +40,7 @@ struct FreeSpace2D {
     std::vector<double> pairLengths;           ///< per pair: lengths of the free edges joining a and b, ascending
     std::vector<double> pairPrefixSum;         ///< per pair: running sums of its lengths, from 0
     std::vector<double> pairPrefixSumSquares;  ///< per pair: running sums of its squared lengths, from 0
-    std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs)
+    std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs); only when hulls are needed
 
     /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.
     int pairIndex(uint32_t a, uint32_t b) const;

@@ -188,8 +188,9 @@ struct FreeSpaceModels {
 /// graphOnly: only what the dendrogram and the Steiner points need (models, pairs with their
 /// shortest connection, edge lengths); no voids, per-pair length statistics, edge pairs or
 /// model points (the pass before the Steiner points, whose result is replaced).
+/// withModelPoints: fill space.modelPoints (read only by the convex hulls).
 void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
-                    FreeSpaceModels& models, bool graphOnly, int threadCount) {
+                    FreeSpaceModels& models, bool graphOnly, int threadCount, bool withModelPoints = false) {
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
 
@@ -317,8 +318,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     space.faceModel.assign(faceCount, -1);
     for (size_t f = 0; f < faceCount; ++f)
         if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;
-    if (!graphOnly) space.modelPoints.resize(space.modelCount);
-    for (size_t v = 0; v < in.part.size() && !graphOnly; ++v) {
+    if (withModelPoints) space.modelPoints.resize(space.modelCount);
+    for (size_t v = 0; v < in.part.size() && withModelPoints; ++v) {
         auto& pts = space.modelPoints[partModel[in.part[v]]];
         pts.push_back(in.x(v));
         pts.push_back(in.y(v));
@@ -382,6 +383,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     std::vector<std::vector<PairEntry>> blockEntries(faceBlocks);
     parallelFor(faceBlocks, threadCount, [&](size_t block) {
         std::vector<PairEntry>& entries = blockEntries[block];
+        entries.reserve(2 * (faceCount / faceBlocks + 1));  // about 1.3 entries per face on a grid
         for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
             const int* v = &tri.faces[3 * f];
             space.faceArea[f] = 0.5 * ((P(v[1])[0] - P(v[0])[0]) * (P(v[2])[1] - P(v[0])[1]) -
@@ -648,6 +650,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     else buildSegmentGrid(in);
     endStage("check input");
 
+    const bool needHulls = settings.computeBaselines || settings.shape == Shape2D::ConvexHull;
     // 2.-5. Triangulation, free space, models and graph; then once more with Steiner points
     // on long boundary edges at the shortest connections of the dendrogram (DESIGN 2.4
     // step 4), so that joined models get a narrow bridge of small triangles.
@@ -721,14 +724,14 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         if (!triangulation.exportTo(newInputIndex, splitFirstIndex, in.part.size(), space.tri, error, settings.threadCount)) return fail(error);
         setShared(in, space.tri);
         endStage("triangulate with Steiner points");
-        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
         endStage("free space and graph again");
     } else {
         Triangulation2D tri = std::move(space.tri);
         space = FreeSpace2D{};
         space.tri = std::move(tri);  // no Steiner point: complete the graph-only pass
-        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount);
+        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
         endStage("free space and graph again");
     }
     out.vertexCount = space.tri.vertexCount();
@@ -801,7 +804,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             if (out.featureModel[f] >= 0)
                 level.aggregates[modelGroup[out.featureModel[f]]].sourceFeatures.push_back(static_cast<uint32_t>(f));
         std::vector<std::vector<double>> hulls;
-        if (settings.computeBaselines || settings.shape == Shape2D::ConvexHull) {
+        if (needHulls) {
             std::vector<std::vector<double>> groupPoints(groupCount);
             for (size_t m = 0; m < space.modelCount; ++m) {
                 auto& gp = groupPoints[modelGroup[m]];
