@@ -99,12 +99,13 @@ void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputV
     handles.reserve(cdt.number_of_faces());
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) handles.push_back(f);
     const size_t faceCount = handles.size();
-    std::vector<std::array<int, 3>> keys(faceCount);
+    std::vector<std::array<int, 3>> keys(faceCount), corners(faceCount);  // sorted / CGAL's order
     const size_t blocks = std::clamp<size_t>(faceCount / 16384, 1, 64);
     parallelFor(blocks, threadCount, [&](size_t block) {
         for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i) {
             const Cdt::Face_handle f = handles[i];
-            std::array<int, 3> key{f->vertex(0)->info().index, f->vertex(1)->info().index, f->vertex(2)->info().index};
+            corners[i] = {f->vertex(0)->info().index, f->vertex(1)->info().index, f->vertex(2)->info().index};
+            std::array<int, 3> key = corners[i];
             std::sort(key.begin(), key.end());
             keys[i] = key;
         }
@@ -142,7 +143,7 @@ void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputV
             const Cdt::Face_handle f = handles[h];
             const size_t i = static_cast<size_t>(f->info());
             for (int k = 0; k < 3; ++k) {
-                out.faces[3 * i + k] = f->vertex(k)->info().index;
+                out.faces[3 * i + k] = corners[h][k];
                 out.neighbors[3 * i + k] = f->neighbor(k)->info();
                 out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
             }
