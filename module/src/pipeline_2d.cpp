@@ -369,13 +369,13 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
     space.edgeLength.resize(3 * faceCount);
     space.faceLongest.resize(faceCount);
     if (!graphOnly) space.edgePair.assign(3 * faceCount, kSameModelEdge2D);
-    struct PairEntry {
+    struct PairEntry {  // 40 bytes: the grouping below moves many of them
         uint32_t a, b;
-        double length;   // free edge length, or -1 for a distance-only entry
-        double distance;
+        double distance;    // of the connection; for an edge entry, the edge length
         int face;
         int connection[3];  // see ModelPair2D::connection
-        long long faceEdge; // 3 * face + edge for an edge entry, -1 for a distance-only entry
+        int8_t edge;        // the face's edge for an edge entry, -1 for a distance-only entry
+        bool counted;       // an edge entry counted in the pair's lengths (each undirected edge once)
     };
     auto P = [&](int v) { return &tri.points[2 * static_cast<size_t>(v)]; };
     // Faces in blocks on all threads; each block writes its own faces and entry list (the
@@ -406,7 +406,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                 const double len = space.edgeLength[3 * f + j];
                 // Count each undirected edge once (from its smaller free face, or its only one).
                 const bool count = n < 0 || space.faceModel[n] >= 0 || static_cast<int>(f) < n;
-                entries.push_back({a, b, count ? len : -1, len, static_cast<int>(f), {u, w, -1}, static_cast<long long>(3 * f + j)});
+                entries.push_back({a, b, len, static_cast<int>(f), {u, w, -1}, static_cast<int8_t>(j), count});
             }
             // Vertex to the opposite edge when that edge is another model's boundary.
             for (int k = 0; k < 3; ++k) {
@@ -414,8 +414,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                 const int mk = space.vertexModel[v[k]], m1 = space.vertexModel[v[j1]], m2 = space.vertexModel[v[j2]];
                 if (mk < 0 || m1 < 0 || m1 != m2 || mk == m1 || !tri.constrained[3 * f + k]) continue;
                 const double d = pointSegmentDistance(P(v[k]), P(v[j1]), P(v[j2]));
-                entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), -1, d,
-                                   static_cast<int>(f), {v[k], v[j1], v[j2]}, -1});
+                entries.push_back({static_cast<uint32_t>(std::min(mk, m1)), static_cast<uint32_t>(std::max(mk, m1)), d,
+                                   static_cast<int>(f), {v[k], v[j1], v[j2]}, -1, false});
             }
         }
     });
@@ -448,8 +448,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         });
     }
     auto less = [](const PairEntry& x, const PairEntry& y) {
-        return std::tie(x.distance, x.face, x.faceEdge, x.connection[0], x.connection[1], x.connection[2]) <
-               std::tie(y.distance, y.face, y.faceEdge, y.connection[0], y.connection[1], y.connection[2]);
+        return std::tie(x.distance, x.face, x.edge, x.connection[0], x.connection[1], x.connection[2]) <
+               std::tie(y.distance, y.face, y.edge, y.connection[0], y.connection[1], y.connection[2]);
     };
     for (size_t i = 0; i < entries.size();) {
         size_t e = i, best = i;
@@ -469,7 +469,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         if (!graphOnly) {
             pair.firstLength = static_cast<uint32_t>(space.pairLengths.size());
             for (size_t k = i; k < e; ++k)
-                if (entries[k].length >= 0) space.pairLengths.push_back(entries[k].length);
+                if (entries[k].counted) space.pairLengths.push_back(entries[k].distance);
             pair.lengthCount = static_cast<uint32_t>(space.pairLengths.size() - pair.firstLength);
             const auto lengths = space.pairLengths.begin() + pair.firstLength;
             std::sort(lengths, lengths + pair.lengthCount);
@@ -482,7 +482,8 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
                 space.pairPrefixSumSquares.push_back(space.pairPrefixSumSquares.back() + length * length);
             }
             for (size_t k = i; k < e; ++k)
-                if (entries[k].faceEdge >= 0) space.edgePair[entries[k].faceEdge] = static_cast<int>(space.pairs.size());
+                if (entries[k].edge >= 0)
+                    space.edgePair[3 * static_cast<size_t>(entries[k].face) + entries[k].edge] = static_cast<int>(space.pairs.size());
         }
         space.pairKeys.push_back(static_cast<uint64_t>(pair.a) << 32 | pair.b);
         space.pairs.push_back(pair);
