@@ -117,11 +117,9 @@ struct Sculptor2D {
         uint32_t best = UINT32_MAX;
         double bestArea = INFINITY;
         for (uint32_t c = fans.slotBegin[slot]; c < fans.slotBegin[slot + 1]; ++c) {
-            bool usable = true;
-            for (uint32_t i = fans.pathBegin[c]; i < fans.pathBegin[c + 1] && usable; ++i) {
-                const int p = fans.faces[i];
-                usable = label[p] == group && !(space.faceLongest[p] > limits.delta);
-            }
+            bool usable = !(fans.pathLongest[c] > limits.delta);
+            for (uint32_t i = fans.pathBegin[c]; i < fans.pathBegin[c + 1] && usable; ++i)
+                usable = label[fans.faces[i]] == group;
             if (usable && (best == UINT32_MAX || fans.pathArea[c] < bestArea)) {
                 best = c;
                 bestArea = fans.pathArea[c];
@@ -224,8 +222,12 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
                             const int n = tri.neighbors[3 * cur + (kv + side) % 3];
                             if (n < 0) break;
                             if (space.faceModel[n] == model) {
-                                double area = 0;
-                                for (int p : path) area += space.faceArea[p];
+                                double area = 0, longest = 0;
+                                for (int p : path) {
+                                    area += space.faceArea[p];
+                                    longest = std::max(longest, space.faceLongest[p]);
+                                }
+                                out.pathLongest.push_back(longest);
                                 out.pathBegin.push_back(static_cast<uint32_t>(out.faces.size()));
                                 out.faces.insert(out.faces.end(), path.begin(), path.end());
                                 out.pathArea.push_back(area);
@@ -249,6 +251,7 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
         for (uint32_t s : b.slotBegin) fans.slotBegin.push_back(s + candidateOffset);
         for (uint32_t p : b.pathBegin) fans.pathBegin.push_back(p + faceOffset);
         fans.pathArea.insert(fans.pathArea.end(), b.pathArea.begin(), b.pathArea.end());
+        fans.pathLongest.insert(fans.pathLongest.end(), b.pathLongest.begin(), b.pathLongest.end());
         fans.faces.insert(fans.faces.end(), b.faces.begin(), b.faces.end());
     }
     fans.slotBegin.push_back(static_cast<uint32_t>(fans.pathArea.size()));

@@ -28,6 +28,7 @@ struct ConnectionFans2D {
     std::vector<uint32_t> slotBegin;  ///< 4 * mergeCount + 1: candidates of each slot
     std::vector<uint32_t> pathBegin;  ///< per candidate, + 1: its faces are faces[pathBegin[c], pathBegin[c + 1])
     std::vector<double> pathArea;     ///< per candidate: total area of its faces
+    std::vector<double> pathLongest;  ///< per candidate: longest edge of its faces (0 if none)
     std::vector<int> faces;
 };
 
