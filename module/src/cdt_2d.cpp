@@ -1,6 +1,7 @@
 // CGAL wrapper: 2D constrained Delaunay triangulation (DESIGN 2.1; paper Section 3.1).
-// All constraints go in one insert_constraints() call (spatially sorted insertion: about
-// 40x faster than inserting polygon by polygon, see NOTES-deps). Inside/outside marking is
+// All points and constraints go in as one batch, the way CGAL's insert_constraints() does it
+// (spatially sorted insertion: about 40x faster than inserting polygon by polygon, see
+// NOTES-deps), written out here to keep each input point's vertex. Inside/outside marking is
 // done by the caller (CGAL 5.5 has no mark_domain_in_triangulation).
 #include "cdt_2d.h"
 
