@@ -11,6 +11,8 @@
 #include <csignal>
 #include <cstring>
 #include <fcntl.h>
+#include <system_error>
+#include <thread>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -72,26 +74,47 @@ TetgenStatus statusFromCode(int code) {
     }
 }
 
-// Fills a tetgenio with the PLC. The arrays are owned by tetgenio (freed with delete[]).
-void fillTetgenInput(const PlcInput& plc, tetgenio& in) {
+// Points a tetgenio at the PLC, for the child process only: the point, vertex and marker
+// arrays alias the PLC's vectors (the child's private copy-on-write view of them) and all
+// polygons share one block, so no per-facet allocation. TetGen only reads its input. The
+// tetgenio must never be destroyed (its destructor would delete[] the aliased arrays): the
+// child leaks it and ends with _exit.
+tetgenio& tetgenInputForChild(const PlcInput& plc) {
+    tetgenio& in = *new tetgenio;
     in.firstnumber = 0;
     in.numberofpoints = static_cast<int>(plc.points.size() / 3);
-    in.pointlist = new REAL[plc.points.size()];
-    std::memcpy(in.pointlist, plc.points.data(), plc.points.size() * sizeof(double));
+    in.pointlist = const_cast<REAL*>(plc.points.data());
     const int faceCount = static_cast<int>(plc.triangles.size() / 3);
     in.numberoffacets = faceCount;
     in.facetlist = new tetgenio::facet[faceCount];
-    in.facetmarkerlist = new int[faceCount];
+    in.facetmarkerlist = const_cast<int*>(plc.triangleMarkers.data());
+    tetgenio::polygon* polygons = new tetgenio::polygon[faceCount];
     for (int f = 0; f < faceCount; ++f) {
         tetgenio::facet& facet = in.facetlist[f];
         tetgenio::init(&facet);
         facet.numberofpolygons = 1;
-        facet.polygonlist = new tetgenio::polygon[1];
-        tetgenio::init(&facet.polygonlist[0]);
-        facet.polygonlist[0].numberofvertices = 3;
-        facet.polygonlist[0].vertexlist = new int[3];
-        for (int k = 0; k < 3; ++k) facet.polygonlist[0].vertexlist[k] = plc.triangles[3 * f + k];
-        in.facetmarkerlist[f] = plc.triangleMarkers[f];
+        facet.polygonlist = &polygons[f];
+        tetgenio::init(&polygons[f]);
+        polygons[f].numberofvertices = 3;
+        polygons[f].vertexlist = const_cast<int*>(&plc.triangles[3 * static_cast<size_t>(f)]);
+    }
+    return in;
+}
+
+// Reaps a child that has delivered its whole result without waiting for it: its exit (the
+// kernel freeing a few hundred MB) then overlaps with this process's next work.
+void reapInBackground(pid_t pid) {
+    int wstatus = 0;
+    if (::waitpid(pid, &wstatus, WNOHANG) != 0) return;  // already gone (or not our child)
+    auto reap = [pid] {
+        int status = 0;
+        while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+        }
+    };
+    try {
+        std::thread(reap).detach();
+    } catch (const std::system_error&) {
+        reap();  // no thread to be had: wait here
     }
 }
 
@@ -131,6 +154,10 @@ TetgenOutcome runIsolated(Work work, Receive receive) {
     const bool gotCode = readAll(fds[0], &code, sizeof code);
     const bool complete = gotCode && code == 0 && receive(fds[0]);
     ::close(fds[0]);
+    if (complete) {
+        reapInBackground(pid);
+        return {};
+    }
     int wstatus = 0;
     while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
     }
@@ -139,8 +166,7 @@ TetgenOutcome runIsolated(Work work, Receive receive) {
         signal = std::string(" (signal ") + std::to_string(WTERMSIG(wstatus)) + ": " + strsignal(WTERMSIG(wstatus)) + ")";
     if (!gotCode) return {TetgenStatus::Crashed, "TetGen stopped without a result" + signal};
     if (code != 0) return {statusFromCode(code), "TetGen reported error code " + std::to_string(code)};
-    if (!complete) return {TetgenStatus::Crashed, "TetGen's result was cut short" + signal};
-    return {};
+    return {TetgenStatus::Crashed, "TetGen's result was cut short" + signal};
 }
 
 }  // namespace
@@ -161,11 +187,9 @@ const char* tetgenStatusName(TetgenStatus status) {
 TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out, const char* extraSwitches) {
     TetgenOutcome outcome = runIsolated(
         [&](int fd) {
-            // Never freed: the child ends with _exit right after sending the result, and
-            // freeing 300k small facet arrays and the output would only delay that.
-            tetgenio& in = *new tetgenio;
+            // Never freed: the child ends with _exit right after sending the result.
+            tetgenio& in = tetgenInputForChild(input);
             tetgenio& result = *new tetgenio;
-            fillTetgenInput(input, in);
             if (const char* dump = std::getenv("AGGRELOD_DUMP_PLC")) {  // debugging aid
                 in.save_nodes(const_cast<char*>(dump));
                 in.save_poly(const_cast<char*>(dump));
@@ -200,9 +224,8 @@ TetgenOutcome findIntersectingFacets(const PlcInput& input, std::vector<int>& in
     std::vector<int> markers;
     TetgenOutcome outcome = runIsolated(
         [&](int fd) {
-            tetgenio& in = *new tetgenio;  // never freed: see tetrahedralizePlc
+            tetgenio& in = tetgenInputForChild(input);  // never freed: see tetrahedralizePlc
             tetgenio& result = *new tetgenio;
-            fillTetgenInput(input, in);
             char switches[] = "pdzQ";
             tetrahedralize(switches, &in, &result);
             int32_t ok = 0;
