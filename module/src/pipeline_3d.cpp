@@ -212,6 +212,7 @@ private:
         bool trianglesCurrent = false;
     };
     std::map<std::pair<uint32_t, uint32_t>, CachedDistance> distanceCache_;
+    void measureLikelyNeighbours(const std::atomic<bool>& stop);
     std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours,
                                                                  const std::atomic<bool>* stop = nullptr) const;
     void prerefineClosePairs();
@@ -407,19 +408,22 @@ bool Baker::triangulate() {
         // TetGen runs in a child process on one core; meanwhile this process builds the
         // models' BVHs and hulls (needed right after) on one thread. Each model's result
         // does not depend on the thread doing it, so output stays deterministic.
-        // Nothing more: on a 2-core machine any work on the other core slows TetGen
-        // (README "Bake benchmark": TetGen's child process), so the thread ends early.
+        // Then it measures exact distances of likely neighbour pairs for the graph stage
+        // until TetGen is done (the cache only saves time; it never changes a result).
         std::thread preparing;
+        std::atomic<bool> tetgenDone{false};
         const bool overlap = !modelsPrepared_ && settings_.threadCount != 1;
         if (overlap)
-            preparing = std::thread([this] {
+            preparing = std::thread([this, &tetgenDone] {
 #ifdef __linux__
                 // Lowest priority for this thread only: on a busy machine TetGen goes first.
                 setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
 #endif
                 prepareModels(1);
+                if (settings_.distance == DistanceMode::Exact) measureLikelyNeighbours(tetgenDone);
             });
         detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
+        tetgenDone = true;
         if (preparing.joinable()) preparing.join();
         for (const char* fallback : {"Y", "M"}) {
             if (outcome.status != detail::TetgenStatus::Crashed && outcome.status != detail::TetgenStatus::InternalError) break;
@@ -886,6 +890,20 @@ std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neigh
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     return candidates;
+}
+
+// Exact distances of each model's nearest models by box distance (more than the
+// near-pair refinement step measured), into distanceCache_, until `stop` is set.
+void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
+    const std::vector<std::pair<uint32_t, uint32_t>> candidates = nearestPairsByBox(32, &stop);
+    for (const auto& [i, j] : candidates) {
+        if (stop) return;
+        const std::pair<uint32_t, uint32_t> key{models_[i].objects[0], models_[j].objects[0]};
+        // Pairs already measured keep their entry: whether the triangles are current must
+        // not depend on this (optional) step, or output would depend on the thread count.
+        if (distanceCache_.count(key)) continue;
+        distanceCache_[key] = CachedDistance{detail::meshDistance(models_[i].bvh, models_[j].bvh), true};
+    }
 }
 
 // Per model: BVH of its surface (for exact distances) and convex hull (for the baseline).
