@@ -11,6 +11,8 @@
 #include <csignal>
 #include <cstring>
 #include <fcntl.h>
+#include <system_error>
+#include <thread>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,7 +20,9 @@
 namespace aggrelod::detail {
 namespace {
 
-// ---- a tiny byte stream over a pipe ------------------------------------------------
+// ---- the child's result, streamed over a pipe -------------------------------------
+// Each array goes as a 64-bit element count followed by the elements. The parent reads
+// them straight into the destination vectors: no intermediate buffer, no second copy.
 bool writeAll(int fd, const void* data, size_t size) {
     const char* p = static_cast<const char*>(data);
     while (size > 0) {
@@ -37,25 +41,26 @@ bool writeArray(int fd, const T* data, size_t count) {
     return writeAll(fd, &n, sizeof n) && (count == 0 || writeAll(fd, data, count * sizeof(T)));
 }
 
-struct ByteReader {
-    std::vector<char> bytes;
-    size_t at = 0;
-    bool ok = true;
-    template <class T>
-    bool readArray(std::vector<T>& out) {
-        uint64_t n = 0;
-        if (!take(&n, sizeof n)) return false;
-        if (n > (bytes.size() - at) / sizeof(T)) return ok = false;
-        out.resize(n);
-        return n == 0 || take(out.data(), n * sizeof(T));
+bool readAll(int fd, void* data, size_t size) {
+    char* p = static_cast<char*>(data);
+    while (size > 0) {
+        ssize_t n = ::read(fd, p, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;  // end of stream before the whole result: the child died
+        p += n;
+        size -= static_cast<size_t>(n);
     }
-    bool take(void* dst, size_t size) {
-        if (bytes.size() - at < size) return ok = false;
-        std::memcpy(dst, bytes.data() + at, size);
-        at += size;
-        return true;
-    }
-};
+    return true;
+}
+
+template <class T>
+bool readArray(int fd, std::vector<T>& out) {
+    uint64_t n = 0;
+    if (!readAll(fd, &n, sizeof n)) return false;
+    if (n > (uint64_t(1) << 36) / sizeof(T)) return false;  // no mesh is 64 GiB: a garbled stream
+    out.resize(static_cast<size_t>(n));
+    return n == 0 || readAll(fd, out.data(), static_cast<size_t>(n) * sizeof(T));
+}
 
 TetgenStatus statusFromCode(int code) {
     switch (code) {
@@ -69,34 +74,58 @@ TetgenStatus statusFromCode(int code) {
     }
 }
 
-// Fills a tetgenio with the PLC. The arrays are owned by tetgenio (freed with delete[]).
-void fillTetgenInput(const PlcInput& plc, tetgenio& in) {
+// Points a tetgenio at the PLC, for the child process only: the point, vertex and marker
+// arrays alias the PLC's vectors (the child's private copy-on-write view of them) and all
+// polygons share one block, so no per-facet allocation. TetGen only reads its input. The
+// tetgenio must never be destroyed (its destructor would delete[] the aliased arrays): the
+// child leaks it and ends with _exit.
+tetgenio& tetgenInputForChild(const PlcInput& plc) {
+    tetgenio& in = *new tetgenio;
     in.firstnumber = 0;
     in.numberofpoints = static_cast<int>(plc.points.size() / 3);
-    in.pointlist = new REAL[plc.points.size()];
-    std::memcpy(in.pointlist, plc.points.data(), plc.points.size() * sizeof(double));
+    in.pointlist = const_cast<REAL*>(plc.points.data());
     const int faceCount = static_cast<int>(plc.triangles.size() / 3);
     in.numberoffacets = faceCount;
     in.facetlist = new tetgenio::facet[faceCount];
-    in.facetmarkerlist = new int[faceCount];
+    in.facetmarkerlist = const_cast<int*>(plc.triangleMarkers.data());
+    tetgenio::polygon* polygons = new tetgenio::polygon[faceCount];
     for (int f = 0; f < faceCount; ++f) {
         tetgenio::facet& facet = in.facetlist[f];
         tetgenio::init(&facet);
         facet.numberofpolygons = 1;
-        facet.polygonlist = new tetgenio::polygon[1];
-        tetgenio::init(&facet.polygonlist[0]);
-        facet.polygonlist[0].numberofvertices = 3;
-        facet.polygonlist[0].vertexlist = new int[3];
-        for (int k = 0; k < 3; ++k) facet.polygonlist[0].vertexlist[k] = plc.triangles[3 * f + k];
-        in.facetmarkerlist[f] = plc.triangleMarkers[f];
+        facet.polygonlist = &polygons[f];
+        tetgenio::init(&polygons[f]);
+        polygons[f].numberofvertices = 3;
+        polygons[f].vertexlist = const_cast<int*>(&plc.triangles[3 * static_cast<size_t>(f)]);
+    }
+    return in;
+}
+
+// Reaps a child that has delivered its whole result without waiting for it: its exit (the
+// kernel freeing a few hundred MB) then overlaps with this process's next work.
+void reapInBackground(pid_t pid) {
+    int wstatus = 0;
+    if (::waitpid(pid, &wstatus, WNOHANG) != 0) return;  // already gone (or not our child)
+    auto reap = [pid] {
+        int status = 0;
+        while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+        }
+    };
+    try {
+        std::thread(reap).detach();
+    } catch (const std::system_error&) {
+        reap();  // no thread to be had: wait here
     }
 }
 
-// Runs `work` in a child process; it writes its result (starting with an int code) to fd.
-template <class Work>
-TetgenOutcome runIsolated(Work work, ByteReader& reader) {
+// Runs `work` in a child process; it writes its result (starting with an int32 code, 0 = ok)
+// to the fd it gets. `receive` reads the rest of an ok result in this process.
+template <class Work, class Receive>
+TetgenOutcome runIsolated(Work work, Receive receive) {
     int fds[2];
-    if (::pipe(fds) != 0) return {TetgenStatus::InternalError, std::string("pipe: ") + std::strerror(errno)};
+    if (::pipe2(fds, O_CLOEXEC) != 0) return {TetgenStatus::InternalError, std::string("pipe: ") + std::strerror(errno)};
+    // A larger pipe buffer: the result (tens of MB) then crosses in fewer context switches.
+    ::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);
     std::fflush(nullptr);
     pid_t pid = ::fork();
     if (pid < 0) {
@@ -108,42 +137,36 @@ TetgenOutcome runIsolated(Work work, ByteReader& reader) {
         ::close(fds[0]);
         int devnull = ::open("/dev/null", O_WRONLY);
         if (devnull >= 0) ::dup2(devnull, STDOUT_FILENO);  // TetGen prints to stdout
-        int code = 2;
         try {
-            code = work(fds[1]);
+            work(fds[1]);
         } catch (int c) {
-            code = c;
-            int32_t c32 = code;
+            int32_t c32 = c;
             writeAll(fds[1], &c32, sizeof c32);
         } catch (...) {
             int32_t c32 = 2;
             writeAll(fds[1], &c32, sizeof c32);
         }
         ::close(fds[1]);
-        ::_exit(0);
+        ::_exit(0);  // no destructors, no atexit handlers of the parent's program
     }
     ::close(fds[1]);
-    char buffer[1 << 16];
-    for (;;) {
-        ssize_t n = ::read(fds[0], buffer, sizeof buffer);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
-        reader.bytes.insert(reader.bytes.end(), buffer, buffer + n);
-    }
+    int32_t code = -1;
+    const bool gotCode = readAll(fds[0], &code, sizeof code);
+    const bool complete = gotCode && code == 0 && receive(fds[0]);
     ::close(fds[0]);
+    if (complete) {
+        reapInBackground(pid);
+        return {};
+    }
     int wstatus = 0;
     while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
     }
-    int32_t code = -1;
-    if (!reader.take(&code, sizeof code)) {
-        std::string why = "TetGen stopped without a result";
-        if (WIFSIGNALED(wstatus)) why += std::string(" (signal ") + std::to_string(WTERMSIG(wstatus)) + ": " + strsignal(WTERMSIG(wstatus)) + ")";
-        return {TetgenStatus::Crashed, why};
-    }
-    if (code != 0) {
-        return {statusFromCode(code), "TetGen reported error code " + std::to_string(code)};
-    }
-    return {};
+    std::string signal;
+    if (WIFSIGNALED(wstatus))
+        signal = std::string(" (signal ") + std::to_string(WTERMSIG(wstatus)) + ": " + strsignal(WTERMSIG(wstatus)) + ")";
+    if (!gotCode) return {TetgenStatus::Crashed, "TetGen stopped without a result" + signal};
+    if (code != 0) return {statusFromCode(code), "TetGen reported error code " + std::to_string(code)};
+    return {TetgenStatus::Crashed, "TetGen's result was cut short" + signal};
 }
 
 }  // namespace
@@ -162,61 +185,55 @@ const char* tetgenStatusName(TetgenStatus status) {
 }
 
 TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out, const char* extraSwitches) {
-    ByteReader reader;
     TetgenOutcome outcome = runIsolated(
-        [&](int fd) -> int {
-            tetgenio in, result;
-            fillTetgenInput(input, in);
+        [&](int fd) {
+            // Never freed: the child ends with _exit right after sending the result.
+            tetgenio& in = tetgenInputForChild(input);
+            tetgenio& result = *new tetgenio;
             if (const char* dump = std::getenv("AGGRELOD_DUMP_PLC")) {  // debugging aid
                 in.save_nodes(const_cast<char*>(dump));
                 in.save_poly(const_cast<char*>(dump));
             }
             std::string switches = std::string("pczQn") + (extraSwitches ? extraSwitches : "");
             tetrahedralize(&switches[0], &in, &result);
-            int32_t ok = 0;
-            writeAll(fd, &ok, sizeof ok);
-            writeArray(fd, result.pointlist, static_cast<size_t>(result.numberofpoints) * 3);
-            writeArray(fd, result.tetrahedronlist, static_cast<size_t>(result.numberoftetrahedra) * 4);
-            writeArray(fd, result.neighborlist, result.neighborlist ? static_cast<size_t>(result.numberoftetrahedra) * 4 : 0);
-            std::vector<double> regions(static_cast<size_t>(result.numberoftetrahedra), -1.0);
+            const size_t tetCount = static_cast<size_t>(result.numberoftetrahedra);
+            std::vector<double> regions(tetCount, -1.0);
             if (result.numberoftetrahedronattributes > 0) {
-                for (int t = 0; t < result.numberoftetrahedra; ++t)
+                for (size_t t = 0; t < tetCount; ++t)
                     regions[t] = result.tetrahedronattributelist[t * result.numberoftetrahedronattributes];
             }
-            writeArray(fd, regions.data(), regions.size());
-            writeArray(fd, result.trifacelist, static_cast<size_t>(result.numberoftrifaces) * 3);
-            writeArray(fd, result.trifacemarkerlist, result.trifacemarkerlist ? static_cast<size_t>(result.numberoftrifaces) : 0);
-            return 0;
+            int32_t ok = 0;
+            writeAll(fd, &ok, sizeof ok) && writeArray(fd, result.pointlist, static_cast<size_t>(result.numberofpoints) * 3) &&
+                writeArray(fd, result.tetrahedronlist, tetCount * 4) &&
+                writeArray(fd, result.neighborlist, result.neighborlist ? tetCount * 4 : 0) &&
+                writeArray(fd, regions.data(), regions.size()) &&
+                writeArray(fd, result.trifacelist, static_cast<size_t>(result.numberoftrifaces) * 3) &&
+                writeArray(fd, result.trifacemarkerlist, result.trifacemarkerlist ? static_cast<size_t>(result.numberoftrifaces) : 0);
         },
-        reader);
+        [&](int fd) {
+            return readArray(fd, out.points) && readArray(fd, out.tets) && readArray(fd, out.neighbors) &&
+                   readArray(fd, out.regions) && readArray(fd, out.boundaryFaces) && readArray(fd, out.boundaryMarkers);
+        });
     if (outcome.status != TetgenStatus::Ok) return outcome;
-    if (!(reader.readArray(out.points) && reader.readArray(out.tets) && reader.readArray(out.neighbors) &&
-          reader.readArray(out.regions) && reader.readArray(out.boundaryFaces) &&
-          reader.readArray(out.boundaryMarkers))) {
-        return {TetgenStatus::InternalError, "TetGen result was cut short"};
-    }
     if (out.neighbors.size() != out.tets.size()) return {TetgenStatus::InternalError, "TetGen gave no neighbours"};
     if (out.boundaryMarkers.size() != out.boundaryFaces.size() / 3) out.boundaryMarkers.assign(out.boundaryFaces.size() / 3, 0);
     return outcome;
 }
 
 TetgenOutcome findIntersectingFacets(const PlcInput& input, std::vector<int>& intersectingMarkers) {
-    ByteReader reader;
+    std::vector<int> markers;
     TetgenOutcome outcome = runIsolated(
-        [&](int fd) -> int {
-            tetgenio in, result;
-            fillTetgenInput(input, in);
+        [&](int fd) {
+            tetgenio& in = tetgenInputForChild(input);  // never freed: see tetrahedralizePlc
+            tetgenio& result = *new tetgenio;
             char switches[] = "pdzQ";
             tetrahedralize(switches, &in, &result);
             int32_t ok = 0;
-            writeAll(fd, &ok, sizeof ok);
-            writeArray(fd, result.trifacemarkerlist, result.trifacemarkerlist ? static_cast<size_t>(result.numberoftrifaces) : 0);
-            return 0;
+            writeAll(fd, &ok, sizeof ok) &&
+                writeArray(fd, result.trifacemarkerlist, result.trifacemarkerlist ? static_cast<size_t>(result.numberoftrifaces) : 0);
         },
-        reader);
+        [&](int fd) { return readArray(fd, markers); });
     if (outcome.status != TetgenStatus::Ok) return outcome;
-    std::vector<int> markers;
-    if (!reader.readArray(markers)) return {TetgenStatus::InternalError, "TetGen result was cut short"};
     std::sort(markers.begin(), markers.end());
     markers.erase(std::unique(markers.begin(), markers.end()), markers.end());
     intersectingMarkers = markers;
