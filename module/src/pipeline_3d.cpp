@@ -1093,6 +1093,7 @@ void Baker::buildLevels() {
             previousHulls = std::move(hulls);
         }
         level.volumeConstant = isConstant ? totalVolume : w.volumeConstant;
+        level.hasVolumeConstant = isConstant || measureConstant;
         level.aggregates = std::move(aggregates);
         out_.levels.push_back(std::move(level));
         timer_.report(double(li + 1) / deltas.size());
