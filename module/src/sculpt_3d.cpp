@@ -415,9 +415,38 @@ struct Sculptor {
             for (int t : near) collectFaces(t);
         }
         changedTets.clear();
-        std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
+        auto useLess = [](const EdgeUse& a, const EdgeUse& b) {
             return std::tie(a.group, a.u, a.v, a.tet) < std::tie(b.group, b.u, b.v, b.tet);
-        });
+        };
+        if (fullScan) {
+            // Every surface edge: only those on more than two faces of a group are work.
+            // Bucketed by the first vertex (counting sort), each small bucket sorted alone;
+            // the few edges kept are then sorted as the work list expects. Same list as
+            // sorting all uses, without sorting hundreds of thousands of them.
+            const size_t pointCount = mesh.pointCount();
+            std::vector<uint32_t> start(pointCount + 1, 0);
+            for (const EdgeUse& use : uses) ++start[use.u + 1];
+            for (size_t p = 0; p < pointCount; ++p) start[p + 1] += start[p];
+            std::vector<EdgeUse> byVertex(uses.size());
+            {
+                std::vector<uint32_t> at(start.begin(), start.end() - 1);
+                for (const EdgeUse& use : uses) byVertex[at[use.u]++] = use;
+            }
+            uses.clear();
+            for (size_t p = 0; p < pointCount; ++p) {
+                EdgeUse* b = byVertex.data() + start[p];
+                EdgeUse* e = byVertex.data() + start[p + 1];
+                if (e - b < 3) continue;
+                std::sort(b, e, useLess);
+                for (EdgeUse* i = b; i != e;) {
+                    EdgeUse* j = i;
+                    while (j != e && j->group == i->group && j->v == i->v) ++j;
+                    if (j - i > 2) uses.insert(uses.end(), i, j);
+                    i = j;
+                }
+            }
+        }
+        std::sort(uses.begin(), uses.end(), useLess);
         // Work list of edges to examine, in a deterministic order: first the candidates,
         // then the edges of every tet a repair changed (a repair can make a neighbour edge
         // non-manifold), until none is left. The cap only guards against a cycle.
@@ -694,6 +723,9 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
     }
     std::vector<int> faceIndexOf(4 * tetCount, -1);
     std::vector<int> twinEdge;
+    constexpr uint64_t kNoEdge = ~0ull;
+    std::vector<uint64_t> edgeKeys;  // open addressing: directed edge (from << 32 | to)
+    std::vector<int> edgeUse;        // its face edge 3 * face + e, or -1 when used twice
     std::vector<uint32_t> outIndex;
     Corners corners, shells;
     for (size_t g = 0; g < groupCount; ++g) {
@@ -715,21 +747,54 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         std::iota(corners.parent.begin(), corners.parent.end(), 0u);
         shells.parent.resize(listSize);
         std::iota(shells.parent.begin(), shells.parent.end(), 0u);
-        // Twin of each face edge, found by one rotation and recorded for both sides (the
-        // rotation from the twin back through the same solid run ends at this face).
+        // Twin of each face edge, recorded for both sides. Where the group's surface uses the
+        // edge once each way (a manifold edge: nearly all), the twin is the one face using it
+        // the other way, looked up in a table of directed edges. Otherwise (the edge is on
+        // more faces) it is found by rotating around the edge through the group's solid;
+        // the rotation from the twin back through the same solid run ends at this face.
         twinEdge.assign(3 * listSize, -1);
+        size_t slots = 16;
+        while (slots < 4 * 3 * listSize) slots <<= 1;  // load factor <= 1/4: short probes
+        const uint64_t mask = slots - 1;
+        edgeKeys.assign(slots, kNoEdge);
+        edgeUse.resize(slots);
+        auto slotOf = [&](uint64_t key) {
+            uint64_t h = (key * 0x9E3779B97F4A7C15ull) >> 20;
+            while (true) {
+                h &= mask;
+                if (edgeKeys[h] == key || edgeKeys[h] == kNoEdge) return h;
+                ++h;
+            }
+        };
+        auto directedKey = [](int from, int to) { return (static_cast<uint64_t>(from) << 32) | static_cast<uint32_t>(to); };
+        for (size_t f = 0; f < listSize; ++f) {
+            const auto [t0, j0] = list[f];
+            for (int e = 0; e < 3; ++e) {
+                const uint64_t key = directedKey(vertexAt(t0, kFaceCorners[j0][e]), vertexAt(t0, kFaceCorners[j0][(e + 1) % 3]));
+                const uint64_t h = slotOf(key);
+                if (edgeKeys[h] == kNoEdge) {
+                    edgeKeys[h] = key;
+                    edgeUse[h] = static_cast<int>(3 * f + e);
+                } else {
+                    edgeUse[h] = -1;  // used twice this way: not manifold
+                }
+            }
+        }
         for (size_t f = 0; f < listSize; ++f) {
             const auto [t0, j0] = list[f];
             for (int e = 0; e < 3; ++e) {
                 if (twinEdge[3 * f + e] >= 0) continue;
                 const int u = vertexAt(t0, kFaceCorners[j0][e]);
                 const int v = vertexAt(t0, kFaceCorners[j0][(e + 1) % 3]);
+                int twinFace = -1;
+                const uint64_t back = slotOf(directedKey(v, u));
+                if (edgeKeys[back] != kNoEdge && edgeUse[back] >= 0 && edgeUse[slotOf(directedKey(u, v))] >= 0)
+                    twinFace = edgeUse[back] / 3;
                 // Rotate around edge uv through the group's solid tets until leaving it.
                 int t = t0;
                 int lu = localCorner(t, u), lv = localCorner(t, v);
                 int cross = 6 - lu - lv - j0;  // the other face of t containing uv
-                int twinFace = -1;
-                for (int guard = 0; guard < 4096; ++guard) {
+                for (int guard = 0; guard < 4096 && twinFace < 0; ++guard) {
                     int n = mesh.neighbors[4 * t + cross];
                     if (n < 0 || label[n] != static_cast<int>(g)) {
                         twinFace = faceIndexOf[4 * t + cross];
