@@ -1009,11 +1009,59 @@ void Baker::buildLevels() {
         }
     }
 
+    // Hull baseline, level by level: starts from each model's own hull. A group's hull is
+    // the hull of its sub-groups' hulls at the previous level (groups only coarsen): a group
+    // unchanged since then keeps its hull, others are built from the few vertices of their
+    // parts' hulls. It does not depend on the sculpting, so it runs as one more task beside
+    // the levels (one chain, in level order), keeping both cores busy to the end.
+    struct GroupHull {
+        std::vector<double> vertices;
+        double volume = 0;
+    };
+    std::vector<std::vector<double>> hullVolumes(deltas.size());  ///< per level, per group
+    auto computeHullBaseline = [&] {
+        std::vector<GroupHull> previousHulls(models_.size());
+        std::vector<uint32_t> previousHullOfModel(models_.size());
+        for (size_t m = 0; m < models_.size(); ++m) {
+            previousHullOfModel[m] = static_cast<uint32_t>(m);
+            previousHulls[m].vertices = models_[m].hullPoints;
+            previousHulls[m].volume = models_[m].hullVolume;
+        }
+        for (size_t li = 0; li < deltas.size(); ++li) {
+            const LevelWork& w = work[li];
+            std::vector<GroupHull> hulls(w.groupCount);
+            std::vector<std::vector<uint32_t>> parts(w.groupCount);
+            for (size_t m = 0; m < models_.size(); ++m) parts[w.modelGroup[m]].push_back(previousHullOfModel[m]);
+            for (size_t g = 0; g < w.groupCount; ++g) {
+                std::vector<uint32_t>& p = parts[g];
+                std::sort(p.begin(), p.end());
+                p.erase(std::unique(p.begin(), p.end()), p.end());
+                if (p.size() == 1) {
+                    hulls[g] = previousHulls[p[0]];
+                } else {
+                    std::vector<double> points;
+                    for (uint32_t part : p) points.insert(points.end(), previousHulls[part].vertices.begin(), previousHulls[part].vertices.end());
+                    hulls[g].volume = detail::convexHullVolume(points, &hulls[g].vertices);
+                }
+            }
+            hullVolumes[li].resize(w.groupCount);
+            for (size_t g = 0; g < w.groupCount; ++g) hullVolumes[li][g] = hulls[g].volume;
+            for (size_t m = 0; m < models_.size(); ++m) previousHullOfModel[m] = w.modelGroup[m];
+            previousHulls = std::move(hulls);
+        }
+    };
+
     // Levels are independent given the one triangulation: sculpt them on several threads;
-    // each level writes only its own LevelWork.
+    // each level writes only its own LevelWork. Task 0 is the hull baseline (when asked).
+    const size_t hullTasks = settings_.computeHullBaseline ? 1 : 0;
     detail::parallelFor(
-        work.size(), settings_.threadCount,
-        [&](size_t li) {
+        hullTasks + work.size(), settings_.threadCount,
+        [&](size_t task) {
+            if (task < hullTasks) {
+                computeHullBaseline();
+                return;
+            }
+            const size_t li = task - hullTasks;
             LevelWork& w = work[li];
             std::vector<int> label, constantLabel;
             if (measureConstant) w.request.baselineLimits = &w.constantLimits;
@@ -1041,22 +1089,9 @@ void Baker::buildLevels() {
                 for (size_t t = 0; t < constantLabel.size(); ++t)
                     if (constantLabel[t] >= 0) w.volumeConstant += space_.tetVolume[t];
         },
-        [&](size_t done) { timer_.report(double(done) / work.size()); });
+        [&](size_t done) { timer_.report(double(done) / (hullTasks + work.size())); });
 
     timer_.begin("level measures");
-    // Hull baseline, level by level: starts from each model's own hull.
-    struct GroupHull {
-        std::vector<double> vertices;
-        double volume = 0;
-    };
-    std::vector<GroupHull> previousHulls(models_.size());
-    std::vector<uint32_t> previousHullOfModel(models_.size());
-    if (settings_.computeHullBaseline)
-        for (size_t m = 0; m < models_.size(); ++m) {
-            previousHullOfModel[m] = static_cast<uint32_t>(m);
-            previousHulls[m].vertices = models_[m].hullPoints;
-            previousHulls[m].volume = models_[m].hullVolume;
-        }
     for (size_t li = 0; li < deltas.size(); ++li) {
         LevelWork& w = work[li];
         Level level;
@@ -1066,32 +1101,11 @@ void Baker::buildLevels() {
         level.triangleCount = w.triangleCount;
         level.measures = measuresOf(totalVolume, totalArea);
         level.volumeOriginal = out_.originals.volume;
-        if (settings_.computeHullBaseline) {
-            // A group's hull is the hull of its sub-groups' hulls at the previous level
-            // (groups only coarsen): a group unchanged since then keeps its hull, others
-            // are built from the few vertices of their parts' hulls.
-            std::vector<GroupHull> hulls(w.groupCount);
-            std::vector<std::vector<uint32_t>> parts(w.groupCount);
-            for (size_t m = 0; m < models_.size(); ++m) parts[w.modelGroup[m]].push_back(previousHullOfModel[m]);
-            detail::parallelFor(w.groupCount, settings_.threadCount, [&](size_t g) {
-                std::vector<uint32_t>& p = parts[g];
-                std::sort(p.begin(), p.end());
-                p.erase(std::unique(p.begin(), p.end()), p.end());
-                if (p.size() == 1) {
-                    hulls[g] = previousHulls[p[0]];
-                } else {
-                    std::vector<double> points;
-                    for (uint32_t part : p) points.insert(points.end(), previousHulls[part].vertices.begin(), previousHulls[part].vertices.end());
-                    hulls[g].volume = detail::convexHullVolume(points, &hulls[g].vertices);
-                }
-            });
+        if (settings_.computeHullBaseline)
             for (size_t g = 0; g < w.groupCount; ++g) {
-                aggregates[g].volumeHull = hulls[g].volume;
-                level.volumeHull += hulls[g].volume;
+                aggregates[g].volumeHull = hullVolumes[li][g];
+                level.volumeHull += hullVolumes[li][g];
             }
-            for (size_t m = 0; m < models_.size(); ++m) previousHullOfModel[m] = w.modelGroup[m];
-            previousHulls = std::move(hulls);
-        }
         level.volumeConstant = isConstant ? totalVolume : w.volumeConstant;
         level.hasVolumeConstant = isConstant || measureConstant;
         level.aggregates = std::move(aggregates);

@@ -21,8 +21,15 @@
 #include <queue>
 #include <tuple>
 
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 namespace aggrelod::detail {
 namespace {
+std::atomic<long long> gProf[10];
+struct ProfPrint { ~ProfPrint() { if (getenv("AGGRELOD_PROF")) { const char* n[10]={"init","protect","baseline","carve","islands","repair","voids","extract","faceIndexAlloc","rotations"}; for (int i=0;i<10;++i) if (gProf[i]) fprintf(stderr,"PROF %s %.3f\n",n[i],gProf[i]*1e-9);} } } gProfPrint;
+struct ProfScope { int k; std::chrono::steady_clock::time_point t=std::chrono::steady_clock::now(); ~ProfScope(){ gProf[k]+=std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now()-t).count(); } };
 
 // Corners of the face opposite corner j, ordered so the normal points out of a
 // positively oriented tet.
@@ -597,6 +604,7 @@ void precomputeTetEdges(FreeSpace& space, int threadCount) {
             if (n < 0 || space.tetModel[n] != space.tetModel[t]) space.objectFaceMask[t] |= static_cast<uint8_t>(1u << j);
         }
     }
+    if (getenv("AGGRELOD_PROF")) { size_t fr=0, inner=0, surf=0; for (size_t t=0;t<tetCount;++t){ if (space.tetModel[t]<0) ++fr; else if (space.objectFaceMask[t]) ++surf; else ++inner;} fprintf(stderr,"PROF tets free %zu objsurf %zu inner %zu\n",fr,surf,inner);}
     space.tetEdgeLength.resize(6 * tetCount);
     space.tetEdgePair.resize(6 * tetCount);
     // Blocks of tets on several threads; each tet writes only its own six slots.
@@ -645,10 +653,10 @@ EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const Aggrega
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
                  std::vector<int>* baselineLabel) {
     Sculptor sculptor(space, request, tetLabel);
-    sculptor.initialLabels();
-    sculptor.isProtected.assign(space.mesh.tetCount(), 0);
-    for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
-    if (request.baselineLimits && baselineLabel) {
+    { ProfScope p{0}; sculptor.initialLabels();
+    sculptor.isProtected.assign(space.mesh.tetCount(), 0);}
+    { ProfScope p{1}; for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);}
+    if (request.baselineLimits && baselineLabel) { ProfScope p{2};
         // Same groups, same protected connections: only the carving limits differ.
         *baselineLabel = tetLabel;
         Sculptor baseline(space, request, *baselineLabel);
@@ -656,7 +664,7 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
         baseline.isProtected = sculptor.isProtected;
         baseline.carve();
     }
-    sculptor.carve();
+    { ProfScope p{3}; sculptor.carve();}
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
@@ -665,10 +673,10 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
     // edge repair follows its own changes. So another round is needed only when the repair
     // opened something (new islands are possible then).
     for (int round = 0; round < 8; ++round) {
-        sculptor.removeIslands(round == 0);
+        { ProfScope p{4}; sculptor.removeIslands(round == 0);}
         sculptor.openedByRepair = false;
-        sculptor.repairNonManifoldEdges(round == 0);
-        sculptor.fillVoids(round == 0);
+        { ProfScope p{5}; sculptor.repairNonManifoldEdges(round == 0);}
+        { ProfScope p{6}; sculptor.fillVoids(round == 0);}
         if (!sculptor.openedByRepair) break;
     }
 }
@@ -692,6 +700,7 @@ struct Corners {
 
 void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size_t groupCount,
                      std::vector<Aggregate>& aggregates) {
+    ProfScope prof{7};
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
     aggregates.resize(groupCount);
@@ -721,7 +730,9 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         std::vector<size_t> at(groupStart.begin(), groupStart.end() - 1);
         for (size_t f = 0; f < allFaces.size(); ++f) byGroup[at[faceGroup[f]]++] = allFaces[f];
     }
+    auto tA = std::chrono::steady_clock::now();
     std::vector<int> faceIndexOf(4 * tetCount, -1);
+    gProf[8] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now()-tA).count();
     std::vector<int> twinEdge;
     constexpr uint64_t kNoEdge = ~0ull;
     std::vector<uint64_t> edgeKeys;  // open addressing: directed edge (from << 32 | to)
@@ -780,6 +791,7 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 }
             }
         }
+        auto tB = std::chrono::steady_clock::now();
         for (size_t f = 0; f < listSize; ++f) {
             const auto [t0, j0] = list[f];
             for (int e = 0; e < 3; ++e) {
@@ -829,6 +841,7 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 shells.unite(static_cast<uint32_t>(f), static_cast<uint32_t>(twinFace));
             }
         }
+        gProf[9] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now()-tB).count();
         // One output vertex per corner class, numbered by first use.
         outIndex.assign(3 * listSize, UINT32_MAX);
         uint32_t next = 0;
