@@ -1052,21 +1052,28 @@ void Baker::buildLevels() {
     };
 
     // Levels are independent given the one triangulation: sculpt them on several threads;
-    // each level writes only its own LevelWork. Task 0 is the hull baseline (when asked).
-    const size_t hullTasks = settings_.computeHullBaseline ? 1 : 0;
+    // each level writes only its own LevelWork. Coarse levels keep much more free space and
+    // cost the most, so they are started first (the threads then finish together); the hull
+    // baseline (when asked) runs as one task after the coarser half.
+    std::vector<size_t> taskOrder;  // level index, or SIZE_MAX for the hull baseline
+    for (size_t k = 0; k < work.size(); ++k) {
+        if (settings_.computeHullBaseline && k == work.size() / 2) taskOrder.push_back(SIZE_MAX);
+        taskOrder.push_back(work.size() - 1 - k);
+    }
+    if (settings_.computeHullBaseline && work.empty()) taskOrder.push_back(SIZE_MAX);
     detail::parallelFor(
-        hullTasks + work.size(), settings_.threadCount,
+        taskOrder.size(), settings_.threadCount,
         [&](size_t task) {
-            if (task < hullTasks) {
+            if (taskOrder[task] == SIZE_MAX) {
                 computeHullBaseline();
                 return;
             }
-            const size_t li = task - hullTasks;
+            const size_t li = taskOrder[task];
             LevelWork& w = work[li];
-            std::vector<int> label, constantLabel;
+            std::vector<int> label, constantLabel, surfaceTets;
             if (measureConstant) w.request.baselineLimits = &w.constantLimits;
-            detail::sculptLevel(space_, w.request, label, &constantLabel);
-            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates);
+            detail::sculptLevel(space_, w.request, label, &constantLabel, &surfaceTets);
+            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates, &surfaceTets);
             // Per-aggregate sources and measures, on the same thread (levels are independent).
             for (size_t m = 0; m < models_.size(); ++m) {
                 Aggregate& agg = w.aggregates[w.modelGroup[m]];
@@ -1089,7 +1096,7 @@ void Baker::buildLevels() {
                 for (size_t t = 0; t < constantLabel.size(); ++t)
                     if (constantLabel[t] >= 0) w.volumeConstant += space_.tetVolume[t];
         },
-        [&](size_t done) { timer_.report(double(done) / (hullTasks + work.size())); });
+        [&](size_t done) { timer_.report(double(done) / taskOrder.size()); });
 
     timer_.begin("level measures");
     for (size_t li = 0; li < deltas.size(); ++li) {

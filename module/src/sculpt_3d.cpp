@@ -16,20 +16,14 @@
 
 #include <algorithm>
 #include <deque>
+#include <iterator>
 #include <cmath>
 #include <numeric>
 #include <queue>
 #include <tuple>
 
-#include <atomic>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 namespace aggrelod::detail {
 namespace {
-std::atomic<long long> gProf[10];
-struct ProfPrint { ~ProfPrint() { if (getenv("AGGRELOD_PROF")) { const char* n[10]={"init","protect","baseline","carve","islands","repair","voids","extract","faceIndexAlloc","rotations"}; for (int i=0;i<10;++i) if (gProf[i]) fprintf(stderr,"PROF %s %.3f\n",n[i],gProf[i]*1e-9);} } } gProfPrint;
-struct ProfScope { int k; std::chrono::steady_clock::time_point t=std::chrono::steady_clock::now(); ~ProfScope(){ gProf[k]+=std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now()-t).count(); } };
 
 // Corners of the face opposite corner j, ordered so the normal points out of a
 // positively oriented tet.
@@ -61,14 +55,24 @@ struct Sculptor {
 
     int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>((*request.modelGroup)[m]); }
 
+    // Tets that can take part in this level's shape, ascending: after step 1, the kept free
+    // tets and the object tets with a face on their model's surface. Carving and the
+    // clean-up's first pass only remove, so their full scans visit these instead of every
+    // tet of the mesh (object interiors and the free space no group claims are most of it).
+    std::vector<int> active;
+    // Tets the clean-up added to a solid (not in `active`).
+    std::vector<int> addedTets;
+
     // Step 1: object interiors take their model's group; a free tet takes the single group
     // of its owned vertices, or -1.
     void initialLabels() {
         const size_t tetCount = mesh.tetCount();
         label.assign(tetCount, -1);
+        active.clear();
         for (size_t t = 0; t < tetCount; ++t) {
             if (space.tetModel[t] >= 0) {
                 label[t] = groupOfModel(space.tetModel[t]);
+                if (label[t] >= 0 && space.objectFaceMask[t]) active.push_back(static_cast<int>(t));
                 continue;
             }
             int group = -1;
@@ -80,6 +84,7 @@ struct Sculptor {
                 else if (g != group) mixed = true;
             }
             label[t] = mixed ? -1 : group;
+            if (label[t] >= 0) active.push_back(static_cast<int>(t));
         }
     }
 
@@ -246,7 +251,7 @@ struct Sculptor {
         std::vector<int> removed;
         removed.swap(removedSinceIslands);
         if (fullScan) {
-            for (size_t t = 0; t < tetCount; ++t) floodFrom(static_cast<int>(t));
+            for (int t : active) floodFrom(t);  // only removals so far: kept free tets are in it
         } else {
             for (int r : removed)
                 for (int j = 0; j < 4; ++j) {
@@ -311,15 +316,20 @@ struct Sculptor {
         std::vector<int> changedTets;
         changedTets.swap(changedSinceVoids);
         if (fullScan) {
-            for (size_t t = 0; t < tetCount; ++t) {
-                if (label[t] < 0) continue;
-                const unsigned faces = candidateFaces(t);
+            // Seeds next to every solid tet: those of `active` and those the edge repair
+            // added. Which cavities get filled does not depend on the seed order (a cavity is
+            // a connected component of unclaimed space, judged whole).
+            auto seedAround = [&](int t) {
+                if (label[t] < 0) return;
+                const unsigned faces = candidateFaces(static_cast<size_t>(t));
                 for (int j = 0; j < 4; ++j) {
                     if (!(faces & (1u << j))) continue;
                     const int n = mesh.neighbors[4 * t + j];
                     if (n >= 0) floodFrom(n);
                 }
-            }
+            };
+            for (int t : active) seedAround(t);
+            for (size_t k = 0; k < addedTets.size(); ++k) seedAround(addedTets[k]);
         } else {
             for (int t : changedTets) {
                 floodFrom(t);
@@ -379,6 +389,7 @@ struct Sculptor {
         changedTets.push_back(t);
         changedSinceVoids.push_back(t);
         if (value < 0) removedSinceIslands.push_back(t);
+        else if (!(cleanUpHistory.size() && (cleanUpHistory[t] & 2))) addedTets.push_back(t);
         if (cleanUpHistory.empty()) cleanUpHistory.assign(mesh.tetCount(), 0);
         cleanUpHistory[t] |= value < 0 ? 1 : 2;
     }
@@ -386,7 +397,6 @@ struct Sculptor {
     bool wasRemoved(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 1); }
 
     bool repairNonManifoldEdges(bool fullScan) {
-        const size_t tetCount = mesh.tetCount();
         struct EdgeUse {
             int u, v, group, tet;
         };
@@ -407,7 +417,7 @@ struct Sculptor {
             }
         };
         if (fullScan) {
-            for (size_t t = 0; t < tetCount; ++t) collectFaces(static_cast<int>(t));
+            for (int t : active) collectFaces(t);  // first pass: only removals so far
         } else {
             // Only edges near tets changed in the previous round; their fans are checked
             // whole below (ring runs), since the unchanged faces were not collected.
@@ -536,11 +546,10 @@ struct Sculptor {
     // only exposes more facets), so the removed set does not depend on the order; a plain
     // stack visits it in linear time.
     void carve() {
-        const size_t tetCount = mesh.tetCount();
         std::vector<int> stack;
-        for (size_t t = 0; t < tetCount; ++t) {
+        for (int t : active) {
             if (space.tetModel[t] >= 0 || label[t] < 0 || isProtected[t]) continue;
-            if (carvePriority(static_cast<int>(t)) > 0) stack.push_back(static_cast<int>(t));
+            if (carvePriority(t) > 0) stack.push_back(t);
         }
         while (!stack.empty()) {
             const int t = stack.back();
@@ -604,7 +613,6 @@ void precomputeTetEdges(FreeSpace& space, int threadCount) {
             if (n < 0 || space.tetModel[n] != space.tetModel[t]) space.objectFaceMask[t] |= static_cast<uint8_t>(1u << j);
         }
     }
-    if (getenv("AGGRELOD_PROF")) { size_t fr=0, inner=0, surf=0; for (size_t t=0;t<tetCount;++t){ if (space.tetModel[t]<0) ++fr; else if (space.objectFaceMask[t]) ++surf; else ++inner;} fprintf(stderr,"PROF tets free %zu objsurf %zu inner %zu\n",fr,surf,inner);}
     space.tetEdgeLength.resize(6 * tetCount);
     space.tetEdgePair.resize(6 * tetCount);
     // Blocks of tets on several threads; each tet writes only its own six slots.
@@ -651,34 +659,50 @@ EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const Aggrega
 }
 
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
-                 std::vector<int>* baselineLabel) {
+                 std::vector<int>* baselineLabel, std::vector<int>* surfaceTets) {
     Sculptor sculptor(space, request, tetLabel);
-    { ProfScope p{0}; sculptor.initialLabels();
-    sculptor.isProtected.assign(space.mesh.tetCount(), 0);}
-    { ProfScope p{1}; for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);}
-    if (request.baselineLimits && baselineLabel) { ProfScope p{2};
+    sculptor.initialLabels();
+    sculptor.isProtected.assign(space.mesh.tetCount(), 0);
+    for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
+    if (request.baselineLimits && baselineLabel) {
         // Same groups, same protected connections: only the carving limits differ.
         *baselineLabel = tetLabel;
         Sculptor baseline(space, request, *baselineLabel);
+        baseline.active = sculptor.active;
         baseline.limits = request.baselineLimits;
         baseline.isProtected = sculptor.isProtected;
         baseline.carve();
     }
-    { ProfScope p{3}; sculptor.carve();}
+    sculptor.carve();
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
-    if (!request.cleanUp) return;
+    // Every tet that can hold a surface face: `active` and what the clean-up added.
+    auto listSurfaceTets = [&] {
+        if (!surfaceTets) return;
+        std::vector<int>& list = *surfaceTets;
+        list = sculptor.addedTets;
+        std::sort(list.begin(), list.end());
+        std::vector<int> merged;
+        merged.reserve(sculptor.active.size() + list.size());
+        std::set_union(sculptor.active.begin(), sculptor.active.end(), list.begin(), list.end(), std::back_inserter(merged));
+        list.swap(merged);
+    };
+    if (!request.cleanUp) {
+        listSurfaceTets();
+        return;
+    }
     // Islands appear only where tets are removed; voids are filled in the same round; the
     // edge repair follows its own changes. So another round is needed only when the repair
     // opened something (new islands are possible then).
     for (int round = 0; round < 8; ++round) {
-        { ProfScope p{4}; sculptor.removeIslands(round == 0);}
+        sculptor.removeIslands(round == 0);
         sculptor.openedByRepair = false;
-        { ProfScope p{5}; sculptor.repairNonManifoldEdges(round == 0);}
-        { ProfScope p{6}; sculptor.fillVoids(round == 0);}
+        sculptor.repairNonManifoldEdges(round == 0);
+        sculptor.fillVoids(round == 0);
         if (!sculptor.openedByRepair) break;
     }
+    listSurfaceTets();
 }
 
 // ---- surface extraction ----------------------------------------------------------------
@@ -699,8 +723,7 @@ struct Corners {
 }  // namespace
 
 void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size_t groupCount,
-                     std::vector<Aggregate>& aggregates) {
-    ProfScope prof{7};
+                     std::vector<Aggregate>& aggregates, const std::vector<int>* surfaceTets) {
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
     aggregates.resize(groupCount);
@@ -708,9 +731,9 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
     // it, gathered by group in one array (counting sort, tet order kept within a group).
     std::vector<std::pair<int, int>> allFaces;
     std::vector<uint32_t> faceGroup;
-    for (size_t t = 0; t < tetCount; ++t) {
+    auto collect = [&](size_t t) {
         const int g = label[t];
-        if (g < 0) continue;
+        if (g < 0) return;
         // Object interiors are skipped: only their model-surface faces can be on a surface.
         const unsigned candidates = space.tetModel[t] >= 0 ? space.objectFaceMask[t] : 0xFu;
         for (int j = 0; j < 4; ++j) {
@@ -721,6 +744,11 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 faceGroup.push_back(static_cast<uint32_t>(g));
             }
         }
+    };
+    if (surfaceTets) {
+        for (int t : *surfaceTets) collect(static_cast<size_t>(t));
+    } else {
+        for (size_t t = 0; t < tetCount; ++t) collect(t);
     }
     std::vector<size_t> groupStart(groupCount + 1, 0);
     for (uint32_t g : faceGroup) ++groupStart[g + 1];
@@ -730,9 +758,7 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         std::vector<size_t> at(groupStart.begin(), groupStart.end() - 1);
         for (size_t f = 0; f < allFaces.size(); ++f) byGroup[at[faceGroup[f]]++] = allFaces[f];
     }
-    auto tA = std::chrono::steady_clock::now();
     std::vector<int> faceIndexOf(4 * tetCount, -1);
-    gProf[8] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now()-tA).count();
     std::vector<int> twinEdge;
     constexpr uint64_t kNoEdge = ~0ull;
     std::vector<uint64_t> edgeKeys;  // open addressing: directed edge (from << 32 | to)
@@ -791,7 +817,6 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 }
             }
         }
-        auto tB = std::chrono::steady_clock::now();
         for (size_t f = 0; f < listSize; ++f) {
             const auto [t0, j0] = list[f];
             for (int e = 0; e < 3; ++e) {
@@ -841,7 +866,6 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 shells.unite(static_cast<uint32_t>(f), static_cast<uint32_t>(twinFace));
             }
         }
-        gProf[9] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now()-tB).count();
         // One output vertex per corner class, numbered by first use.
         outIndex.assign(3 * listSize, UINT32_MAX);
         uint32_t next = 0;
