@@ -791,7 +791,7 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         // the rotation from the twin back through the same solid run ends at this face.
         twinEdge.assign(3 * listSize, -1);
         size_t slots = 16;
-        while (slots < 4 * 3 * listSize) slots <<= 1;  // load factor <= 1/4: short probes
+        while (slots < 2 * 3 * listSize) slots <<= 1;  // load factor <= 1/2: short probes
         const uint64_t mask = slots - 1;
         edgeKeys.assign(slots, kNoEdge);
         edgeUse.resize(slots);
