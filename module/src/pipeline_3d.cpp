@@ -20,6 +20,8 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <numeric>
 #include <set>
 #include <string>
@@ -1055,6 +1057,20 @@ void Baker::buildLevels() {
     // each level writes only its own LevelWork. Coarse levels keep much more free space and
     // cost the most, so they are started first (the threads then finish together); the hull
     // baseline (when asked) runs as one task after the coarser half.
+    // Buffers reused by the next level on whichever thread (at most one set per thread).
+    std::vector<std::unique_ptr<detail::SculptScratch>> scratchPool;
+    std::mutex scratchMutex;
+    auto takeScratch = [&] {
+        std::lock_guard<std::mutex> lock(scratchMutex);
+        if (scratchPool.empty()) return std::make_unique<detail::SculptScratch>();
+        std::unique_ptr<detail::SculptScratch> s = std::move(scratchPool.back());
+        scratchPool.pop_back();
+        return s;
+    };
+    auto giveBackScratch = [&](std::unique_ptr<detail::SculptScratch> s) {
+        std::lock_guard<std::mutex> lock(scratchMutex);
+        scratchPool.push_back(std::move(s));
+    };
     std::vector<size_t> taskOrder;  // level index, or SIZE_MAX for the hull baseline
     for (size_t k = 0; k < work.size(); ++k) {
         if (settings_.computeHullBaseline && k == work.size() / 2) taskOrder.push_back(SIZE_MAX);
@@ -1070,10 +1086,12 @@ void Baker::buildLevels() {
             }
             const size_t li = taskOrder[task];
             LevelWork& w = work[li];
-            std::vector<int> label, constantLabel, surfaceTets;
+            std::unique_ptr<detail::SculptScratch> scratch = takeScratch();
+            std::vector<int>& label = scratch->label;
+            std::vector<int>& constantLabel = scratch->baselineLabel;
             if (measureConstant) w.request.baselineLimits = &w.constantLimits;
-            detail::sculptLevel(space_, w.request, label, &constantLabel, &surfaceTets);
-            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates, &surfaceTets);
+            detail::sculptLevel(space_, w.request, label, &constantLabel, &scratch->surfaceTets, scratch.get());
+            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates, &scratch->surfaceTets, scratch.get());
             // Per-aggregate sources and measures, on the same thread (levels are independent).
             for (size_t m = 0; m < models_.size(); ++m) {
                 Aggregate& agg = w.aggregates[w.modelGroup[m]];
@@ -1095,6 +1113,7 @@ void Baker::buildLevels() {
             if (measureConstant)
                 for (size_t t = 0; t < constantLabel.size(); ++t)
                     if (constantLabel[t] >= 0) w.volumeConstant += space_.tetVolume[t];
+            giveBackScratch(std::move(scratch));
         },
         [&](size_t done) { timer_.report(double(done) / taskOrder.size()); });
 

@@ -396,11 +396,15 @@ struct Sculptor {
     bool wasAdded(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 2); }
     bool wasRemoved(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 1); }
 
+    struct EdgeUse {
+        int u, v, group, tet;
+    };
+    std::vector<EdgeUse> repairUses, repairByVertex;  // scratch of repairNonManifoldEdges
+    std::vector<uint32_t> repairStart;
+
     bool repairNonManifoldEdges(bool fullScan) {
-        struct EdgeUse {
-            int u, v, group, tet;
-        };
-        std::vector<EdgeUse> uses;
+        std::vector<EdgeUse>& uses = repairUses;
+        uses.clear();
         auto collectFaces = [&](int t) {
             const int g = label[t];
             if (g < 0) return;
@@ -441,10 +445,12 @@ struct Sculptor {
             // the few edges kept are then sorted as the work list expects. Same list as
             // sorting all uses, without sorting hundreds of thousands of them.
             const size_t pointCount = mesh.pointCount();
-            std::vector<uint32_t> start(pointCount + 1, 0);
+            std::vector<uint32_t>& start = repairStart;
+            start.assign(pointCount + 1, 0);
             for (const EdgeUse& use : uses) ++start[use.u + 1];
             for (size_t p = 0; p < pointCount; ++p) start[p + 1] += start[p];
-            std::vector<EdgeUse> byVertex(uses.size());
+            std::vector<EdgeUse>& byVertex = repairByVertex;
+            byVertex.resize(uses.size());
             {
                 std::vector<uint32_t> at(start.begin(), start.end() - 1);
                 for (const EdgeUse& use : uses) byVertex[at[use.u]++] = use;
@@ -568,6 +574,62 @@ struct Sculptor {
 
 }  // namespace
 
+// The per-tet and per-edge buffers of one level, kept between levels on one thread.
+struct SculptScratch::Buffers {
+    std::vector<char> isProtected;
+    std::vector<unsigned char> floodState, cleanUpHistory;
+    std::vector<double> best;  // all +inf between uses
+    std::vector<int> from;     // all -1 between uses
+    std::vector<int> floodMembers, active, addedTets, changedTets, removedSinceIslands, changedSinceVoids;
+    std::vector<Sculptor::EdgeUse> repairUses, repairByVertex;
+    std::vector<uint32_t> repairStart;
+    // extractSurfaces
+    std::vector<int> faceIndexOf;  // all -1 between uses
+    std::vector<std::pair<int, int>> allFaces, byGroup;
+    std::vector<uint32_t> faceGroup;
+    std::vector<uint64_t> edgeKeys;
+    std::vector<int> edgeUse, twinEdge;
+};
+
+SculptScratch::SculptScratch() : buffers(std::make_unique<Buffers>()) {}
+SculptScratch::~SculptScratch() = default;
+
+namespace {
+// Lends the scratch buffers to a Sculptor for its lifetime (swaps keep their capacity).
+struct BorrowedBuffers {
+    Sculptor& s;
+    SculptScratch::Buffers* b;
+    BorrowedBuffers(Sculptor& sculptor, SculptScratch* scratch) : s(sculptor), b(scratch ? scratch->buffers.get() : nullptr) {
+        swapAll();
+        // State that must start empty (the rest is assigned before use, or kept in its
+        // neutral state between uses).
+        s.cleanUpHistory.clear();
+        s.addedTets.clear();
+        s.changedTets.clear();
+        s.removedSinceIslands.clear();
+        s.changedSinceVoids.clear();
+    }
+    ~BorrowedBuffers() { swapAll(); }
+    void swapAll() {
+        if (!b) return;
+        s.isProtected.swap(b->isProtected);
+        s.floodState.swap(b->floodState);
+        s.cleanUpHistory.swap(b->cleanUpHistory);
+        s.scratchBest.swap(b->best);
+        s.scratchFrom.swap(b->from);
+        s.floodMembers.swap(b->floodMembers);
+        s.active.swap(b->active);
+        s.addedTets.swap(b->addedTets);
+        s.changedTets.swap(b->changedTets);
+        s.removedSinceIslands.swap(b->removedSinceIslands);
+        s.changedSinceVoids.swap(b->changedSinceVoids);
+        s.repairUses.swap(b->repairUses);
+        s.repairByVertex.swap(b->repairByVertex);
+        s.repairStart.swap(b->repairStart);
+    }
+};
+}  // namespace
+
 int FreeSpace::findPair(uint32_t a, uint32_t b) const {
     if (a > b) std::swap(a, b);
     auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(a, b),
@@ -659,8 +721,9 @@ EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const Aggrega
 }
 
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
-                 std::vector<int>* baselineLabel, std::vector<int>* surfaceTets) {
+                 std::vector<int>* baselineLabel, std::vector<int>* surfaceTets, SculptScratch* scratch) {
     Sculptor sculptor(space, request, tetLabel);
+    BorrowedBuffers borrowed(sculptor, scratch);
     sculptor.initialLabels();
     sculptor.isProtected.assign(space.mesh.tetCount(), 0);
     for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
@@ -723,14 +786,18 @@ struct Corners {
 }  // namespace
 
 void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size_t groupCount,
-                     std::vector<Aggregate>& aggregates, const std::vector<int>* surfaceTets) {
+                     std::vector<Aggregate>& aggregates, const std::vector<int>* surfaceTets, SculptScratch* scratch) {
+    SculptScratch local;
+    SculptScratch::Buffers& buffers = scratch ? *scratch->buffers : *local.buffers;
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
     aggregates.resize(groupCount);
     // Surface faces: (tet, face) with the tet in a group's solid and the neighbour outside
     // it, gathered by group in one array (counting sort, tet order kept within a group).
-    std::vector<std::pair<int, int>> allFaces;
-    std::vector<uint32_t> faceGroup;
+    std::vector<std::pair<int, int>>& allFaces = buffers.allFaces;
+    std::vector<uint32_t>& faceGroup = buffers.faceGroup;
+    allFaces.clear();
+    faceGroup.clear();
     auto collect = [&](size_t t) {
         const int g = label[t];
         if (g < 0) return;
@@ -753,16 +820,18 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
     std::vector<size_t> groupStart(groupCount + 1, 0);
     for (uint32_t g : faceGroup) ++groupStart[g + 1];
     for (size_t g = 0; g < groupCount; ++g) groupStart[g + 1] += groupStart[g];
-    std::vector<std::pair<int, int>> byGroup(allFaces.size());
+    std::vector<std::pair<int, int>>& byGroup = buffers.byGroup;
+    byGroup.resize(allFaces.size());
     {
         std::vector<size_t> at(groupStart.begin(), groupStart.end() - 1);
         for (size_t f = 0; f < allFaces.size(); ++f) byGroup[at[faceGroup[f]]++] = allFaces[f];
     }
-    std::vector<int> faceIndexOf(4 * tetCount, -1);
-    std::vector<int> twinEdge;
+    std::vector<int>& faceIndexOf = buffers.faceIndexOf;  // all -1 again after each group
+    if (faceIndexOf.size() != 4 * tetCount) faceIndexOf.assign(4 * tetCount, -1);
+    std::vector<int>& twinEdge = buffers.twinEdge;
     constexpr uint64_t kNoEdge = ~0ull;
-    std::vector<uint64_t> edgeKeys;  // open addressing: directed edge (from << 32 | to)
-    std::vector<int> edgeUse;        // its face edge 3 * face + e, or -1 when used twice
+    std::vector<uint64_t>& edgeKeys = buffers.edgeKeys;  // open addressing: directed edge (from << 32 | to)
+    std::vector<int>& edgeUse = buffers.edgeUse;         // its face edge 3 * face + e, or -1 when used twice
     std::vector<uint32_t> outIndex;
     Corners corners, shells;
     for (size_t g = 0; g < groupCount; ++g) {
