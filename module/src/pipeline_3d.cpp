@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -214,9 +213,7 @@ private:
         bool trianglesCurrent = false;
     };
     std::map<std::pair<uint32_t, uint32_t>, CachedDistance> distanceCache_;
-    void measureLikelyNeighbours(const std::atomic<bool>& stop);
-    std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours,
-                                                                 const std::atomic<bool>* stop = nullptr) const;
+    std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours) const;
     void prerefineClosePairs();
     struct Insertion {
         uint32_t model, triangle;
@@ -410,22 +407,19 @@ bool Baker::triangulate() {
         // TetGen runs in a child process on one core; meanwhile this process builds the
         // models' BVHs and hulls (needed right after) on one thread. Each model's result
         // does not depend on the thread doing it, so output stays deterministic.
-        // Then it measures exact distances of likely neighbour pairs for the graph stage
-        // until TetGen is done (the cache only saves time; it never changes a result).
+        // (It used to go on measuring likely neighbour pairs until TetGen was done; on this
+        // 2-vCPU VM that slowed TetGen's child by more than it saved in the graph stage.)
         std::thread preparing;
-        std::atomic<bool> tetgenDone{false};
         const bool overlap = !modelsPrepared_ && settings_.threadCount != 1;
         if (overlap)
-            preparing = std::thread([this, &tetgenDone] {
+            preparing = std::thread([this] {
 #ifdef __linux__
                 // Lowest priority for this thread only: on a busy machine TetGen goes first.
                 setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
 #endif
                 prepareModels(1);
-                if (settings_.distance == DistanceMode::Exact) measureLikelyNeighbours(tetgenDone);
             });
         detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
-        tetgenDone = true;
         if (preparing.joinable()) preparing.join();
         for (const char* fallback : {"Y", "M"}) {
             if (outcome.status != detail::TetgenStatus::Crashed && outcome.status != detail::TetgenStatus::InternalError) break;
@@ -868,13 +862,12 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex
 }
 
 // Pairs (i < j, sorted, unique) of each model with its `neighbours` nearest models by box
-// distance. Stops early (possibly incomplete) when `stop` is set.
-std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neighbours,
-                                                                    const std::atomic<bool>* stop) const {
+// distance.
+std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neighbours) const {
     const size_t n = models_.size();
     std::vector<std::pair<uint32_t, uint32_t>> candidates;
     std::vector<std::pair<double, uint32_t>> near;
-    for (uint32_t i = 0; i < n && !(stop && *stop); ++i) {
+    for (uint32_t i = 0; i < n; ++i) {
         near.clear();
         for (uint32_t j = 0; j < n; ++j) {
             if (j == i) continue;
@@ -892,20 +885,6 @@ std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neigh
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     return candidates;
-}
-
-// Exact distances of each model's nearest models by box distance (more than the
-// near-pair refinement step measured), into distanceCache_, until `stop` is set.
-void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
-    const std::vector<std::pair<uint32_t, uint32_t>> candidates = nearestPairsByBox(32, &stop);
-    for (const auto& [i, j] : candidates) {
-        if (stop) return;
-        const std::pair<uint32_t, uint32_t> key{models_[i].objects[0], models_[j].objects[0]};
-        // Pairs already measured keep their entry: whether the triangles are current must
-        // not depend on this (optional) step, or output would depend on the thread count.
-        if (distanceCache_.count(key)) continue;
-        distanceCache_[key] = CachedDistance{detail::meshDistance(models_[i].bvh, models_[j].bvh), true};
-    }
 }
 
 // Per model: BVH of its surface (for exact distances) and convex hull (for the baseline).
