@@ -204,15 +204,11 @@ private:
     bool refineCoarseConnections();
     void prepareModels(int threadCount);
     bool modelsPrepared_ = false;  ///< BVHs and hulls match the models' current surfaces
-    /// Exact distances measured before triangulating, by (first object of a, first object of b).
-    /// trianglesCurrent: the triangle numbers refer to the current surfaces (no point was
-    /// inserted since the measurement). Whether a pair is cached never changes the result:
-    /// meshDistance gives the same closest pair with or without its distance bound.
-    struct CachedDistance {
-        detail::ClosestPair pair;
-        bool trianglesCurrent = false;
-    };
-    std::map<std::pair<uint32_t, uint32_t>, CachedDistance> distanceCache_;
+    /// Exact distances measured before triangulating (prerefine), by (first object of a,
+    /// first object of b). Their triangle numbers are not used: points are inserted right
+    /// after. Whether a pair is cached never changes the result: meshDistance gives the same
+    /// closest pair with or without its distance bound.
+    std::map<std::pair<uint32_t, uint32_t>, detail::ClosestPair> distanceCache_;
     std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours) const;
     void prerefineClosePairs();
     struct Insertion {
@@ -642,12 +638,12 @@ void Baker::buildGraph() {
         auto cached = distanceCache_.find({models_[p.a].objects[0], models_[p.b].objects[0]});
         const bool fromCache = cached != distanceCache_.end();
         const detail::ClosestPair cp =
-            fromCache ? cached->second.pair : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
+            fromCache ? cached->second : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
         if (std::isfinite(cp.distance) && cp.distance <= p.shortestEdge) {
             p.exactDistance = cp.distance;
             std::copy(cp.pointA, cp.pointA + 3, p.closestA);
             std::copy(cp.pointB, cp.pointB + 3, p.closestB);
-            if (!fromCache || cached->second.trianglesCurrent) {
+            if (!fromCache) {
                 p.closestTriangleA = cp.triangleA;
                 p.closestTriangleB = cp.triangleB;
             }
@@ -698,7 +694,7 @@ void Baker::prerefineClosePairs() {
         for (int k = 0; k < 2; ++k)
             if (use[c][k]) insertions.push_back(found[c][k]);
         const auto [i, j] = candidates[c];
-        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = CachedDistance{measured[c], false};
+        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = measured[c];
     }
     insertSurfacePoints(insertions, NearVertex::Skip);
 }
@@ -711,7 +707,6 @@ void Baker::prerefineClosePairs() {
 // closed, manifold and outward. Returns how many points were inserted.
 size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex nearVertex) {
     modelsPrepared_ = false;  // surfaces change (not their shape: distances stay valid)
-    for (auto& entry : distanceCache_) entry.second.trianglesCurrent = false;
     std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
         return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
     });
