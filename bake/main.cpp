@@ -76,6 +76,7 @@ struct BakeOptions {
     int threads = 0;
     double proxyError = 0.25;
     bool tiles = false;
+    bool constantBaseline = false;
     bool quiet = false;
 };
 
@@ -123,6 +124,9 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "(each child of a scene root, with all meshes below it)")
         ->transform(CLI::IsMember({"node", "subtree"}, CLI::ignore_case));
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
+    cmd->add_flag("--constant-baseline", o.constantBaseline,
+                  "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
+                  "added_volume_constant in the stats (one more carving per level; off by default)");
     cmd->add_option("--touch-tolerance", o.touchTolerance,
                     "Objects closer than this are one model (default: 1e-6 x scene diagonal)")
         ->check(CLI::NonNegativeNumber);
@@ -227,6 +231,7 @@ int runBake(BakeOptions o) {
     settings.distance = o.distance == "cdt" ? DistanceMode::Cdt : DistanceMode::Exact;
     settings.touchTolerance = o.touchTolerance;
     settings.threadCount = o.threads;
+    settings.computeConstantBaseline = o.constantBaseline;
     settings.progress = [&progress](const char* stage, double fraction) {
         progress.update(stage, fraction);
     };

@@ -192,10 +192,10 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
         w.field("volume_original", l.volumeOriginal);
         w.field("volume_aggregate", l.measures.volume);
         w.field("volume_hull", l.volumeHull);
-        w.field("volume_constant", l.volumeConstant);
+        if (l.hasVolumeConstant) w.field("volume_constant", l.volumeConstant);
         w.field("added_volume", l.measures.volume - l.volumeOriginal);
         w.field("added_volume_hull", l.volumeHull - l.volumeOriginal);
-        w.field("added_volume_constant", l.volumeConstant - l.volumeOriginal);
+        if (l.hasVolumeConstant) w.field("added_volume_constant", l.volumeConstant - l.volumeOriginal);
         w.field("area", l.measures.area);
         w.field("sphericity", l.measures.sphericity);
         w.fieldSigned("components", components);

@@ -329,6 +329,25 @@ inline double pruneBound2(double best, double slack) {
     return r * r;
 }
 
+// Separating-axis lower bound (a cheap reject before the full triangle-triangle distance):
+// the gap between the two triangles' projections on any axis n is at most their distance
+// times |n|. Axes: both normals and the centroid difference. True when the gap on one of
+// them exceeds sqrt(bound2), so the pair cannot reach the pruning bound; bound2 holds the
+// same slack as the box test, which covers the rounding of these few dot products, so a
+// pair that could win (or tie) is never rejected and results stay bit for bit the same.
+inline bool separatedBeyond(const Vec3 A[3], const Vec3 B[3], double bound2) {
+    const Vec3 axes[3] = {cross(A[1] - A[0], A[2] - A[0]), cross(B[1] - B[0], B[2] - B[0]),
+                          (B[0] + B[1] + B[2]) - (A[0] + A[1] + A[2])};
+    for (const Vec3& n : axes) {
+        const double a0 = dot(n, A[0]), a1 = dot(n, A[1]), a2 = dot(n, A[2]);
+        const double b0 = dot(n, B[0]), b1 = dot(n, B[1]), b2 = dot(n, B[2]);
+        const double gap = std::max(std::min({b0, b1, b2}) - std::max({a0, a1, a2}),
+                                    std::min({a0, a1, a2}) - std::max({b0, b1, b2}));
+        if (gap > 0 && gap * gap > bound2 * dot(n, n)) return true;
+    }
+    return false;
+}
+
 inline bool pairLess(uint32_t a0, uint32_t b0, uint32_t a1, uint32_t b1) {
     return a0 < a1 || (a0 == a1 && b0 < b1);
 }
@@ -683,6 +702,7 @@ ClosestPair meshDistance(const TriangleBvh& a, const TriangleBvh& b, double maxD
                         continue;  // nothing beats 0, and the tie rule prefers the current pair
                     const double* cb = b.slotCorners(B.first + j);
                     const Vec3 TB[3] = {load(cb), load(cb + 3), load(cb + 6)};
+                    if (separatedBeyond(TA, TB, bound2)) continue;
                     Vec3 pa, pb;
                     double d = std::sqrt(triangleTriangle2(TA, TB, pa, pb));
                     bool take = d < best ||

@@ -15,11 +15,12 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <numeric>
 #include <set>
 #include <string>
@@ -203,18 +204,12 @@ private:
     bool refineCoarseConnections();
     void prepareModels(int threadCount);
     bool modelsPrepared_ = false;  ///< BVHs and hulls match the models' current surfaces
-    /// Exact distances measured before triangulating, by (first object of a, first object of b).
-    /// trianglesCurrent: the triangle numbers refer to the current surfaces (no point was
-    /// inserted since the measurement). Whether a pair is cached never changes the result:
-    /// meshDistance gives the same closest pair with or without its distance bound.
-    struct CachedDistance {
-        detail::ClosestPair pair;
-        bool trianglesCurrent = false;
-    };
-    std::map<std::pair<uint32_t, uint32_t>, CachedDistance> distanceCache_;
-    void measureLikelyNeighbours(const std::atomic<bool>& stop);
-    std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours,
-                                                                 const std::atomic<bool>* stop = nullptr) const;
+    /// Exact distances measured before triangulating (prerefine), by (first object of a,
+    /// first object of b). Their triangle numbers are not used: points are inserted right
+    /// after. Whether a pair is cached never changes the result: meshDistance gives the same
+    /// closest pair with or without its distance bound.
+    std::map<std::pair<uint32_t, uint32_t>, detail::ClosestPair> distanceCache_;
+    std::vector<std::pair<uint32_t, uint32_t>> nearestPairsByBox(size_t neighbours) const;
     void prerefineClosePairs();
     struct Insertion {
         uint32_t model, triangle;
@@ -408,22 +403,19 @@ bool Baker::triangulate() {
         // TetGen runs in a child process on one core; meanwhile this process builds the
         // models' BVHs and hulls (needed right after) on one thread. Each model's result
         // does not depend on the thread doing it, so output stays deterministic.
-        // Then it measures exact distances of likely neighbour pairs for the graph stage
-        // until TetGen is done (the cache only saves time; it never changes a result).
+        // (It used to go on measuring likely neighbour pairs until TetGen was done; on this
+        // 2-vCPU VM that slowed TetGen's child by more than it saved in the graph stage.)
         std::thread preparing;
-        std::atomic<bool> tetgenDone{false};
         const bool overlap = !modelsPrepared_ && settings_.threadCount != 1;
         if (overlap)
-            preparing = std::thread([this, &tetgenDone] {
+            preparing = std::thread([this] {
 #ifdef __linux__
                 // Lowest priority for this thread only: on a busy machine TetGen goes first.
                 setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
 #endif
                 prepareModels(1);
-                if (settings_.distance == DistanceMode::Exact) measureLikelyNeighbours(tetgenDone);
             });
         detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, space_.mesh);
-        tetgenDone = true;
         if (preparing.joinable()) preparing.join();
         for (const char* fallback : {"Y", "M"}) {
             if (outcome.status != detail::TetgenStatus::Crashed && outcome.status != detail::TetgenStatus::InternalError) break;
@@ -646,12 +638,12 @@ void Baker::buildGraph() {
         auto cached = distanceCache_.find({models_[p.a].objects[0], models_[p.b].objects[0]});
         const bool fromCache = cached != distanceCache_.end();
         const detail::ClosestPair cp =
-            fromCache ? cached->second.pair : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
+            fromCache ? cached->second : detail::meshDistance(models_[p.a].bvh, models_[p.b].bvh, p.shortestEdge);
         if (std::isfinite(cp.distance) && cp.distance <= p.shortestEdge) {
             p.exactDistance = cp.distance;
             std::copy(cp.pointA, cp.pointA + 3, p.closestA);
             std::copy(cp.pointB, cp.pointB + 3, p.closestB);
-            if (!fromCache || cached->second.trianglesCurrent) {
+            if (!fromCache) {
                 p.closestTriangleA = cp.triangleA;
                 p.closestTriangleB = cp.triangleB;
             }
@@ -702,7 +694,7 @@ void Baker::prerefineClosePairs() {
         for (int k = 0; k < 2; ++k)
             if (use[c][k]) insertions.push_back(found[c][k]);
         const auto [i, j] = candidates[c];
-        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = CachedDistance{measured[c], false};
+        distanceCache_[{models_[i].objects[0], models_[j].objects[0]}] = measured[c];
     }
     insertSurfacePoints(insertions, NearVertex::Skip);
 }
@@ -715,7 +707,6 @@ void Baker::prerefineClosePairs() {
 // closed, manifold and outward. Returns how many points were inserted.
 size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex nearVertex) {
     modelsPrepared_ = false;  // surfaces change (not their shape: distances stay valid)
-    for (auto& entry : distanceCache_) entry.second.trianglesCurrent = false;
     std::stable_sort(insertions.begin(), insertions.end(), [](const Insertion& x, const Insertion& y) {
         return std::tie(x.model, x.triangle) < std::tie(y.model, y.triangle);
     });
@@ -866,13 +857,12 @@ size_t Baker::insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex
 }
 
 // Pairs (i < j, sorted, unique) of each model with its `neighbours` nearest models by box
-// distance. Stops early (possibly incomplete) when `stop` is set.
-std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neighbours,
-                                                                    const std::atomic<bool>* stop) const {
+// distance.
+std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neighbours) const {
     const size_t n = models_.size();
     std::vector<std::pair<uint32_t, uint32_t>> candidates;
     std::vector<std::pair<double, uint32_t>> near;
-    for (uint32_t i = 0; i < n && !(stop && *stop); ++i) {
+    for (uint32_t i = 0; i < n; ++i) {
         near.clear();
         for (uint32_t j = 0; j < n; ++j) {
             if (j == i) continue;
@@ -890,20 +880,6 @@ std::vector<std::pair<uint32_t, uint32_t>> Baker::nearestPairsByBox(size_t neigh
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     return candidates;
-}
-
-// Exact distances of each model's nearest models by box distance (more than the
-// near-pair refinement step measured), into distanceCache_, until `stop` is set.
-void Baker::measureLikelyNeighbours(const std::atomic<bool>& stop) {
-    const std::vector<std::pair<uint32_t, uint32_t>> candidates = nearestPairsByBox(32, &stop);
-    for (const auto& [i, j] : candidates) {
-        if (stop) return;
-        const std::pair<uint32_t, uint32_t> key{models_[i].objects[0], models_[j].objects[0]};
-        // Pairs already measured keep their entry: whether the triangles are current must
-        // not depend on this (optional) step, or output would depend on the thread count.
-        if (distanceCache_.count(key)) continue;
-        distanceCache_[key] = CachedDistance{detail::meshDistance(models_[i].bvh, models_[j].bvh), true};
-    }
 }
 
 // Per model: BVH of its surface (for exact distances) and convex hull (for the baseline).
@@ -1009,16 +985,87 @@ void Baker::buildLevels() {
         }
     }
 
+    // Hull baseline, level by level: starts from each model's own hull. A group's hull is
+    // the hull of its sub-groups' hulls at the previous level (groups only coarsen): a group
+    // unchanged since then keeps its hull, others are built from the few vertices of their
+    // parts' hulls. It does not depend on the sculpting, so it runs as one more task beside
+    // the levels (one chain, in level order), keeping both cores busy to the end.
+    struct GroupHull {
+        std::vector<double> vertices;
+        double volume = 0;
+    };
+    std::vector<std::vector<double>> hullVolumes(deltas.size());  ///< per level, per group
+    auto computeHullBaseline = [&] {
+        std::vector<GroupHull> previousHulls(models_.size());
+        std::vector<uint32_t> previousHullOfModel(models_.size());
+        for (size_t m = 0; m < models_.size(); ++m) {
+            previousHullOfModel[m] = static_cast<uint32_t>(m);
+            previousHulls[m].vertices = models_[m].hullPoints;
+            previousHulls[m].volume = models_[m].hullVolume;
+        }
+        for (size_t li = 0; li < deltas.size(); ++li) {
+            const LevelWork& w = work[li];
+            std::vector<GroupHull> hulls(w.groupCount);
+            std::vector<std::vector<uint32_t>> parts(w.groupCount);
+            for (size_t m = 0; m < models_.size(); ++m) parts[w.modelGroup[m]].push_back(previousHullOfModel[m]);
+            for (size_t g = 0; g < w.groupCount; ++g) {
+                std::vector<uint32_t>& p = parts[g];
+                std::sort(p.begin(), p.end());
+                p.erase(std::unique(p.begin(), p.end()), p.end());
+                if (p.size() == 1) {
+                    hulls[g] = previousHulls[p[0]];
+                } else {
+                    std::vector<double> points;
+                    for (uint32_t part : p) points.insert(points.end(), previousHulls[part].vertices.begin(), previousHulls[part].vertices.end());
+                    hulls[g].volume = detail::convexHullVolume(points, &hulls[g].vertices);
+                }
+            }
+            hullVolumes[li].resize(w.groupCount);
+            for (size_t g = 0; g < w.groupCount; ++g) hullVolumes[li][g] = hulls[g].volume;
+            for (size_t m = 0; m < models_.size(); ++m) previousHullOfModel[m] = w.modelGroup[m];
+            previousHulls = std::move(hulls);
+        }
+    };
+
     // Levels are independent given the one triangulation: sculpt them on several threads;
-    // each level writes only its own LevelWork.
+    // each level writes only its own LevelWork. Coarse levels keep much more free space and
+    // cost the most, so they are started first (the threads then finish together); the hull
+    // baseline (when asked) runs as one task after the coarser half.
+    // Buffers reused by the next level on whichever thread (at most one set per thread).
+    std::vector<std::unique_ptr<detail::SculptScratch>> scratchPool;
+    std::mutex scratchMutex;
+    auto takeScratch = [&] {
+        std::lock_guard<std::mutex> lock(scratchMutex);
+        if (scratchPool.empty()) return std::make_unique<detail::SculptScratch>();
+        std::unique_ptr<detail::SculptScratch> s = std::move(scratchPool.back());
+        scratchPool.pop_back();
+        return s;
+    };
+    auto giveBackScratch = [&](std::unique_ptr<detail::SculptScratch> s) {
+        std::lock_guard<std::mutex> lock(scratchMutex);
+        scratchPool.push_back(std::move(s));
+    };
+    std::vector<size_t> taskOrder;  // level index, or SIZE_MAX for the hull baseline
+    for (size_t k = 0; k < work.size(); ++k) {
+        if (settings_.computeHullBaseline && k == work.size() / 2) taskOrder.push_back(SIZE_MAX);
+        taskOrder.push_back(work.size() - 1 - k);
+    }
+    if (settings_.computeHullBaseline && work.empty()) taskOrder.push_back(SIZE_MAX);
     detail::parallelFor(
-        work.size(), settings_.threadCount,
-        [&](size_t li) {
+        taskOrder.size(), settings_.threadCount,
+        [&](size_t task) {
+            if (taskOrder[task] == SIZE_MAX) {
+                computeHullBaseline();
+                return;
+            }
+            const size_t li = taskOrder[task];
             LevelWork& w = work[li];
-            std::vector<int> label, constantLabel;
+            std::unique_ptr<detail::SculptScratch> scratch = takeScratch();
+            std::vector<int>& label = scratch->label;
+            std::vector<int>& constantLabel = scratch->baselineLabel;
             if (measureConstant) w.request.baselineLimits = &w.constantLimits;
-            detail::sculptLevel(space_, w.request, label, &constantLabel);
-            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates);
+            detail::sculptLevel(space_, w.request, label, &constantLabel, &scratch->surfaceTets, scratch.get());
+            detail::extractSurfaces(space_, label, w.groupCount, w.aggregates, &scratch->surfaceTets, scratch.get());
             // Per-aggregate sources and measures, on the same thread (levels are independent).
             for (size_t m = 0; m < models_.size(); ++m) {
                 Aggregate& agg = w.aggregates[w.modelGroup[m]];
@@ -1040,23 +1087,11 @@ void Baker::buildLevels() {
             if (measureConstant)
                 for (size_t t = 0; t < constantLabel.size(); ++t)
                     if (constantLabel[t] >= 0) w.volumeConstant += space_.tetVolume[t];
+            giveBackScratch(std::move(scratch));
         },
-        [&](size_t done) { timer_.report(double(done) / work.size()); });
+        [&](size_t done) { timer_.report(double(done) / taskOrder.size()); });
 
     timer_.begin("level measures");
-    // Hull baseline, level by level: starts from each model's own hull.
-    struct GroupHull {
-        std::vector<double> vertices;
-        double volume = 0;
-    };
-    std::vector<GroupHull> previousHulls(models_.size());
-    std::vector<uint32_t> previousHullOfModel(models_.size());
-    if (settings_.computeHullBaseline)
-        for (size_t m = 0; m < models_.size(); ++m) {
-            previousHullOfModel[m] = static_cast<uint32_t>(m);
-            previousHulls[m].vertices = models_[m].hullPoints;
-            previousHulls[m].volume = models_[m].hullVolume;
-        }
     for (size_t li = 0; li < deltas.size(); ++li) {
         LevelWork& w = work[li];
         Level level;
@@ -1066,33 +1101,13 @@ void Baker::buildLevels() {
         level.triangleCount = w.triangleCount;
         level.measures = measuresOf(totalVolume, totalArea);
         level.volumeOriginal = out_.originals.volume;
-        if (settings_.computeHullBaseline) {
-            // A group's hull is the hull of its sub-groups' hulls at the previous level
-            // (groups only coarsen): a group unchanged since then keeps its hull, others
-            // are built from the few vertices of their parts' hulls.
-            std::vector<GroupHull> hulls(w.groupCount);
-            std::vector<std::vector<uint32_t>> parts(w.groupCount);
-            for (size_t m = 0; m < models_.size(); ++m) parts[w.modelGroup[m]].push_back(previousHullOfModel[m]);
-            detail::parallelFor(w.groupCount, settings_.threadCount, [&](size_t g) {
-                std::vector<uint32_t>& p = parts[g];
-                std::sort(p.begin(), p.end());
-                p.erase(std::unique(p.begin(), p.end()), p.end());
-                if (p.size() == 1) {
-                    hulls[g] = previousHulls[p[0]];
-                } else {
-                    std::vector<double> points;
-                    for (uint32_t part : p) points.insert(points.end(), previousHulls[part].vertices.begin(), previousHulls[part].vertices.end());
-                    hulls[g].volume = detail::convexHullVolume(points, &hulls[g].vertices);
-                }
-            });
+        if (settings_.computeHullBaseline)
             for (size_t g = 0; g < w.groupCount; ++g) {
-                aggregates[g].volumeHull = hulls[g].volume;
-                level.volumeHull += hulls[g].volume;
+                aggregates[g].volumeHull = hullVolumes[li][g];
+                level.volumeHull += hullVolumes[li][g];
             }
-            for (size_t m = 0; m < models_.size(); ++m) previousHullOfModel[m] = w.modelGroup[m];
-            previousHulls = std::move(hulls);
-        }
         level.volumeConstant = isConstant ? totalVolume : w.volumeConstant;
+        level.hasVolumeConstant = isConstant || measureConstant;
         level.aggregates = std::move(aggregates);
         out_.levels.push_back(std::move(level));
         timer_.report(double(li + 1) / deltas.size());

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <deque>
+#include <iterator>
 #include <cmath>
 #include <numeric>
 #include <queue>
@@ -54,14 +55,24 @@ struct Sculptor {
 
     int groupOfModel(int m) const { return m < 0 ? -1 : static_cast<int>((*request.modelGroup)[m]); }
 
+    // Tets that can take part in this level's shape, ascending: after step 1, the kept free
+    // tets and the object tets with a face on their model's surface. Carving and the
+    // clean-up's first pass only remove, so their full scans visit these instead of every
+    // tet of the mesh (object interiors and the free space no group claims are most of it).
+    std::vector<int> active;
+    // Tets the clean-up added to a solid (not in `active`).
+    std::vector<int> addedTets;
+
     // Step 1: object interiors take their model's group; a free tet takes the single group
     // of its owned vertices, or -1.
     void initialLabels() {
         const size_t tetCount = mesh.tetCount();
         label.assign(tetCount, -1);
+        active.clear();
         for (size_t t = 0; t < tetCount; ++t) {
             if (space.tetModel[t] >= 0) {
                 label[t] = groupOfModel(space.tetModel[t]);
+                if (label[t] >= 0 && space.objectFaceMask[t]) active.push_back(static_cast<int>(t));
                 continue;
             }
             int group = -1;
@@ -73,6 +84,7 @@ struct Sculptor {
                 else if (g != group) mixed = true;
             }
             label[t] = mixed ? -1 : group;
+            if (label[t] >= 0) active.push_back(static_cast<int>(t));
         }
     }
 
@@ -239,7 +251,7 @@ struct Sculptor {
         std::vector<int> removed;
         removed.swap(removedSinceIslands);
         if (fullScan) {
-            for (size_t t = 0; t < tetCount; ++t) floodFrom(static_cast<int>(t));
+            for (int t : active) floodFrom(t);  // only removals so far: kept free tets are in it
         } else {
             for (int r : removed)
                 for (int j = 0; j < 4; ++j) {
@@ -304,15 +316,20 @@ struct Sculptor {
         std::vector<int> changedTets;
         changedTets.swap(changedSinceVoids);
         if (fullScan) {
-            for (size_t t = 0; t < tetCount; ++t) {
-                if (label[t] < 0) continue;
-                const unsigned faces = candidateFaces(t);
+            // Seeds next to every solid tet: those of `active` and those the edge repair
+            // added. Which cavities get filled does not depend on the seed order (a cavity is
+            // a connected component of unclaimed space, judged whole).
+            auto seedAround = [&](int t) {
+                if (label[t] < 0) return;
+                const unsigned faces = candidateFaces(static_cast<size_t>(t));
                 for (int j = 0; j < 4; ++j) {
                     if (!(faces & (1u << j))) continue;
                     const int n = mesh.neighbors[4 * t + j];
                     if (n >= 0) floodFrom(n);
                 }
-            }
+            };
+            for (int t : active) seedAround(t);
+            for (size_t k = 0; k < addedTets.size(); ++k) seedAround(addedTets[k]);
         } else {
             for (int t : changedTets) {
                 floodFrom(t);
@@ -372,18 +389,22 @@ struct Sculptor {
         changedTets.push_back(t);
         changedSinceVoids.push_back(t);
         if (value < 0) removedSinceIslands.push_back(t);
+        else if (!(cleanUpHistory.size() && (cleanUpHistory[t] & 2))) addedTets.push_back(t);
         if (cleanUpHistory.empty()) cleanUpHistory.assign(mesh.tetCount(), 0);
         cleanUpHistory[t] |= value < 0 ? 1 : 2;
     }
     bool wasAdded(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 2); }
     bool wasRemoved(int t) const { return !cleanUpHistory.empty() && (cleanUpHistory[t] & 1); }
 
+    struct EdgeUse {
+        int u, v, group, tet;
+    };
+    std::vector<EdgeUse> repairUses, repairByVertex;  // scratch of repairNonManifoldEdges
+    std::vector<uint32_t> repairStart;
+
     bool repairNonManifoldEdges(bool fullScan) {
-        const size_t tetCount = mesh.tetCount();
-        struct EdgeUse {
-            int u, v, group, tet;
-        };
-        std::vector<EdgeUse> uses;
+        std::vector<EdgeUse>& uses = repairUses;
+        uses.clear();
         auto collectFaces = [&](int t) {
             const int g = label[t];
             if (g < 0) return;
@@ -400,7 +421,7 @@ struct Sculptor {
             }
         };
         if (fullScan) {
-            for (size_t t = 0; t < tetCount; ++t) collectFaces(static_cast<int>(t));
+            for (int t : active) collectFaces(t);  // first pass: only removals so far
         } else {
             // Only edges near tets changed in the previous round; their fans are checked
             // whole below (ring runs), since the unchanged faces were not collected.
@@ -415,9 +436,40 @@ struct Sculptor {
             for (int t : near) collectFaces(t);
         }
         changedTets.clear();
-        std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
+        auto useLess = [](const EdgeUse& a, const EdgeUse& b) {
             return std::tie(a.group, a.u, a.v, a.tet) < std::tie(b.group, b.u, b.v, b.tet);
-        });
+        };
+        if (fullScan) {
+            // Every surface edge: only those on more than two faces of a group are work.
+            // Bucketed by the first vertex (counting sort), each small bucket sorted alone;
+            // the few edges kept are then sorted as the work list expects. Same list as
+            // sorting all uses, without sorting hundreds of thousands of them.
+            const size_t pointCount = mesh.pointCount();
+            std::vector<uint32_t>& start = repairStart;
+            start.assign(pointCount + 1, 0);
+            for (const EdgeUse& use : uses) ++start[use.u + 1];
+            for (size_t p = 0; p < pointCount; ++p) start[p + 1] += start[p];
+            std::vector<EdgeUse>& byVertex = repairByVertex;
+            byVertex.resize(uses.size());
+            {
+                std::vector<uint32_t> at(start.begin(), start.end() - 1);
+                for (const EdgeUse& use : uses) byVertex[at[use.u]++] = use;
+            }
+            uses.clear();
+            for (size_t p = 0; p < pointCount; ++p) {
+                EdgeUse* b = byVertex.data() + start[p];
+                EdgeUse* e = byVertex.data() + start[p + 1];
+                if (e - b < 3) continue;
+                std::sort(b, e, useLess);
+                for (EdgeUse* i = b; i != e;) {
+                    EdgeUse* j = i;
+                    while (j != e && j->group == i->group && j->v == i->v) ++j;
+                    if (j - i > 2) uses.insert(uses.end(), i, j);
+                    i = j;
+                }
+            }
+        }
+        std::sort(uses.begin(), uses.end(), useLess);
         // Work list of edges to examine, in a deterministic order: first the candidates,
         // then the edges of every tet a repair changed (a repair can make a neighbour edge
         // non-manifold), until none is left. The cap only guards against a cycle.
@@ -500,11 +552,10 @@ struct Sculptor {
     // only exposes more facets), so the removed set does not depend on the order; a plain
     // stack visits it in linear time.
     void carve() {
-        const size_t tetCount = mesh.tetCount();
         std::vector<int> stack;
-        for (size_t t = 0; t < tetCount; ++t) {
+        for (int t : active) {
             if (space.tetModel[t] >= 0 || label[t] < 0 || isProtected[t]) continue;
-            if (carvePriority(static_cast<int>(t)) > 0) stack.push_back(static_cast<int>(t));
+            if (carvePriority(t) > 0) stack.push_back(t);
         }
         while (!stack.empty()) {
             const int t = stack.back();
@@ -521,6 +572,62 @@ struct Sculptor {
     }
 };
 
+}  // namespace
+
+// The per-tet and per-edge buffers of one level, kept between levels on one thread.
+struct SculptScratch::Buffers {
+    std::vector<char> isProtected;
+    std::vector<unsigned char> floodState, cleanUpHistory;
+    std::vector<double> best;  // all +inf between uses
+    std::vector<int> from;     // all -1 between uses
+    std::vector<int> floodMembers, active, addedTets, changedTets, removedSinceIslands, changedSinceVoids;
+    std::vector<Sculptor::EdgeUse> repairUses, repairByVertex;
+    std::vector<uint32_t> repairStart;
+    // extractSurfaces
+    std::vector<int> faceIndexOf;  // all -1 between uses
+    std::vector<std::pair<int, int>> allFaces, byGroup;
+    std::vector<uint32_t> faceGroup;
+    std::vector<uint64_t> edgeKeys;
+    std::vector<int> edgeUse, twinEdge;
+};
+
+SculptScratch::SculptScratch() : buffers(std::make_unique<Buffers>()) {}
+SculptScratch::~SculptScratch() = default;
+
+namespace {
+// Lends the scratch buffers to a Sculptor for its lifetime (swaps keep their capacity).
+struct BorrowedBuffers {
+    Sculptor& s;
+    SculptScratch::Buffers* b;
+    BorrowedBuffers(Sculptor& sculptor, SculptScratch* scratch) : s(sculptor), b(scratch ? scratch->buffers.get() : nullptr) {
+        swapAll();
+        // State that must start empty (the rest is assigned before use, or kept in its
+        // neutral state between uses).
+        s.cleanUpHistory.clear();
+        s.addedTets.clear();
+        s.changedTets.clear();
+        s.removedSinceIslands.clear();
+        s.changedSinceVoids.clear();
+    }
+    ~BorrowedBuffers() { swapAll(); }
+    void swapAll() {
+        if (!b) return;
+        s.isProtected.swap(b->isProtected);
+        s.floodState.swap(b->floodState);
+        s.cleanUpHistory.swap(b->cleanUpHistory);
+        s.scratchBest.swap(b->best);
+        s.scratchFrom.swap(b->from);
+        s.floodMembers.swap(b->floodMembers);
+        s.active.swap(b->active);
+        s.addedTets.swap(b->addedTets);
+        s.changedTets.swap(b->changedTets);
+        s.removedSinceIslands.swap(b->removedSinceIslands);
+        s.changedSinceVoids.swap(b->changedSinceVoids);
+        s.repairUses.swap(b->repairUses);
+        s.repairByVertex.swap(b->repairByVertex);
+        s.repairStart.swap(b->repairStart);
+    }
+};
 }  // namespace
 
 int FreeSpace::findPair(uint32_t a, uint32_t b) const {
@@ -614,8 +721,9 @@ EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const Aggrega
 }
 
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
-                 std::vector<int>* baselineLabel) {
+                 std::vector<int>* baselineLabel, std::vector<int>* surfaceTets, SculptScratch* scratch) {
     Sculptor sculptor(space, request, tetLabel);
+    BorrowedBuffers borrowed(sculptor, scratch);
     sculptor.initialLabels();
     sculptor.isProtected.assign(space.mesh.tetCount(), 0);
     for (const ProtectedConnection& c : request.connections) sculptor.protectConnection(c);
@@ -623,6 +731,7 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
         // Same groups, same protected connections: only the carving limits differ.
         *baselineLabel = tetLabel;
         Sculptor baseline(space, request, *baselineLabel);
+        baseline.active = sculptor.active;
         baseline.limits = request.baselineLimits;
         baseline.isProtected = sculptor.isProtected;
         baseline.carve();
@@ -631,7 +740,21 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
     // Clean-up for a manifold result: drop fill not face-connected to its group's objects,
     // and open or fill the tets around edges where a solid touches itself only along an
     // edge. Each round only changes free tets; a few rounds settle it.
-    if (!request.cleanUp) return;
+    // Every tet that can hold a surface face: `active` and what the clean-up added.
+    auto listSurfaceTets = [&] {
+        if (!surfaceTets) return;
+        std::vector<int>& list = *surfaceTets;
+        list = sculptor.addedTets;
+        std::sort(list.begin(), list.end());
+        std::vector<int> merged;
+        merged.reserve(sculptor.active.size() + list.size());
+        std::set_union(sculptor.active.begin(), sculptor.active.end(), list.begin(), list.end(), std::back_inserter(merged));
+        list.swap(merged);
+    };
+    if (!request.cleanUp) {
+        listSurfaceTets();
+        return;
+    }
     // Islands appear only where tets are removed; voids are filled in the same round; the
     // edge repair follows its own changes. So another round is needed only when the repair
     // opened something (new islands are possible then).
@@ -642,6 +765,7 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
         sculptor.fillVoids(round == 0);
         if (!sculptor.openedByRepair) break;
     }
+    listSurfaceTets();
 }
 
 // ---- surface extraction ----------------------------------------------------------------
@@ -662,17 +786,21 @@ struct Corners {
 }  // namespace
 
 void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size_t groupCount,
-                     std::vector<Aggregate>& aggregates) {
+                     std::vector<Aggregate>& aggregates, const std::vector<int>* surfaceTets, SculptScratch* scratch) {
+    SculptScratch local;
+    SculptScratch::Buffers& buffers = scratch ? *scratch->buffers : *local.buffers;
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
     aggregates.resize(groupCount);
     // Surface faces: (tet, face) with the tet in a group's solid and the neighbour outside
     // it, gathered by group in one array (counting sort, tet order kept within a group).
-    std::vector<std::pair<int, int>> allFaces;
-    std::vector<uint32_t> faceGroup;
-    for (size_t t = 0; t < tetCount; ++t) {
+    std::vector<std::pair<int, int>>& allFaces = buffers.allFaces;
+    std::vector<uint32_t>& faceGroup = buffers.faceGroup;
+    allFaces.clear();
+    faceGroup.clear();
+    auto collect = [&](size_t t) {
         const int g = label[t];
-        if (g < 0) continue;
+        if (g < 0) return;
         // Object interiors are skipped: only their model-surface faces can be on a surface.
         const unsigned candidates = space.tetModel[t] >= 0 ? space.objectFaceMask[t] : 0xFu;
         for (int j = 0; j < 4; ++j) {
@@ -683,17 +811,27 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 faceGroup.push_back(static_cast<uint32_t>(g));
             }
         }
+    };
+    if (surfaceTets) {
+        for (int t : *surfaceTets) collect(static_cast<size_t>(t));
+    } else {
+        for (size_t t = 0; t < tetCount; ++t) collect(t);
     }
     std::vector<size_t> groupStart(groupCount + 1, 0);
     for (uint32_t g : faceGroup) ++groupStart[g + 1];
     for (size_t g = 0; g < groupCount; ++g) groupStart[g + 1] += groupStart[g];
-    std::vector<std::pair<int, int>> byGroup(allFaces.size());
+    std::vector<std::pair<int, int>>& byGroup = buffers.byGroup;
+    byGroup.resize(allFaces.size());
     {
         std::vector<size_t> at(groupStart.begin(), groupStart.end() - 1);
         for (size_t f = 0; f < allFaces.size(); ++f) byGroup[at[faceGroup[f]]++] = allFaces[f];
     }
-    std::vector<int> faceIndexOf(4 * tetCount, -1);
-    std::vector<int> twinEdge;
+    std::vector<int>& faceIndexOf = buffers.faceIndexOf;  // all -1 again after each group
+    if (faceIndexOf.size() != 4 * tetCount) faceIndexOf.assign(4 * tetCount, -1);
+    std::vector<int>& twinEdge = buffers.twinEdge;
+    constexpr uint64_t kNoEdge = ~0ull;
+    std::vector<uint64_t>& edgeKeys = buffers.edgeKeys;  // open addressing: directed edge (from << 32 | to)
+    std::vector<int>& edgeUse = buffers.edgeUse;         // its face edge 3 * face + e, or -1 when used twice
     std::vector<uint32_t> outIndex;
     Corners corners, shells;
     for (size_t g = 0; g < groupCount; ++g) {
@@ -715,21 +853,54 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
         std::iota(corners.parent.begin(), corners.parent.end(), 0u);
         shells.parent.resize(listSize);
         std::iota(shells.parent.begin(), shells.parent.end(), 0u);
-        // Twin of each face edge, found by one rotation and recorded for both sides (the
-        // rotation from the twin back through the same solid run ends at this face).
+        // Twin of each face edge, recorded for both sides. Where the group's surface uses the
+        // edge once each way (a manifold edge: nearly all), the twin is the one face using it
+        // the other way, looked up in a table of directed edges. Otherwise (the edge is on
+        // more faces) it is found by rotating around the edge through the group's solid;
+        // the rotation from the twin back through the same solid run ends at this face.
         twinEdge.assign(3 * listSize, -1);
+        size_t slots = 16;
+        while (slots < 2 * 3 * listSize) slots <<= 1;  // load factor <= 1/2: short probes
+        const uint64_t mask = slots - 1;
+        edgeKeys.assign(slots, kNoEdge);
+        edgeUse.resize(slots);
+        auto slotOf = [&](uint64_t key) {
+            uint64_t h = (key * 0x9E3779B97F4A7C15ull) >> 20;
+            while (true) {
+                h &= mask;
+                if (edgeKeys[h] == key || edgeKeys[h] == kNoEdge) return h;
+                ++h;
+            }
+        };
+        auto directedKey = [](int from, int to) { return (static_cast<uint64_t>(from) << 32) | static_cast<uint32_t>(to); };
+        for (size_t f = 0; f < listSize; ++f) {
+            const auto [t0, j0] = list[f];
+            for (int e = 0; e < 3; ++e) {
+                const uint64_t key = directedKey(vertexAt(t0, kFaceCorners[j0][e]), vertexAt(t0, kFaceCorners[j0][(e + 1) % 3]));
+                const uint64_t h = slotOf(key);
+                if (edgeKeys[h] == kNoEdge) {
+                    edgeKeys[h] = key;
+                    edgeUse[h] = static_cast<int>(3 * f + e);
+                } else {
+                    edgeUse[h] = -1;  // used twice this way: not manifold
+                }
+            }
+        }
         for (size_t f = 0; f < listSize; ++f) {
             const auto [t0, j0] = list[f];
             for (int e = 0; e < 3; ++e) {
                 if (twinEdge[3 * f + e] >= 0) continue;
                 const int u = vertexAt(t0, kFaceCorners[j0][e]);
                 const int v = vertexAt(t0, kFaceCorners[j0][(e + 1) % 3]);
+                int twinFace = -1;
+                const uint64_t back = slotOf(directedKey(v, u));
+                if (edgeKeys[back] != kNoEdge && edgeUse[back] >= 0 && edgeUse[slotOf(directedKey(u, v))] >= 0)
+                    twinFace = edgeUse[back] / 3;
                 // Rotate around edge uv through the group's solid tets until leaving it.
                 int t = t0;
                 int lu = localCorner(t, u), lv = localCorner(t, v);
                 int cross = 6 - lu - lv - j0;  // the other face of t containing uv
-                int twinFace = -1;
-                for (int guard = 0; guard < 4096; ++guard) {
+                for (int guard = 0; guard < 4096 && twinFace < 0; ++guard) {
                     int n = mesh.neighbors[4 * t + cross];
                     if (n < 0 || label[n] != static_cast<int>(g)) {
                         twinFace = faceIndexOf[4 * t + cross];

@@ -6,6 +6,7 @@
 
 #include <aggrelod/aggregate3d.h>
 
+#include <memory>
 #include <vector>
 
 namespace aggrelod::detail {
@@ -34,6 +35,18 @@ void precomputeTetEdges(FreeSpace& space, int threadCount);
 EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
                              DistanceMode distance);
 
+/// Buffers that sculptLevel and extractSurfaces reuse from one level to the next (each call
+/// fills them afresh: reuse never changes a result, it only saves allocating and
+/// page-faulting tens of megabytes per level). One thread at a time.
+class SculptScratch {
+public:
+    SculptScratch();
+    ~SculptScratch();
+    struct Buffers;
+    std::unique_ptr<Buffers> buffers;
+    std::vector<int> label, baselineLabel, surfaceTets;  ///< for the caller's per-level outputs
+};
+
 struct LevelShapeRequest {
     const std::vector<uint32_t>* modelGroup = nullptr;  ///< per model: group index at this level
     size_t groupCount = 0;
@@ -48,12 +61,18 @@ struct LevelShapeRequest {
 /// Labels every tet with the group whose solid contains it (-1: not in any aggregate).
 /// Object interiors take their model's group; free tets are kept or carved. When
 /// request.baselineLimits is set, *baselineLabel gets the labels carved with those limits.
+/// surfaceTets (optional) gets, ascending, every tet that can hold a face of the surfaces:
+/// a superset of the free tets in a solid and of the solid object tets on a model surface
+/// (for extractSurfaces, so it need not scan the whole mesh).
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,
-                 std::vector<int>* baselineLabel = nullptr);
+                 std::vector<int>* baselineLabel = nullptr, std::vector<int>* surfaceTets = nullptr,
+                 SculptScratch* scratch = nullptr);
 
 /// Builds the closed, edge-manifold, outward surface of every group from the tet labels.
-/// aggregates[g] gets positions, indices and componentCount.
+/// aggregates[g] gets positions, indices and componentCount. surfaceTets (optional): the
+/// list sculptLevel gave; without it every tet is scanned (same result).
 void extractSurfaces(const FreeSpace& space, const std::vector<int>& tetLabel, size_t groupCount,
-                     std::vector<Aggregate>& aggregates);
+                     std::vector<Aggregate>& aggregates, const std::vector<int>* surfaceTets = nullptr,
+                     SculptScratch* scratch = nullptr);
 
 }  // namespace aggrelod::detail
