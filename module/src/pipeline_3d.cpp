@@ -1050,7 +1050,6 @@ void Baker::buildLevels() {
         if (settings_.computeHullBaseline && k == work.size() / 2) taskOrder.push_back(SIZE_MAX);
         taskOrder.push_back(work.size() - 1 - k);
     }
-    if (settings_.computeHullBaseline && work.empty()) taskOrder.push_back(SIZE_MAX);
     detail::parallelFor(
         taskOrder.size(), settings_.threadCount,
         [&](size_t task) {

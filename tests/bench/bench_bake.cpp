@@ -13,103 +13,22 @@
 //
 // Usage: bench_bake [objects=1000] [triangles=150000] [levels=8] [seed=1] [threads=0 (all)]
 //                   [also bake with the constant baseline 1|0 = 1] [runs=3]
+#include "tetgen_peer.h"
+
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/samples.h>
-
-#include <tetgen.h>
-
-#include <sys/resource.h>
-#include <time.h>
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 
 using namespace aggrelod;
-
-namespace {
-double cpuSeconds(clockid_t clock) {
-    timespec ts{};
-    clock_gettime(clock, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-double childrenCpuSeconds() {
-    rusage usage{};
-    getrusage(RUSAGE_CHILDREN, &usage);
-    return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
-double tetgenAloneSeconds(const std::vector<InputObject>& objects, int& tetCount, double& cpu) {
-    tetgenio in, out;
-    size_t points = 0, faces = 0;
-    for (const InputObject& o : objects) {
-        points += o.positions.size() / 3;
-        faces += o.indices.size() / 3;
-    }
-    in.numberofpoints = static_cast<int>(points);
-    in.pointlist = new REAL[3 * points];
-    in.numberoffacets = static_cast<int>(faces);
-    in.facetlist = new tetgenio::facet[faces];
-    in.facetmarkerlist = new int[faces];
-    size_t p = 0, f = 0;
-    for (size_t m = 0; m < objects.size(); ++m) {
-        const InputObject& o = objects[m];
-        const size_t base = p;
-        std::memcpy(in.pointlist + 3 * p, o.positions.data(), o.positions.size() * sizeof(double));
-        p += o.positions.size() / 3;
-        for (size_t t = 0; t < o.indices.size(); t += 3, ++f) {
-            tetgenio::facet& facet = in.facetlist[f];
-            tetgenio::init(&facet);
-            facet.numberofpolygons = 1;
-            facet.polygonlist = new tetgenio::polygon[1];
-            tetgenio::init(&facet.polygonlist[0]);
-            facet.polygonlist[0].numberofvertices = 3;
-            facet.polygonlist[0].vertexlist = new int[3];
-            for (int k = 0; k < 3; ++k) facet.polygonlist[0].vertexlist[k] = static_cast<int>(base + o.indices[t + k]);
-            in.facetmarkerlist[f] = static_cast<int>(m) + 1;
-        }
-    }
-    char switches[] = "pczQn";
-    auto start = std::chrono::steady_clock::now();
-    const double cpuStart = cpuSeconds(CLOCK_THREAD_CPUTIME_ID);
-    tetrahedralize(switches, &in, &out);
-    cpu = cpuSeconds(CLOCK_THREAD_CPUTIME_ID) - cpuStart;
-    tetCount = out.numberoftetrahedra;
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-}  // namespace
-
-// TetGen alone in a fresh process, as the `tetgen` program or our bake's child runs it:
-// this process re-executes itself with --tetgen-alone, regenerates the same scene and
-// times only the tetrahedralize() call. Returns wall seconds; cpu gets CPU seconds.
-double tetgenFreshProcessSeconds(int objects, int triangles, uint32_t seed, int& tetCount, double& cpu) {
-    char command[512];
-    std::snprintf(command, sizeof command, "/proc/%d/exe --tetgen-alone %d %d %u", static_cast<int>(getpid()), objects,
-                  triangles, seed);
-    FILE* pipe = popen(command, "r");
-    double seconds = -1;
-    cpu = -1;
-    if (!pipe) return -1;
-    if (std::fscanf(pipe, "%lf %lf %d", &seconds, &cpu, &tetCount) != 3) seconds = -1;
-    pclose(pipe);
-    return seconds;
-}
+using bench::childrenCpuSeconds;
+using bench::cpuSeconds;
 
 int main(int argc, char** argv) {
-    if (argc == 5 && std::strcmp(argv[1], "--tetgen-alone") == 0) {
-        std::vector<InputObject> objects = samples::makeRandomScene(std::atoi(argv[2]), std::atoi(argv[3]),
-                                                                    static_cast<uint32_t>(std::atoi(argv[4])));
-        int tets = 0;
-        double cpu = 0;
-        const double seconds = tetgenAloneSeconds(objects, tets, cpu);
-        std::printf("%.6f %.6f %d\n", seconds, cpu, tets);
-        return 0;
-    }
+    if (bench::runTetgenAloneIfAsked(argc, argv)) return 0;
     const int objectCount = argc > 1 ? std::atoi(argv[1]) : 1000;
     const int triangles = argc > 2 ? std::atoi(argv[2]) : 150000;
     const int levels = argc > 3 ? std::atoi(argv[3]) : 8;
@@ -138,8 +57,12 @@ int main(int argc, char** argv) {
     std::vector<std::pair<double, double>> alone(runs), fresh(runs);  // wall, cpu
     int tets = 0, freshTets = 0;
     for (int r = 0; r < runs; ++r) {
-        fresh[r].first = tetgenFreshProcessSeconds(objectCount, triangles, seed, freshTets, fresh[r].second);
-        alone[r].first = tetgenAloneSeconds(objects, tets, alone[r].second);
+        const bench::TetgenPeerRun freshRun = bench::tetgenAloneFreshProcess(objectCount, triangles, seed);
+        fresh[r] = {freshRun.wall, freshRun.cpu};
+        freshTets = freshRun.tets;
+        const bench::TetgenPeerRun aloneRun = bench::tetgenAlone(objects);
+        alone[r] = {aloneRun.wall, aloneRun.cpu};
+        tets = aloneRun.tets;
         BakeRun& b = bakes[r];
         auto start = std::chrono::steady_clock::now();
         const double childCpuStart = childrenCpuSeconds(), processCpuStart = cpuSeconds(CLOCK_PROCESS_CPUTIME_ID);

@@ -10,43 +10,28 @@
 // Modes alternate per run; medians of wall seconds and of TetGen's CPU seconds are printed.
 //
 // Usage: bench_tetgen_child [objects=1000] [triangles=150000] [seed=1] [runs=5] [heap=1]
+#include "tetgen_backend.h"
+#include "tetgen_peer.h"
+
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/samples.h>
 
-#include "tetgen_backend.h"
-
-#include <tetgen.h>
-
 #include <sys/resource.h>
 #include <sys/syscall.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <thread>
 #include <vector>
 
 using namespace aggrelod;
+using bench::childrenCpuSeconds;
 
 namespace {
-double cpuSeconds(clockid_t clock) {
-    timespec ts{};
-    clock_gettime(clock, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-double childrenCpuSeconds() {
-    rusage usage{};
-    getrusage(RUSAGE_CHILDREN, &usage);
-    return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 detail::PlcInput makePlc(const std::vector<InputObject>& objects) {
     detail::PlcInput plc;
     for (size_t m = 0; m < objects.size(); ++m) {
@@ -56,35 +41,6 @@ detail::PlcInput makePlc(const std::vector<InputObject>& objects) {
         plc.triangleMarkers.insert(plc.triangleMarkers.end(), objects[m].indices.size() / 3, static_cast<int>(m) + 1);
     }
     return plc;
-}
-
-// TetGen alone on the PLC in this process: wall seconds of tetrahedralize(); cpu = its CPU.
-double tetgenAlone(const detail::PlcInput& plc, double& cpu) {
-    tetgenio in, out;
-    in.numberofpoints = static_cast<int>(plc.points.size() / 3);
-    in.pointlist = new REAL[plc.points.size()];
-    std::memcpy(in.pointlist, plc.points.data(), plc.points.size() * sizeof(double));
-    const int faces = static_cast<int>(plc.triangles.size() / 3);
-    in.numberoffacets = faces;
-    in.facetlist = new tetgenio::facet[faces];
-    in.facetmarkerlist = new int[faces];
-    for (int f = 0; f < faces; ++f) {
-        tetgenio::facet& facet = in.facetlist[f];
-        tetgenio::init(&facet);
-        facet.numberofpolygons = 1;
-        facet.polygonlist = new tetgenio::polygon[1];
-        tetgenio::init(&facet.polygonlist[0]);
-        facet.polygonlist[0].numberofvertices = 3;
-        facet.polygonlist[0].vertexlist = new int[3];
-        for (int k = 0; k < 3; ++k) facet.polygonlist[0].vertexlist[k] = plc.triangles[3 * f + k];
-        in.facetmarkerlist[f] = plc.triangleMarkers[f];
-    }
-    char switches[] = "pczQn";
-    const auto start = std::chrono::steady_clock::now();
-    const double cpuStart = cpuSeconds(CLOCK_THREAD_CPUTIME_ID);
-    tetrahedralize(switches, &in, &out);
-    cpu = cpuSeconds(CLOCK_THREAD_CPUTIME_ID) - cpuStart;
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // A low-priority thread doing memory-heavy work (like BVH builds and distance queries).
@@ -116,15 +72,8 @@ struct Sample {
 };
 
 Sample freshProcess(int objects, int triangles, uint32_t seed) {
-    char command[512];
-    std::snprintf(command, sizeof command, "/proc/%d/exe --tetgen-alone %d %d %u", static_cast<int>(getpid()), objects,
-                  triangles, seed);
-    Sample s{-1, -1};
-    if (FILE* pipe = popen(command, "r")) {
-        if (std::fscanf(pipe, "%lf %lf", &s.wall, &s.cpu) != 2) s = {-1, -1};
-        pclose(pipe);
-    }
-    return s;
+    const bench::TetgenPeerRun run = bench::tetgenAloneFreshProcess(objects, triangles, seed);
+    return {run.wall, run.cpu};
 }
 
 Sample backend(const detail::PlcInput& plc) {
@@ -149,14 +98,7 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc == 5 && std::strcmp(argv[1], "--tetgen-alone") == 0) {
-        const detail::PlcInput plc = makePlc(
-            samples::makeRandomScene(std::atoi(argv[2]), std::atoi(argv[3]), static_cast<uint32_t>(std::atoi(argv[4]))));
-        double cpu = 0;
-        const double wall = tetgenAlone(plc, cpu);
-        std::printf("%.6f %.6f\n", wall, cpu);
-        return 0;
-    }
+    if (bench::runTetgenAloneIfAsked(argc, argv)) return 0;
     const int objectCount = argc > 1 ? std::atoi(argv[1]) : 1000;
     const int triangles = argc > 2 ? std::atoi(argv[2]) : 150000;
     const uint32_t seed = argc > 3 ? static_cast<uint32_t>(std::atoi(argv[3])) : 1u;

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "grid_measure.h"
 #include "test_support.h"
 
 #include <algorithm>
@@ -21,7 +22,7 @@ using namespace aggrelod;
 
 namespace {
 
-using aggrelod::testing::windingNumber;
+using aggrelod::testing::gridMeasure;
 
 struct Baked {
     std::vector<InputObject> objects;
@@ -61,44 +62,6 @@ bool sphereInsideFloat(const HierarchyNode& inner, const HierarchyNode& outer) {
         d2 += d * d;
     }
     return std::sqrt(d2) + float(inner.sphereRadius) <= float(outer.sphereRadius);
-}
-
-
-/// Calls visit(point) for a 15-point barycentric grid (step 1/4) on every triangle.
-template <class Positions, class Visit>
-void forEachGridPoint(const Positions& pos, const std::vector<uint32_t>& idx, Visit&& visit) {
-    for (size_t t = 0; t < idx.size(); t += 3)
-        for (int i = 0; i <= 4; ++i)
-            for (int j = 0; i + j <= 4; ++j) {
-                double p[3];
-                for (int k = 0; k < 3; ++k) {
-                    const double a = pos[3 * idx[t] + k], b = pos[3 * idx[t + 1] + k], c = pos[3 * idx[t + 2] + k];
-                    p[k] = a + 0.25 * i * (b - a) + 0.25 * j * (c - a);
-                }
-                visit(p);
-            }
-}
-
-/// max(proxy -> originals, originals -> proxy solid) over grid points.
-double gridMeasuredError(const HierarchyNode& n, const std::vector<const InputObject*>& originals) {
-    std::vector<double> op;
-    std::vector<uint32_t> oi;
-    for (const InputObject* o : originals) {
-        const uint32_t base = uint32_t(op.size() / 3);
-        op.insert(op.end(), o->positions.begin(), o->positions.end());
-        for (uint32_t i : o->indices) oi.push_back(base + i);
-    }
-    detail::TriangleBvh origBvh, proxyBvh;
-    origBvh.build(op.data(), op.size() / 3, oi.data(), oi.size() / 3);
-    const std::vector<double> pp(n.positions.begin(), n.positions.end());
-    proxyBvh.build(pp.data(), pp.size() / 3, n.indices.data(), n.indices.size() / 3);
-    double worst = 0;
-    forEachGridPoint(n.positions, n.indices, [&](const double* p) { worst = std::max(worst, detail::closestPoint(origBvh, p).distance); });
-    forEachGridPoint(op, oi, [&](const double* p) {
-        const double d = detail::closestPoint(proxyBvh, p).distance;
-        if (d > worst && windingNumber(n.positions, n.indices, p) < 0.5) worst = d;
-    });
-    return worst;
 }
 
 }  // namespace
@@ -186,7 +149,7 @@ TEST(HierarchyNodes, ProxiesAreSimplerAndTheirStoredErrorBoundsAnIndependentMeas
         // exceeds the certified bound stored in the node.
         std::vector<const InputObject*> originals;
         for (uint32_t o : n.sources) originals.push_back(&b.objects[o]);
-        const double measured = gridMeasuredError(n, originals);
+        const double measured = gridMeasure(n.positions, n.indices, originals, 4).worst();
         EXPECT_LE(measured, n.geometricError) << "node " << i;
         EXPECT_LE(measured, n.error.bound()) << "node " << i;
         worstRatio = std::max(worstRatio, measured / n.geometricError);

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "grid_measure.h"
 #include "test_support.h"
 
 #include <algorithm>
@@ -21,7 +22,8 @@ using namespace aggrelod;
 
 namespace {
 
-using aggrelod::testing::windingNumber;
+using aggrelod::testing::GridMeasured;
+using aggrelod::testing::gridMeasure;
 
 /// A generic rotation (about a tilted axis), so that flat faces are flat only up to rounding.
 void rotate(std::vector<double>& positions) {
@@ -39,52 +41,9 @@ void rotate(std::vector<double>& positions) {
 std::vector<float> toFloat(const std::vector<double>& p) { return std::vector<float>(p.begin(), p.end()); }
 
 
-/// visit(point) on a barycentric grid of step 1/n on every triangle.
-template <class Visit>
-void forEachGridPoint(const std::vector<double>& pos, const std::vector<uint32_t>& idx, int n, Visit&& visit) {
-    for (size_t t = 0; t < idx.size(); t += 3)
-        for (int i = 0; i <= n; ++i)
-            for (int j = 0; i + j <= n; ++j) {
-                double p[3];
-                for (int k = 0; k < 3; ++k) {
-                    const double a = pos[3 * idx[t] + k], b = pos[3 * idx[t + 1] + k], c = pos[3 * idx[t + 2] + k];
-                    p[k] = a + (b - a) * i / n + (c - a) * j / n;
-                }
-                visit(p);
-            }
-}
-
-struct Measured {
-    double proxyToOriginals = 0, originalsToProxy = 0;
-};
-
-/// Brute-force one-sided distances on a grid of step 1/n.
-Measured gridMeasure(const std::vector<float>& proxyPositions, const std::vector<uint32_t>& proxyIndices,
-                     const std::vector<const InputObject*>& originals, int n) {
-    std::vector<double> op, pp(proxyPositions.begin(), proxyPositions.end());
-    std::vector<uint32_t> oi;
-    for (const InputObject* o : originals) {
-        const uint32_t base = uint32_t(op.size() / 3);
-        op.insert(op.end(), o->positions.begin(), o->positions.end());
-        for (uint32_t i : o->indices) oi.push_back(base + i);
-    }
-    detail::TriangleBvh origBvh, proxyBvh;
-    origBvh.build(op.data(), op.size() / 3, oi.data(), oi.size() / 3);
-    proxyBvh.build(pp.data(), pp.size() / 3, proxyIndices.data(), proxyIndices.size() / 3);
-    Measured m;
-    forEachGridPoint(pp, proxyIndices, n, [&](const double* p) {
-        m.proxyToOriginals = std::max(m.proxyToOriginals, detail::closestPoint(origBvh, p).distance);
-    });
-    forEachGridPoint(op, oi, n, [&](const double* p) {
-        const double d = detail::closestPoint(proxyBvh, p).distance;
-        if (d > m.originalsToProxy && windingNumber(pp, proxyIndices, p) < 0.5) m.originalsToProxy = d;
-    });
-    return m;
-}
-
 /// The bound is certified (never below the grid measurement) and converged (within the
 /// tolerance of the largest distance it found, which it found at a real point).
-void expectCertifiedAndConverged(const ProxyError& e, const Measured& m) {
+void expectCertifiedAndConverged(const ProxyError& e, const GridMeasured& m) {
     const double rounding = 1e-9;
     EXPECT_GE(e.proxyToOriginals + rounding, m.proxyToOriginals);
     EXPECT_GE(e.originalsToProxy + rounding, m.originalsToProxy);
@@ -169,7 +128,7 @@ TEST(ProxyErrorBounds, BumpySphereProxyMatchesBruteForce) {
     const std::vector<float> proxy = toFloat(bumpy);
     const double tolerance = 2e-3;
     const ProxyError e = measureProxyError(proxy, sphere.indices, {&sphere}, tolerance, 200000);
-    const Measured m = gridMeasure(proxy, sphere.indices, {&sphere}, 12);
+    const GridMeasured m = gridMeasure(proxy, sphere.indices, {&sphere}, 12);
     expectCertifiedAndConverged(e, m);
     EXPECT_GT(m.originalsToProxy, 0.01);  // the case really has originals outside the proxy
     EXPECT_GT(m.proxyToOriginals, 0.01);
