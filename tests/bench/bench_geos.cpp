@@ -2,12 +2,16 @@
 // ConcaveHullOfPolygons, the strongest open peer, at the same edge-length threshold.
 //
 // GEOS takes a length ratio r, not a length: L = r * (max - min) + min over the
-// unconstrained edges of the triangles between the polygons (GEOS computeTargetEdgeLength;
-// NOTES-deps). Our own constrained triangulation of the same vertices gives the same min /
-// max, so both remove exposed edges longer than delta. aggrelod builds ALL its levels (8 thresholds); GEOS builds one. Figures: seconds,
+// unconstrained edges of ITS triangulation (GEOS computeTargetEdgeLength; NOTES-deps). That
+// triangulation has a frame around the input (the envelope grown by 4 diagonals on each
+// side) whose corners change which long edges exist near the convex hull, so min / max are
+// not those of aggrelod's triangulation. geosEdgeRange() rebuilds GEOS's triangulation (a
+// constrained Delaunay triangulation is unique up to co-circular ties) and reads min / max
+// the way GEOS does, so that L = delta exactly; the table prints L. aggrelod builds ALL its levels (8 thresholds); GEOS builds one. Figures: seconds,
 // added area (relative to the originals), validity (GEOSisValid), and the longest boundary
 // edge of the output that does not lie on an input boundary versus delta.
 // GEOS time grows about with the square of the polygon count: it is skipped above 10k.
+#include "cdt_2d.h"  // aggrelod's CGAL wrapper, for GEOS's edge-length range
 #include "geo_io.h"
 
 #include <aggrelod/aggregate2d.h>
@@ -114,6 +118,64 @@ double longestFreeEdge(const std::vector<Polygon2D>& output, const GEOSPreparedG
     return longest;
 }
 
+/// Shortest and longest edge GEOS's computeTargetEdgeLength() sees for `shells` (x y rings,
+/// unclosed): triangulate the frame polygon (envelope grown by FRAME_EXPAND_FACTOR = 4
+/// diagonals) with the shells as holes; over the triangles outside the shells with no frame
+/// corner, every edge with a triangle on both sides.
+std::pair<double, double> geosEdgeRange(const std::vector<std::vector<double>>& shells) {
+    std::vector<double> points;
+    std::vector<std::pair<size_t, size_t>> segments;
+    double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY;
+    for (const auto& r : shells) {
+        const size_t first = points.size() / 2, n = r.size() / 2;
+        for (size_t i = 0; i < n; ++i) {
+            minX = std::min(minX, r[2 * i]), maxX = std::max(maxX, r[2 * i]);
+            minY = std::min(minY, r[2 * i + 1]), maxY = std::max(maxY, r[2 * i + 1]);
+            segments.emplace_back(first + i, first + (i + 1) % n);
+        }
+        points.insert(points.end(), r.begin(), r.end());
+    }
+    const size_t frameFirst = points.size() / 2;
+    const double grow = 4 * std::hypot(maxX - minX, maxY - minY);
+    for (double c : {minX - grow, minY - grow, maxX + grow, minY - grow, maxX + grow, maxY + grow, minX - grow, maxY + grow})
+        points.push_back(c);
+    for (size_t i = 0; i < 4; ++i) segments.emplace_back(frameFirst + i, frameFirst + (i + 1) % 4);
+    detail::Triangulation2D tri;
+    detail::ConstrainedTriangulation2D cdt;
+    std::string error;
+    if (!cdt.build(points, segments, tri, error)) return {0, 0};
+    // Outside the shells: flood from the hull (the frame), crossing a constraint flips sides.
+    const size_t faces = tri.faceCount();
+    std::vector<int> side(faces, -1), queue;
+    for (size_t f = 0; f < faces; ++f)
+        for (int j = 0; j < 3; ++j)
+            if (tri.neighbors[3 * f + j] < 0 && side[f] < 0) side[f] = 0, queue.push_back(static_cast<int>(f));
+    for (size_t head = 0; head < queue.size(); ++head) {
+        const int f = queue[head];
+        for (int j = 0; j < 3; ++j) {
+            const int n = tri.neighbors[3 * f + j];
+            if (n < 0 || side[n] >= 0) continue;
+            side[n] = side[f] ^ (tri.constrained[3 * f + j] ? 1 : 0);
+            queue.push_back(n);
+        }
+    }
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t f = 0; f < faces; ++f) {
+        if (side[f] != 0) continue;
+        const int* v = &tri.faces[3 * f];
+        bool frame = false;
+        for (int k = 0; k < 3; ++k) frame |= tri.vertexInput[v[k]] >= static_cast<int>(frameFirst);
+        if (frame) continue;
+        for (int j = 0; j < 3; ++j) {
+            if (tri.constrained[3 * f + j] || tri.neighbors[3 * f + j] < 0) continue;
+            const int a = v[(j + 1) % 3], b = v[(j + 2) % 3];
+            const double len = std::hypot(tri.points[2 * b] - tri.points[2 * a], tri.points[2 * b + 1] - tri.points[2 * a + 1]);
+            lo = std::min(lo, len), hi = std::max(hi, len);
+        }
+    }
+    return {lo, hi};
+}
+
 double totalArea(const std::vector<Polygon2D>& polys) {
     GEOSGeometry* g = multiPolygon(polys);
     double a = 0;
@@ -190,13 +252,19 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
     const double oursLongest = longestFreeEdge(oursOut, prepared, tol);
     const double oursAdded = (level->measures.area - inputArea) / inputArea;
 
+    double geosLength = NAN;  // GEOS's edge-length threshold L
     std::string geosTime = "skipped", geosAdded = "-", geosValid = "-", geosLongest = "-", speedup = "-";
     if (runGeos) {
-        const double ratio = (delta - h.freeEdgeMin) / (h.freeEdgeMax - h.freeEdgeMin);
         // GEOS needs a valid MultiPolygon: touching inputs (land data) are unioned first
         // (not timed; the grids are already valid).
         GEOSGeometry* geosInput = GEOSisValid_r(H, inputGeom) == 1 ? GEOSGeom_clone_r(H, inputGeom)
                                                                    : GEOSUnaryUnion_r(H, inputGeom);
+        std::vector<std::vector<double>> shells;
+        if (geosInput)
+            for (const Polygon2D& p : polygonsOf(geosInput)) shells.push_back(p.exterior);
+        const auto [edgeMin, edgeMax] = geosEdgeRange(shells);
+        const double ratio = std::clamp((delta - edgeMin) / (edgeMax - edgeMin), 0.0, 1.0);
+        geosLength = ratio * (edgeMax - edgeMin) + edgeMin;  // GEOS's own formula
         const auto t1 = Clock::now();
         GEOSGeometry* hull = geosInput ? GEOSConcaveHullOfPolygons_r(H, geosInput, ratio, 1, 1) : nullptr;
         const double geos = secondsSince(t1);
@@ -219,9 +287,9 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
         }
         if (geosInput) GEOSGeom_destroy_r(H, geosInput);
     }
-    std::printf("| %s | %zu | %.4g | %.3f | %.3f | %.4f | %s | %.4g | %s | %s | %s | %s | %s |\n", name.c_str(),
+    std::printf("| %s | %zu | %.4g | %.3f | %.3f | %.4f | %s | %.4g | %.4g | %s | %s | %s | %s | %s |\n", name.c_str(),
                 features.size(), delta, ours, oursOne, oursAdded, oursInvalid == 0 ? "valid" : (std::to_string(oursInvalid) + " INVALID").c_str(),
-                oursLongest, geosTime.c_str(), geosAdded.c_str(), geosValid.c_str(), geosLongest.c_str(), speedup.c_str());
+                oursLongest, geosLength, geosTime.c_str(), geosAdded.c_str(), geosValid.c_str(), geosLongest.c_str(), speedup.c_str());
     std::fflush(stdout);
     GEOSPreparedGeom_destroy_r(H, prepared);
     GEOSGeom_destroy_r(H, boundary);
@@ -240,8 +308,8 @@ int main(int argc, char** argv) {
                 "conversion and validity checks are not timed. aggrelod: median of %d runs; GEOS: one run.\n\n",
                 GEOSversion(), geosLimit, kRuns);
     std::printf("| case | polygons | delta | aggrelod s (8 levels) | aggrelod s (1 level) | aggrelod added area | aggrelod valid | aggrelod longest free edge | "
-                "GEOS s (1 level) | GEOS added area | GEOS valid | GEOS longest free edge | GEOS / aggrelod time |\n"
-                "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---|---:|---:|\n");
+                "GEOS L | GEOS s (1 level) | GEOS added area | GEOS valid | GEOS longest free edge | GEOS / aggrelod time |\n"
+                "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---|---:|---:|\n");
     // Unit squares, gaps 0.5 +- 0.4 (jittered grid), delta 0.45.
     for (int n : {1000, 4000, 10000, 40000})
         runCase("grid " + std::to_string(n / 1000) + "k", samples::makeSquareGrid(n, 1.0, 0.5, 0.2, 1), 0.45, n <= geosLimit);
