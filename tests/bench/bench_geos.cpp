@@ -36,7 +36,7 @@ using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 GEOSContextHandle_t H;
-constexpr int kRuns = 5;                         // aggrelod runs per figure (median)
+constexpr int kRuns = 9;                         // aggrelod runs per figure (median)
 constexpr int kGeosRuns = 3;                     // GEOS runs per figure (median; its time varies by ~20%)
 std::map<std::string, double> eightLevelSeconds;  // case -> aggrelod seconds, 8 levels
 
