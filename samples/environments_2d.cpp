@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace aggrelod::samples {
 namespace {
@@ -272,6 +273,47 @@ std::vector<Feature2D> makeSquareGrid(int count, double size, double gap, double
         out.push_back(feature("square", static_cast<size_t>(i), {x, y, x + size, y, x + size, y + size, x, y + size}));
     }
     return out;
+}
+
+std::vector<Feature2D> makeRandomOverlappingPolygons(uint32_t seed) {
+    Random rnd(seed);
+    std::vector<Feature2D> features;
+    const int n = rnd.uniformInt(2, 25);
+    const double span = rnd.uniform(10, 60);
+    for (int i = 0; i < n; ++i) {
+        Feature2D f;
+        f.name = "random " + std::to_string(i);
+        f.id = static_cast<uint32_t>(i);
+        const double cx = rnd.uniform(0, span), cy = rnd.uniform(0, span), r = rnd.uniform(1, 8);
+        const int k = rnd.uniformInt(3, 12);
+        Polygon2D p;
+        for (int j = 0; j < k; ++j) {
+            const double a = 2 * M_PI * j / k, rr = r * rnd.uniform(0.4, 1.0);
+            double x = cx + rr * std::cos(a), y = cy + rr * std::sin(a);
+            if (rnd.uniform01() < 0.3) {  // integer vertices: exact touches and shared edges
+                x = std::round(x);
+                y = std::round(y);
+            }
+            p.exterior.push_back(x);
+            p.exterior.push_back(y);
+        }
+        if (rnd.uniform01() < 0.2) {
+            std::vector<double> hole;
+            for (int j = 0; j < 4; ++j) {
+                hole.push_back(cx + 0.2 * r * std::cos(-M_PI / 2 * j));
+                hole.push_back(cy + 0.2 * r * std::sin(-M_PI / 2 * j));
+            }
+            p.holes.push_back(hole);
+        }
+        f.polygons.push_back(p);
+        if (rnd.uniform01() < 0.1) {  // an overlapping second part with the same hole
+            Polygon2D q = p;
+            for (size_t t = 0; t < q.exterior.size(); t += 2) q.exterior[t] += rnd.uniform(-3, 3);
+            f.polygons.push_back(q);
+        }
+        features.push_back(std::move(f));
+    }
+    return features;
 }
 
 }  // namespace aggrelod::samples

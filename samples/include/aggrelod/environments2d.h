@@ -29,4 +29,11 @@ std::vector<Feature2D> makeEnvironment2D(Environment2D env, uint32_t seed = 1);
 std::vector<Feature2D> makeSquareGrid(int count, double size = 1.0, double gap = 0.5, double jitter = 0,
                                       uint32_t seed = 1);
 
+/// A random test set (seeded): 2-25 star-shaped polygons of 3-12 vertices, radius 1-8, in a
+/// square of side 10-60, so they overlap and touch (30% of the vertices rounded to integers:
+/// exact touches and shared edges); 20% have a square hole, 10% of the features a second,
+/// overlapping part with the same hole. Names "random i", ids 0..n-1. Unlike the
+/// environments, these polygons do overlap: they exercise the input checks and the winding.
+std::vector<Feature2D> makeRandomOverlappingPolygons(uint32_t seed);
+
 }  // namespace aggrelod::samples
