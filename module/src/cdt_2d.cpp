@@ -2,21 +2,22 @@
 // All points and constraints go in as one batch, the way CGAL's insert_constraints() does it
 // (spatially sorted insertion: about 40x faster than inserting polygon by polygon, see
 // NOTES-deps), written out here to keep each input point's vertex. Inside/outside marking is
-// done by the caller (CGAL 5.5 has no mark_domain_in_triangulation).
+// done by the caller (CGAL 5.5 has no mark_domain_in_triangulation). Also CGAL's two exact
+// predicates, for the Steiner points that steiner_2d.cpp inserts into the export.
 #include "cdt_2d.h"
 
 #include "parallel_for.h"
+#include "radix_sort.h"
+#include "steiner_2d.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/Spatial_sort_traits_adapter_2.h>
-#include <CGAL/property_map.h>
-#include <CGAL/spatial_sort.h>
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <exception>
 #include <numeric>
 
@@ -38,8 +39,7 @@ using Point = Kernel::Point_2;
 
 struct ConstrainedTriangulation2D::Impl {
     Cdt cdt;
-    std::vector<Cdt::Vertex_handle> inputHandle;               // per build() input point
-    std::vector<std::vector<Cdt::Vertex_handle>> splitHandle;  // per insertSplits() request: its new vertices
+    std::vector<Cdt::Vertex_handle> inputHandle;  // per build() input point
 };
 
 ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
@@ -65,9 +65,67 @@ ConstrainedTriangulation2D::~ConstrainedTriangulation2D() { delete impl_; }
 
 namespace {
 
+// Position of the cell (x, y) along the Hilbert curve through a 2^16 x 2^16 grid
+// (the classic xy -> d conversion, one quadrant per bit from the top).
+uint64_t hilbertIndex(uint32_t x, uint32_t y) {
+    constexpr uint32_t n = 1u << 16;
+    uint64_t d = 0;
+    for (uint32_t s = n / 2; s > 0; s /= 2) {
+        const uint32_t rx = (x & s) ? 1 : 0, ry = (y & s) ? 1 : 0;
+        d += static_cast<uint64_t>(s) * s * ((3 * rx) ^ ry);
+        if (ry == 0) {
+            if (rx == 1) {
+                x = n - 1 - x;
+                y = n - 1 - y;
+            }
+            std::swap(x, y);
+        }
+    }
+    return d;
+}
+
+// Insertion order: the points along a Hilbert curve over their bounding square (equal cells in
+// index order), so each insertion starts its walk next to the previous vertex. The
+// triangulation does not depend on the order (CGAL's flips use a symbolic perturbation), only
+// its speed does; a radix sort of the curve positions costs far less than CGAL's spatial_sort.
+std::vector<uint32_t> hilbertOrder(const std::vector<double>& points) {
+    const size_t n = points.size() / 2;
+    double minX = INFINITY, minY = INFINITY, maxX = -INFINITY, maxY = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        minX = std::min(minX, points[2 * i]), maxX = std::max(maxX, points[2 * i]);
+        minY = std::min(minY, points[2 * i + 1]), maxY = std::max(maxY, points[2 * i + 1]);
+    }
+    const double span = std::max(maxX - minX, maxY - minY);
+    const double scale = span > 0 && std::isfinite(span) ? 65535.0 / span : 0;
+    auto cell = [&](double v, double lo) { return static_cast<uint32_t>(std::clamp((v - lo) * scale, 0.0, 65535.0)); };
+    // Biased randomized rounds (BRIO, as CGAL's spatial_sort): a point joins an earlier round
+    // with probability 1/4 per round, from a hash of its index (deterministic); rounds go in
+    // from the smallest, each along the curve.
+    std::vector<uint64_t> keyed(n);  // (round, curve position) << 32 | point index
+    for (size_t i = 0; i < n; ++i) {
+        uint64_t h = i + 0x9e3779b97f4a7c15ull;  // splitmix64
+        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+        h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+        h ^= h >> 31;
+        uint64_t earlier = 0;
+        while (earlier < 8 && ((h >> (62 - 2 * earlier)) & 3) == 3) ++earlier;
+        const uint64_t key = (8 - earlier) << 32 | hilbertIndex(cell(points[2 * i], minX), cell(points[2 * i + 1], minY));
+        keyed[i] = key << 28 | i;  // n < 2^28
+    }
+    radixSortStable(keyed, [](uint64_t k) { return k >> 28; }, 36);
+    std::vector<uint32_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(keyed[i] & ((1u << 28) - 1));
+    return order;
+}
+
+}  // namespace
+
+namespace {
+
 // Flat export. Vertices are numbered in the order of their input point (info().input, the
 // smallest input index at the vertex's place; Steiner points after, in CGAL's order, which is
-// deterministic for a given input); faces by their sorted vertex triple. Neither depends on
+// deterministic for a given input); faces then get the canonical order of
+// canonicalizeFaces2D (by sorted vertex triple, smallest corner first). Neither depends on
 // CGAL's storage order.
 void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputVertex, Triangulation2D& out, int threadCount) {
     out = Triangulation2D{};
@@ -93,63 +151,34 @@ void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputV
     for (Cdt::Vertex_handle v : steiner) add(v, -1);
     out.inputVertex.resize(inputCount);
     for (size_t i = 0; i < inputCount; ++i) out.inputVertex[i] = inputVertex[i]->info().index;
-    // Faces by sorted vertex triple: a counting sort on the smallest vertex, then tiny sorts.
-    // Keys and sorts in parallel blocks (each writing its own slots; same result for any
-    // thread count).
+    // Faces in CGAL's storage order first (infinite faces are -1), in parallel blocks each
+    // writing its own slots; then the canonical order.
     std::vector<Cdt::Face_handle> handles;
     handles.reserve(cdt.number_of_faces());
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) handles.push_back(f);
-    const size_t faceCount = handles.size();
-    std::vector<std::array<int, 3>> keys(faceCount), corners(faceCount);  // sorted / CGAL's order
-    const size_t blocks = std::clamp<size_t>(faceCount / 16384, 1, 64);
-    parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i) {
-            const Cdt::Face_handle f = handles[i];
-            corners[i] = {f->vertex(0)->info().index, f->vertex(1)->info().index, f->vertex(2)->info().index};
-            std::array<int, 3> key = corners[i];
-            std::sort(key.begin(), key.end());
-            keys[i] = key;
-        }
-    });
-    std::vector<uint32_t> bucketStart(vertexCount + 1, 0);
-    for (const auto& key : keys) ++bucketStart[key[0] + 1];
-    for (size_t v = 0; v < vertexCount; ++v) bucketStart[v + 1] += bucketStart[v];
-    std::vector<uint32_t> sorted(faceCount);  // storage positions, by key
-    {
-        std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
-        for (size_t i = 0; i < faceCount; ++i) sorted[fill[keys[i][0]]++] = static_cast<uint32_t>(i);
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+        f->info() = static_cast<int>(handles.size());
+        handles.push_back(f);
     }
-    const size_t vertexBlocks = std::clamp<size_t>(vertexCount / 8192, 1, 64);
-    parallelFor(vertexBlocks, threadCount, [&](size_t block) {
-        for (size_t v = vertexCount * block / vertexBlocks; v < vertexCount * (block + 1) / vertexBlocks; ++v)
-            if (bucketStart[v + 1] - bucketStart[v] > 1)
-                std::sort(sorted.begin() + bucketStart[v], sorted.begin() + bucketStart[v + 1],
-                          [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
-    });
-    // Infinite faces (around the infinite vertex) are -1; every finite one gets its number.
     {
         auto first = cdt.incident_faces(cdt.infinite_vertex()), f = first;
         if (f != nullptr) do f->info() = -1; while (++f != first);
     }
-    parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i)
-            handles[sorted[i]]->info() = static_cast<int>(i);
-    });
+    const size_t faceCount = handles.size();
     out.faces.resize(3 * faceCount);
     out.neighbors.resize(3 * faceCount);
     out.constrained.resize(3 * faceCount);
-    // In CGAL's storage order (sequential reads), each face writing its own slots.
+    const size_t blocks = std::clamp<size_t>(faceCount / 16384, 1, 64);
     parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t h = faceCount * block / blocks; h < faceCount * (block + 1) / blocks; ++h) {
-            const Cdt::Face_handle f = handles[h];
-            const size_t i = static_cast<size_t>(f->info());
+        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i) {
+            const Cdt::Face_handle f = handles[i];
             for (int k = 0; k < 3; ++k) {
-                out.faces[3 * i + k] = corners[h][k];
+                out.faces[3 * i + k] = f->vertex(k)->info().index;
                 out.neighbors[3 * i + k] = f->neighbor(k)->info();
                 out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
             }
         }
     });
+    canonicalizeFaces2D(out, threadCount);
 }
 
 }  // namespace
@@ -165,17 +194,13 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         pts.reserve(n);
         for (size_t i = 0; i < n; ++i) pts.emplace_back(points[2 * i], points[2 * i + 1]);
         // CGAL's insert_constraints(points, segments) (Triangulation_2/insert_constraints.h),
-        // step by step to keep the vertex of every input point: spatially sorted insertion,
-        // then the constraints between the vertices.
-        std::vector<std::size_t> order(n);
-        std::iota(order.begin(), order.end(), std::size_t{0});
-        CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::Pointer_property_map<Point>::const_type> sortTraits(
-            CGAL::make_property_map(static_cast<const std::vector<Point>&>(pts)), cdt.geom_traits());
-        CGAL::spatial_sort(order.begin(), order.end(), sortTraits);
+        // step by step to keep the vertex of every input point: spatially sorted insertion
+        // (hilbertOrder), then the constraints between the vertices.
+        const std::vector<uint32_t> order = hilbertOrder(points);
         std::vector<Cdt::Vertex_handle>& handle = impl_->inputHandle;
         handle.assign(n, Cdt::Vertex_handle());
         Cdt::Face_handle hint;
-        for (std::size_t i : order) {
+        for (const uint32_t i : order) {
             const Cdt::Vertex_handle v = cdt.insert(pts[i], hint);
             handle[i] = v;
             hint = v->face();
@@ -184,7 +209,6 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         }
         for (const auto& [a, b] : segments)
             if (handle[a] != handle[b]) insertConstraint(cdt, handle[a], handle[b]);
-        impl_->splitHandle.clear();
         exportTriangulation(cdt, handle, out, threadCount);
     } catch (const std::exception& e) {
         error = std::string("2D triangulation failed: ") + e.what();
@@ -193,68 +217,27 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
     return true;
 }
 
-bool ConstrainedTriangulation2D::exportTo(const std::vector<size_t>& newInputIndex, const std::vector<long long>& splitFirstIndex,
-                                          size_t inputCount, Triangulation2D& out, std::string& error,
-                                          int threadCount) {
-    try {
-        Cdt& cdt = impl_->cdt;
-        for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
-            if (v->info().input >= 0) v->info().input = static_cast<int>(newInputIndex[static_cast<size_t>(v->info().input)]);
-        for (size_t k = 0; k < impl_->splitHandle.size() && k < splitFirstIndex.size(); ++k) {
-            if (splitFirstIndex[k] < 0) continue;
-            for (size_t j = 0; j < impl_->splitHandle[k].size(); ++j) {
-                const Cdt::Vertex_handle v = impl_->splitHandle[k][j];
-                const int input = static_cast<int>(splitFirstIndex[k] + static_cast<long long>(j));
-                if (v->info().input < 0 || input < v->info().input) v->info().input = input;
-            }
-        }
-        std::vector<Cdt::Vertex_handle> inputVertex(inputCount);
-        for (size_t i = 0; i < impl_->inputHandle.size(); ++i) inputVertex.at(newInputIndex[i]) = impl_->inputHandle[i];
-        for (size_t k = 0; k < impl_->splitHandle.size() && k < splitFirstIndex.size(); ++k)
-            for (size_t j = 0; j < impl_->splitHandle[k].size() && splitFirstIndex[k] >= 0; ++j)
-                inputVertex.at(static_cast<size_t>(splitFirstIndex[k]) + j) = impl_->splitHandle[k][j];
-        impl_->splitHandle.clear();
-        exportTriangulation(cdt, inputVertex, out, threadCount);
-    } catch (const std::exception& e) {
-        error = std::string("2D triangulation failed while adding points: ") + e.what();
-        return false;
-    }
-    return true;
+int orientation2D(const double* a, const double* b, const double* c) {
+    return static_cast<int>(CGAL::orientation(Point(a[0], a[1]), Point(b[0], b[1]), Point(c[0], c[1])));
 }
 
-bool ConstrainedTriangulation2D::insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied,
-                                              std::string& error) {
-    applied.assign(splits.size(), 0);
-    impl_->splitHandle.assign(splits.size(), {});
-    try {
-        Cdt& cdt = impl_->cdt;
-        for (size_t k = 0; k < splits.size(); ++k) {
-            const ConstraintSplit& split = splits[k];
-            if (split.from >= impl_->inputHandle.size() || split.to >= impl_->inputHandle.size()) continue;
-            const Cdt::Vertex_handle va = impl_->inputHandle[split.from], vb = impl_->inputHandle[split.to];
-            Cdt::Face_handle face;
-            int index = 0;
-            // Only a segment that is still one constrained edge (not already split by another
-            // ring's vertex on it) is split here; the caller leaves the others as they are.
-            if (va == Cdt::Vertex_handle() || vb == Cdt::Vertex_handle() || !cdt.is_edge(va, vb, face, index) ||
-                !face->is_constrained(index))
-                continue;
-            cdt.remove_constrained_edge(face, index);
-            Cdt::Vertex_handle previous = va;
-            for (size_t i = 0; i + 1 < split.points.size(); i += 2) {
-                const Cdt::Vertex_handle v = cdt.insert(Point(split.points[i], split.points[i + 1]), va->face());
-                impl_->splitHandle[k].push_back(v);
-                insertConstraint(cdt, previous, v);
-                previous = v;
-            }
-            insertConstraint(cdt, previous, vb);
-            applied[k] = 1;
-        }
-    } catch (const std::exception& e) {
-        error = std::string("2D triangulation failed while adding points: ") + e.what();
-        return false;
+// Triangulation_2::side_of_oriented_circle(p0, p1, p2, p, perturb = true) of CGAL 5.5, the
+// test of every Delaunay flip CGAL's constrained Delaunay triangulation makes.
+int perturbedSideOfCircle2D(const double* a, const double* b, const double* c, const double* d) {
+    const Point p0(a[0], a[1]), p1(b[0], b[1]), p2(c[0], c[1]), p(d[0], d[1]);
+    const CGAL::Oriented_side side = Kernel().side_of_oriented_circle_2_object()(p0, p1, p2, p);
+    if (side != CGAL::ON_ORIENTED_BOUNDARY) return static_cast<int>(side);
+    // Symbolic perturbation: the points in lexicographic order, the leading monomials decide.
+    const Point* points[4] = {&p0, &p1, &p2, &p};
+    std::sort(points, points + 4, [](const Point* u, const Point* v) { return CGAL::compare_xy(*u, *v) == CGAL::SMALLER; });
+    for (int i = 3; i > 0; --i) {
+        if (points[i] == &p) return -1;
+        CGAL::Orientation o;
+        if (points[i] == &p2 && (o = CGAL::orientation(p0, p1, p)) != CGAL::COLLINEAR) return static_cast<int>(o);
+        if (points[i] == &p1 && (o = CGAL::orientation(p0, p, p2)) != CGAL::COLLINEAR) return static_cast<int>(o);
+        if (points[i] == &p0 && (o = CGAL::orientation(p, p1, p2)) != CGAL::COLLINEAR) return static_cast<int>(o);
     }
-    return true;
+    return -1;
 }
 
 }  // namespace aggrelod::detail

@@ -21,11 +21,20 @@ struct Triangulation2D {
     size_t faceCount() const { return faces.size() / 3; }
 };
 
-/// New vertices on one constraint segment of the build() input, from point `from` to `to`.
+/// New vertices on one constraint segment of the build() input, from point `from` to `to`
+/// (inserted by insertSplitPoints2D, steiner_2d.h).
 struct ConstraintSplit {
     size_t from = 0, to = 0;     ///< indices of build() input points
     std::vector<double> points;  ///< x y pairs, in order from `from` to `to`
 };
+
+/// CGAL's exact orientation of the triangle a b c (x y pairs): 1 counter-clockwise, -1
+/// clockwise, 0 collinear.
+int orientation2D(const double* a, const double* b, const double* c);
+
+/// CGAL's in-circle test with the symbolic perturbation its Delaunay flips use: 1 when p is
+/// inside the circle through the counter-clockwise triangle p0 p1 p2, -1 outside (never 0).
+int perturbedSideOfCircle2D(const double* p0, const double* p1, const double* p2, const double* p);
 
 /// A constrained Delaunay triangulation (CGAL's, hidden behind this class).
 class ConstrainedTriangulation2D {
@@ -42,20 +51,6 @@ public:
     /// threadCount: threads for the export (0 = all cores; same result for any count).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
                Triangulation2D& out, std::string& error, int threadCount = 0);
-
-    /// Splits constraint segments (DESIGN 2.4 step 4, Steiner points): each segment that is
-    /// still one constrained edge loses its constraint, gets its points inserted, and the
-    /// chain from -> points -> to becomes constrained, so the new vertices lie exactly on
-    /// constraints whatever the rounding of their coordinates. applied[k] says whether
-    /// splits[k] was done.
-    bool insertSplits(const std::vector<ConstraintSplit>& splits, std::vector<char>& applied, std::string& error);
-
-    /// Exports again after insertSplits(), numbering vertices by the new input: build() input
-    /// point i becomes input point newInputIndex[i], and the j-th point of splits[k] input
-    /// point splitFirstIndex[k] + j (splitFirstIndex[k] < 0: the split is not kept in the
-    /// numbering). inputCount: size of the new input.
-    bool exportTo(const std::vector<size_t>& newInputIndex, const std::vector<long long>& splitFirstIndex,
-                  size_t inputCount, Triangulation2D& out, std::string& error, int threadCount = 0);
 
 private:
     struct Impl;

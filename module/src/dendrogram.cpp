@@ -1,8 +1,11 @@
 // Kruskal dendrogram and level thresholds (DESIGN 2.3; paper Algorithm 1, Section 3.2).
 #include <aggrelod/dendrogram.h>
 
+#include "radix_sort.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <tuple>
 
@@ -16,14 +19,35 @@ struct DisjointSets {
         return x;
     }
 };
+
+// Sorts by (weight, a, b). Edges that already come in (a, b) order (the 2D graph's pairs do)
+// with non-negative weights take a stable LSD radix sort on the weight's bits (for such
+// doubles the bit patterns order as the values): a few linear passes instead of a
+// comparison sort of the whole graph.
+void sortByWeightThenIds(std::vector<GraphEdge>& edges) {
+    auto byIds = [](const GraphEdge& x, const GraphEdge& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); };
+    bool radix = edges.size() > 256 && std::is_sorted(edges.begin(), edges.end(), byIds);
+    for (size_t i = 0; i < edges.size() && radix; ++i)
+        radix = edges[i].weight >= 0 && !std::signbit(edges[i].weight) && std::isfinite(edges[i].weight);
+    if (!radix) {
+        std::sort(edges.begin(), edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
+            return std::tie(x.weight, x.a, x.b) < std::tie(y.weight, y.a, y.b);
+        });
+        return;
+    }
+    detail::radixSortStable(edges, [](const GraphEdge& e) {
+        uint64_t bits;
+        std::memcpy(&bits, &e.weight, sizeof bits);
+        return bits;
+    });
+}
+
 }  // namespace
 
 std::vector<Merge> kruskalMerges(size_t modelCount, std::vector<GraphEdge> edges) {
     for (GraphEdge& e : edges)
         if (e.a > e.b) std::swap(e.a, e.b);
-    std::sort(edges.begin(), edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
-        return std::tie(x.weight, x.a, x.b) < std::tie(y.weight, y.a, y.b);
-    });
+    sortByWeightThenIds(edges);
     DisjointSets sets(modelCount);
     std::vector<Merge> merges;
     for (const GraphEdge& e : edges) {

@@ -6,6 +6,7 @@
 #include "parallel_for.h"
 #include "polygon_check_2d.h"
 #include "sculpt_2d.h"
+#include "steiner_2d.h"
 
 #include <aggrelod/aggregate2d.h>
 #include <aggrelod/dendrogram.h>
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <future>
 #include <numeric>
 #include <string>
@@ -693,22 +695,30 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         requestSegment.push_back(v);
     }
     if (!requests.empty()) {
-        // The new vertices go into the live triangulation with their constraints split
-        // exactly; segments that cannot be split that way keep no new vertex.
-        // The input with the new vertices is prepared on another thread while CGAL inserts them.
-        std::vector<char> applied;
+        // The new vertices go into the exported triangulation, each splitting its constrained
+        // edge; a segment that cannot be split that way keeps fewer (or no) new vertices.
+        // The input with the new vertices is prepared on another thread meanwhile.
+        Triangulation2D tri = std::move(space.tri);
         space = FreeSpace2D{};
         InputVertices split;
         std::future<InputVertices> splitLater;
         if (settings.threadCount != 1)
             splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits); });
-        const bool inserted = triangulation.insertSplits(requests, applied, error);
+        std::vector<uint32_t> appliedCount;
+        std::vector<int> firstVertex;
+        bool inserted = true;
+        try {
+            insertSplitPoints2D(tri, requests, appliedCount, firstVertex);
+        } catch (const std::exception& e) {
+            inserted = false;
+            error = std::string("2D triangulation failed while adding points: ") + e.what();
+        }
         split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits);
         if (!inserted) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
-            if (!applied[k]) {
-                splits[requestSegment[k]].clear();
+            if (appliedCount[k] < splits[requestSegment[k]].size()) {
+                splits[requestSegment[k]].resize(appliedCount[k]);
                 allApplied = false;
             }
         // The new input numbering: every original vertex followed by its segment's new points.
@@ -720,9 +730,11 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         }
         std::vector<long long> splitFirstIndex(requests.size(), -1);
         for (size_t k = 0; k < requests.size(); ++k)
-            if (applied[k]) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
+            if (appliedCount[k] > 0) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
         in = allApplied ? std::move(split) : inputVertices(checked, splits);
-        if (!triangulation.exportTo(newInputIndex, splitFirstIndex, in.part.size(), space.tri, error, settings.threadCount)) return fail(error);
+        renumberAfterSplits2D(tri, newInputIndex, splitFirstIndex, appliedCount, firstVertex, in.part.size(),
+                              settings.threadCount);
+        space.tri = std::move(tri);
         setShared(in, space.tri);
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);

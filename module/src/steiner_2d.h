@@ -1,0 +1,48 @@
+// Steiner points on the constrained edges of a flat 2D constrained Delaunay triangulation
+// (DESIGN 2.4 step 4): the points the 2D pipeline adds at the shortest connection of every
+// merge, inserted into the exported triangulation instead of into CGAL's, so that the
+// triangulation is neither rebuilt nor exported twice. Also the canonical numbering that
+// every exported triangulation gets.
+#pragma once
+
+#include "cdt_2d.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace aggrelod::detail {
+
+/// Puts the faces of `tri` in canonical order, so that the numbering depends only on the
+/// triangulation, not on how it was built: each face's corners rotated to start at its
+/// smallest vertex (still counter-clockwise; neighbors and constrained rotate along), faces
+/// sorted by their sorted vertex triple, neighbour indices renumbered. threadCount: 0 = all
+/// cores; the result is the same for every count.
+void canonicalizeFaces2D(Triangulation2D& tri, int threadCount);
+
+/// Inserts the points of every split into `tri` (as build() exported it: vertexInput and
+/// inputVertex refer to build()'s input), each on the constrained edge from input point
+/// split.from to split.to, which becomes the constrained chain from -> points -> to.
+/// The triangulation stays constrained Delaunay: each point splits the edge's two faces
+/// (2 -> 4; on the convex hull, the faces CGAL would make) and Lawson flips with CGAL's
+/// in-circle test and its symbolic perturbation restore the Delaunay property, so the result
+/// is the triangulation CGAL builds for the same points and constraints. A point a rounding
+/// error off its segment is kept where it is: the chain bends by that error, as in CGAL.
+/// Only a segment that is still one constrained edge is split (not one already split by
+/// another ring's vertex); its points go in in order, and a point that would make a flat or
+/// inverted triangle (next to a sliver) ends that split. appliedCount[k]: how many points of
+/// splits[k] went in (a prefix). firstVertex[k]: the vertex of its first point; the others
+/// follow, consecutive. New vertices are appended with vertexInput -1; faces are changed in
+/// place or appended: call renumberAfterSplits2D() before reading the result.
+void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit>& splits,
+                         std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex);
+
+/// The numbering the export gives, after insertSplitPoints2D(): build() input point i becomes
+/// input point newInputIndex[i], point j of splits[k] input point splitFirstIndex[k] + j
+/// (j < appliedCount[k]). Vertices are numbered by their smallest input point, the
+/// intersection vertices CGAL made (vertexInput -1) after them in their old order; then
+/// canonicalizeFaces2D(). inputCount: the size of the new input.
+void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newInputIndex,
+                           const std::vector<long long>& splitFirstIndex, const std::vector<uint32_t>& appliedCount,
+                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount);
+
+}  // namespace aggrelod::detail
