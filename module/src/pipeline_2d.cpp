@@ -186,16 +186,11 @@ struct FreeSpaceModels {
     std::vector<char> partTouches;  // touches or overlaps a part of another feature
 };
 
-/// Stages 3-5 on the triangulation in space.tri: inside/outside, models, voids, model pairs.
-/// graphOnly: only what the dendrogram and the Steiner points need (models, pairs with their
-/// shortest connection, edge lengths); no voids, per-pair length statistics, edge pairs or
-/// model points (the pass before the Steiner points, whose result is replaced).
-/// withModelPoints: fill space.modelPoints (read only by the convex hulls).
-void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, FreeSpace2D& space,
-                    FreeSpaceModels& models, bool graphOnly, int threadCount, bool withModelPoints = false) {
-    const Triangulation2D& tri = space.tri;
-    const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
-
+/// Stage 3 on a triangulation of `in`: per face the winding number of the input rings (the
+/// number of polygons containing it), by a flood from the outside of the hull that counts
+/// the rings along each constrained edge it crosses.
+std::vector<int> windingNumbers(const InputVertices& in, const Triangulation2D& tri, int threadCount) {
+    const size_t faceCount = tri.faceCount();
     // 3. Inside / outside by winding count, flooding from the outside of the hull.
     std::vector<int> winding(faceCount, INT32_MIN);
     std::vector<std::tuple<size_t, int>> found;
@@ -260,6 +255,21 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, Fre
         }
         winding[f] = windingNumberAt(in, cx, cy);
     }
+    return winding;
+}
+
+/// Stages 4-5 on the triangulation in space.tri, given its windingNumbers(): models, voids, model pairs.
+/// graphOnly: only what the dendrogram and the Steiner points need (models, pairs with their
+/// shortest connection, edge lengths); no voids, per-pair length statistics, edge pairs or
+/// model points (the pass before the Steiner points, whose result is replaced).
+/// withModelPoints: fill space.modelPoints (read only by the convex hulls).
+void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, const std::vector<int>& winding,
+                    FreeSpace2D& space, FreeSpaceModels& models, bool graphOnly, int threadCount,
+                    bool withModelPoints = false) {
+    const Triangulation2D& tri = space.tri;
+    const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
+
+    const size_t faceBlocks = std::clamp<size_t>(faceCount / 8192, 1, 64);
     // Part of each vertex and of each interior face.
     std::vector<int> vertexPart(vertexCount, -1);
     for (size_t v = 0; v < vertexCount; ++v)
@@ -505,6 +515,12 @@ std::vector<GraphEdge> graphEdges(const FreeSpace2D& space) {
     return graph;
 }
 
+/// in.partTouches from checked.touchingParts.
+void markTouchingParts(InputVertices& in, const CheckedPolygons& checked) {
+    in.partTouches.assign(checked.parts.size(), 0);
+    for (auto [a, b] : checked.touchingParts) in.partTouches[a] = in.partTouches[b] = 1;
+}
+
 /// in.shared from the triangulation of `in`: input points sharing a vertex lie at the same place.
 void setShared(InputVertices& in, const Triangulation2D& tri) {
     std::vector<uint8_t> count(tri.vertexCount(), 0);
@@ -544,8 +560,7 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
             }
         }
     }
-    in.partTouches.assign(checked.parts.size(), 0);
-    for (auto [a, b] : checked.touchingParts) in.partTouches[a] = in.partTouches[b] = 1;
+    markTouchingParts(in, checked);
     if (withGrid) buildSegmentGrid(in);
     return in;
 }
@@ -631,26 +646,27 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     for (double d : settings.deltas)
         if (!std::isfinite(d) || d < 0) return fail("every threshold delta must be a finite number >= 0");
 
-    // 1. Input checks.
+    // 1. Input checks, in two steps: the rings are cleaned and oriented first; the contact
+    // checks (self-intersections, crossings, touching polygons) then run on another thread
+    // while CGAL triangulates the cleaned rings, followed there by the segment grid of the
+    // free-space pass (they touch different members of `in`). Only when the contact checks
+    // drop a polygon is the triangulation made again, without it.
     progress("checking input", 0);
     CheckedPolygons checked;
-    checkPolygons(features, checked, out.diagnostics);
-    if (checked.parts.empty()) return fail("no usable polygon in the input");
-    for (const Polygon2D& poly : checked.parts) {
-        out.originals.area += ringSignedArea(poly.exterior);
-        out.originals.perimeter += ringLength(poly.exterior);
-        for (const auto& hole : poly.holes) {
-            out.originals.area += ringSignedArea(hole);
-            out.originals.perimeter += ringLength(hole);
-        }
-    }
-    out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
-    // The segment grid (read by the free-space pass only) is built on another thread while
-    // CGAL triangulates; they touch different members.
+    PolygonCheckProgress checkProgress;
+    cleanPolygons(features, checked, out.diagnostics, checkProgress);
+    const size_t cleanedParts = checked.parts.size();
     InputVertices in = inputVertices(checked, {}, /*withGrid=*/false);
-    std::future<void> gridLater;
-    if (settings.threadCount != 1) gridLater = std::async(std::launch::async, [&] { buildSegmentGrid(in); });
-    else buildSegmentGrid(in);
+    std::vector<Diagnostic> contactDiagnostics;
+    auto checkContacts = [&] {
+        checkPolygonContacts(features, checked, contactDiagnostics, checkProgress);
+        if (checked.parts.size() != cleanedParts) return;  // `in` is made again below
+        markTouchingParts(in, checked);
+        buildSegmentGrid(in);
+    };
+    std::future<void> contactsLater;
+    if (settings.threadCount != 1 && cleanedParts > 0) contactsLater = std::async(std::launch::async, checkContacts);
+    else checkContacts();
     endStage("check input");
 
     const bool needHulls = settings.computeBaselines || settings.shape == Shape2D::ConvexHull;
@@ -662,11 +678,28 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    if (!triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount)) return fail(error);
+    bool triangulated = cleanedParts > 0 && triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount);
+    if (contactsLater.valid()) contactsLater.get();
+    out.diagnostics.insert(out.diagnostics.end(), contactDiagnostics.begin(), contactDiagnostics.end());
+    if (checked.parts.empty()) return fail("no usable polygon in the input");
+    if (checked.parts.size() != cleanedParts) {  // a polygon was dropped: triangulate without it
+        in = inputVertices(checked, {});
+        triangulated = triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount);
+    }
+    if (!triangulated) return fail(error);
+    for (const Polygon2D& poly : checked.parts) {
+        out.originals.area += ringSignedArea(poly.exterior);
+        out.originals.perimeter += ringLength(poly.exterior);
+        for (const auto& hole : poly.holes) {
+            out.originals.area += ringSignedArea(hole);
+            out.originals.perimeter += ringLength(hole);
+        }
+    }
+    out.originals.circularity = circularity(out.originals.area, out.originals.perimeter);
     setShared(in, space.tri);
-    if (gridLater.valid()) gridLater.get();
     endStage("triangulate");
-    buildFreeSpace(in, checked, space, models, /*graphOnly=*/true, settings.threadCount);
+    std::vector<int> winding = windingNumbers(in, space.tri, settings.threadCount);
+    buildFreeSpace(in, checked, winding, space, models, /*graphOnly=*/true, settings.threadCount);
     // Unconstrained edges of free triangles (hull edges included), before Steiner points:
     // the edges GEOS's ConcaveHullOfPolygons takes for its length ratio.
     out.freeEdgeMin = INFINITY;
@@ -703,17 +736,17 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         InputVertices split;
         std::future<InputVertices> splitLater;
         if (settings.threadCount != 1)
-            splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits); });
+            splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits, /*withGrid=*/false); });
         std::vector<uint32_t> appliedCount;
         std::vector<int> firstVertex;
         bool inserted = true;
         try {
-            insertSplitPoints2D(tri, requests, appliedCount, firstVertex);
+            insertSplitPoints2D(tri, requests, appliedCount, firstVertex, &winding);
         } catch (const std::exception& e) {
             inserted = false;
             error = std::string("2D triangulation failed while adding points: ") + e.what();
         }
-        split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits);
+        split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits, /*withGrid=*/false);
         if (!inserted) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
@@ -731,20 +764,20 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         std::vector<long long> splitFirstIndex(requests.size(), -1);
         for (size_t k = 0; k < requests.size(); ++k)
             if (appliedCount[k] > 0) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
-        in = allApplied ? std::move(split) : inputVertices(checked, splits);
+        in = allApplied ? std::move(split) : inputVertices(checked, splits, /*withGrid=*/false);
         renumberAfterSplits2D(tri, newInputIndex, splitFirstIndex, appliedCount, firstVertex, in.part.size(),
-                              settings.threadCount);
+                              settings.threadCount, &winding);
         space.tri = std::move(tri);
         setShared(in, space.tri);
         endStage("triangulate with Steiner points");
-        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
+        buildFreeSpace(in, checked, winding, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
         out.merges = kruskalMerges(space.modelCount, graphEdges(space));
         endStage("free space and graph again");
     } else {
         Triangulation2D tri = std::move(space.tri);
         space = FreeSpace2D{};
         space.tri = std::move(tri);  // no Steiner point: complete the graph-only pass
-        buildFreeSpace(in, checked, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
+        buildFreeSpace(in, checked, winding, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
         endStage("free space and graph again");
     }
     out.vertexCount = space.tri.vertexCount();

@@ -161,18 +161,17 @@ double ringLength(const std::vector<double>& ring) {
     return len;
 }
 
-void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
-                   std::vector<Diagnostic>& diagnostics) {
+void cleanPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out, std::vector<Diagnostic>& diagnostics,
+                   PolygonCheckProgress& progress) {
     out = CheckedPolygons{};
     out.featureAccepted.assign(features.size(), 0);
-    auto reject = [&](size_t f, const std::string& message) {
-        diagnostics.push_back({Diagnostic::Severity::Error, features[f].name, message + "; feature skipped"});
-    };
+    progress = PolygonCheckProgress{};
     // 1. Per ring: finite, >= 3 distinct vertices, non-zero area; orientation normalised.
     // A bad polygon of a multipolygon is dropped (warning); a feature left without polygons
     // is skipped (error). A degenerate hole is dropped (warning).
-    std::vector<uint32_t> partIndexInFeature;
-    std::vector<std::string> droppedParts(features.size());  // first problem, for the error message
+    std::vector<uint32_t>& partIndexInFeature = progress.partIndexInFeature;
+    std::vector<std::string>& droppedParts = progress.droppedParts;  // first problem, for the error message
+    droppedParts.assign(features.size(), {});
     auto warn = [&](size_t f, const std::string& message) {
         diagnostics.push_back({Diagnostic::Severity::Warning, features[f].name, message});
     };
@@ -212,7 +211,18 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
             partIndexInFeature.push_back(static_cast<uint32_t>(p));
         }
     }
+}
 
+void checkPolygonContacts(const std::vector<Feature2D>& features, CheckedPolygons& out,
+                          std::vector<Diagnostic>& diagnostics, PolygonCheckProgress& progress) {
+    const std::vector<uint32_t>& partIndexInFeature = progress.partIndexInFeature;
+    std::vector<std::string>& droppedParts = progress.droppedParts;
+    auto warn = [&](size_t f, const std::string& message) {
+        diagnostics.push_back({Diagnostic::Severity::Warning, features[f].name, message});
+    };
+    auto reject = [&](size_t f, const std::string& message) {
+        diagnostics.push_back({Diagnostic::Severity::Error, features[f].name, message + "; feature skipped"});
+    };
     // 2. Segments of every ring, into a grid.
     std::vector<Segment> segments;
     std::vector<std::pair<uint32_t, int>> ringOwner;  // global ring -> (part, hole index or -1)
@@ -354,6 +364,13 @@ void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
         if (newIndex[a] != UINT32_MAX && newIndex[b] != UINT32_MAX) out.touchingParts.emplace_back(newIndex[a], newIndex[b]);
     std::sort(out.touchingParts.begin(), out.touchingParts.end());
     out.touchingParts.erase(std::unique(out.touchingParts.begin(), out.touchingParts.end()), out.touchingParts.end());
+}
+
+void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
+                   std::vector<Diagnostic>& diagnostics) {
+    PolygonCheckProgress progress;
+    cleanPolygons(features, out, diagnostics, progress);
+    checkPolygonContacts(features, out, diagnostics, progress);
 }
 
 }  // namespace aggrelod::detail

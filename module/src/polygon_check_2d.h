@@ -5,6 +5,7 @@
 
 #include <aggrelod/aggregate2d.h>
 
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -18,9 +19,27 @@ struct CheckedPolygons {
 };
 
 /// Checks every feature; a feature with any bad ring is rejected as a whole (Error diagnostic
-/// naming the feature, polygon, ring and place). Deterministic.
+/// naming the feature, polygon, ring and place). Deterministic. The same as cleanPolygons()
+/// then checkPolygonContacts().
 void checkPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out,
                    std::vector<Diagnostic>& diagnostics);
+
+/// What the first step of the checks hands to the second.
+struct PolygonCheckProgress {
+    std::vector<uint32_t> partIndexInFeature;  ///< per part: its polygon's index in its feature
+    std::vector<std::string> droppedParts;     ///< per feature: first problem found, for the message
+};
+
+/// Step 1 (linear, cheap): every ring finite, >= 3 distinct vertices, non-zero area, repeated
+/// vertices removed, oriented; out.parts then holds every polygon whose rings are usable.
+void cleanPolygons(const std::vector<Feature2D>& features, CheckedPolygons& out, std::vector<Diagnostic>& diagnostics,
+                   PolygonCheckProgress& progress);
+
+/// Step 2: self-intersecting and crossing rings, holes outside their exterior (those polygons
+/// are dropped from out.parts) and touching or overlapping parts (out.touchingParts).
+/// Changes out.parts only when it drops a polygon.
+void checkPolygonContacts(const std::vector<Feature2D>& features, CheckedPolygons& out,
+                          std::vector<Diagnostic>& diagnostics, PolygonCheckProgress& progress);
 
 /// Signed area of an open ring (2 * n doubles), positive when counter-clockwise.
 double ringSignedArea(const std::vector<double>& ring);

@@ -13,7 +13,7 @@
 
 namespace aggrelod::detail {
 
-void canonicalizeFaces2D(Triangulation2D& tri, int threadCount) {
+void canonicalizeFaces2D(Triangulation2D& tri, int threadCount, std::vector<int>* faceValues) {
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
     std::vector<std::array<int, 3>> keys(faceCount);  // sorted vertex triple
     std::vector<uint8_t> rotation(faceCount);         // corner that comes first: the smallest
@@ -64,6 +64,11 @@ void canonicalizeFaces2D(Triangulation2D& tri, int threadCount) {
     tri.faces = std::move(faces);
     tri.neighbors = std::move(neighbors);
     tri.constrained = std::move(constrained);
+    if (faceValues) {
+        std::vector<int> values(faceCount);
+        for (size_t i = 0; i < faceCount; ++i) values[i] = (*faceValues)[sorted[i]];
+        *faceValues = std::move(values);
+    }
 }
 
 namespace {
@@ -71,7 +76,8 @@ namespace {
 /// The flat triangulation with a vertex -> incident face table, edited in place.
 class SplitMesh {
 public:
-    explicit SplitMesh(Triangulation2D& tri) : t_(tri), vertexFace_(tri.vertexCount(), -1) {
+    SplitMesh(Triangulation2D& tri, std::vector<int>* faceWinding)
+        : t_(tri), winding_(faceWinding), vertexFace_(tri.vertexCount(), -1) {
         for (size_t f = 0; f < tri.faceCount(); ++f)
             for (int k = 0; k < 3; ++k) vertexFace_[static_cast<size_t>(tri.faces[3 * f + k])] = static_cast<int>(f);
     }
@@ -98,7 +104,7 @@ public:
             if (side < 0 && (orientation2D(P(hullPredecessor(f, i)), P(ex), p) <= 0 ||
                              orientation2D(P(ey), P(hullSuccessor(f, i)), p) <= 0))
                 return -1;
-            if (side > 0) sliver = newFace();  // inside: CGAL keeps the hull edge and a flat face
+            if (side > 0) sliver = newFace(0);  // inside: CGAL keeps the hull edge and a flat face (outside the rings)
         }
         const int v = static_cast<int>(t_.vertexCount());
         t_.points.push_back(x);
@@ -108,8 +114,8 @@ public:
         // Old neighbours and constraints of the four outer edges.
         const int nX = neighbor(f, i + 1), nY = neighbor(f, i + 2);  // across (ey, c), (c, ex)
         const char cX = t_.constrained[3 * f + (i + 1) % 3], cY = t_.constrained[3 * f + (i + 2) % 3];
-        const int f1 = f, f2 = newFace();
-        const int outside1 = g >= 0 ? newFace() : sliver, outside2 = g >= 0 ? g : sliver;  // faces across (ex, v), (v, ey)
+        const int f1 = f, f2 = newFace(windingOf(f));
+        const int outside1 = g >= 0 ? newFace(windingOf(g)) : sliver, outside2 = g >= 0 ? g : sliver;  // faces across (ex, v), (v, ey)
         setFace(f1, {c, ex, v}, {outside1, f2, nY}, {1, 0, cY});
         setFace(f2, {c, v, ey}, {outside2, nX, f1}, {1, cX, 0});
         replaceNeighbor(nX, f, f2);
@@ -134,10 +140,12 @@ public:
 
 private:
     Triangulation2D& t_;
+    std::vector<int>* winding_;  // per face, or null
     std::vector<int> vertexFace_;
     std::vector<int> stack_;
 
     const double* P(int v) const { return &t_.points[2 * static_cast<size_t>(v)]; }
+    int windingOf(int f) const { return winding_ ? (*winding_)[static_cast<size_t>(f)] : 0; }
     int corner(int f, int k) const { return t_.faces[3 * static_cast<size_t>(f) + k % 3]; }
     int neighbor(int f, int k) const { return t_.neighbors[3 * static_cast<size_t>(f) + k % 3]; }
     int cornerOf(int f, int v) const {
@@ -150,7 +158,8 @@ private:
             if (corner(f, k) != a && corner(f, k) != b) return k;
         throw std::logic_error("2D Steiner insertion: degenerate face");
     }
-    int newFace() {
+    int newFace(int winding) {
+        if (winding_) winding_->push_back(winding);
         t_.faces.insert(t_.faces.end(), 3, -1);
         t_.neighbors.insert(t_.neighbors.end(), 3, -1);
         t_.constrained.insert(t_.constrained.end(), 3, 0);
@@ -248,7 +257,8 @@ private:
 }  // namespace
 
 void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit>& splits,
-                         std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex) {
+                         std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex,
+                         std::vector<int>* faceWinding) {
     appliedCount.assign(splits.size(), 0);
     firstVertex.assign(splits.size(), -1);
     size_t newPoints = 0;
@@ -258,7 +268,8 @@ void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit
     tri.faces.reserve(tri.faces.size() + 3 * 3 * newPoints);
     tri.neighbors.reserve(tri.neighbors.size() + 3 * 3 * newPoints);
     tri.constrained.reserve(tri.constrained.size() + 3 * 3 * newPoints);
-    SplitMesh mesh(tri);
+    if (faceWinding) faceWinding->reserve(faceWinding->size() + 3 * newPoints);
+    SplitMesh mesh(tri, faceWinding);
     for (size_t k = 0; k < splits.size(); ++k) {
         const ConstraintSplit& split = splits[k];
         if (split.from >= tri.inputVertex.size() || split.to >= tri.inputVertex.size()) continue;
@@ -277,7 +288,8 @@ void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit
 
 void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newInputIndex,
                            const std::vector<long long>& splitFirstIndex, const std::vector<uint32_t>& appliedCount,
-                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount) {
+                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount,
+                           std::vector<int>* faceValues) {
     const size_t vertexCount = tri.vertexCount();
     // Smallest new input point of every vertex (-1: an intersection vertex).
     std::vector<long long> input(vertexCount, -1);
@@ -315,7 +327,7 @@ void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newI
     tri.points = std::move(points);
     tri.vertexInput = std::move(vertexInput);
     tri.inputVertex = std::move(inputVertex);
-    canonicalizeFaces2D(tri, threadCount);
+    canonicalizeFaces2D(tri, threadCount, faceValues);
 }
 
 }  // namespace aggrelod::detail

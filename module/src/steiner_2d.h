@@ -16,8 +16,9 @@ namespace aggrelod::detail {
 /// triangulation, not on how it was built: each face's corners rotated to start at its
 /// smallest vertex (still counter-clockwise; neighbors and constrained rotate along), faces
 /// sorted by their sorted vertex triple, neighbour indices renumbered. threadCount: 0 = all
-/// cores; the result is the same for every count.
-void canonicalizeFaces2D(Triangulation2D& tri, int threadCount);
+/// cores; the result is the same for every count. faceValues (optional, one per face) are
+/// reordered along.
+void canonicalizeFaces2D(Triangulation2D& tri, int threadCount, std::vector<int>* faceValues = nullptr);
 
 /// Inserts the points of every split into `tri` (as build() exported it: vertexInput and
 /// inputVertex refer to build()'s input), each on the constrained edge from input point
@@ -33,16 +34,22 @@ void canonicalizeFaces2D(Triangulation2D& tri, int threadCount);
 /// splits[k] went in (a prefix). firstVertex[k]: the vertex of its first point; the others
 /// follow, consecutive. New vertices are appended with vertexInput -1; faces are changed in
 /// place or appended: call renumberAfterSplits2D() before reading the result.
+/// faceWinding (optional, one per face): winding numbers of the input rings, or any label
+/// that changes only across constrained edges; kept up to date (the pieces of a split face
+/// keep its value, a flip keeps its faces' common value, the flat face on a hull edge lies
+/// outside every ring: 0), so they need not be computed again.
 void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit>& splits,
-                         std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex);
+                         std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex,
+                         std::vector<int>* faceWinding = nullptr);
 
 /// The numbering the export gives, after insertSplitPoints2D(): build() input point i becomes
 /// input point newInputIndex[i], point j of splits[k] input point splitFirstIndex[k] + j
 /// (j < appliedCount[k]). Vertices are numbered by their smallest input point, the
 /// intersection vertices CGAL made (vertexInput -1) after them in their old order; then
-/// canonicalizeFaces2D(). inputCount: the size of the new input.
+/// canonicalizeFaces2D() (faceValues reordered along). inputCount: the size of the new input.
 void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newInputIndex,
                            const std::vector<long long>& splitFirstIndex, const std::vector<uint32_t>& appliedCount,
-                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount);
+                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount,
+                           std::vector<int>* faceValues = nullptr);
 
 }  // namespace aggrelod::detail
