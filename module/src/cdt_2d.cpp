@@ -65,21 +65,20 @@ ConstrainedTriangulation2D::~ConstrainedTriangulation2D() { delete impl_; }
 
 namespace {
 
-// Position of the cell (x, y) along the Hilbert curve through a 2^16 x 2^16 grid
-// (the classic xy -> d conversion, one quadrant per bit from the top).
+// Position of the cell (x, y) along the Hilbert curve through a 2^16 x 2^16 grid: the classic
+// xy -> d conversion (one quadrant per bit from the top; in the lower quadrants the rest is
+// mirrored and / or transposed), without branches.
 uint64_t hilbertIndex(uint32_t x, uint32_t y) {
-    constexpr uint32_t n = 1u << 16;
     uint64_t d = 0;
-    for (uint32_t s = n / 2; s > 0; s /= 2) {
-        const uint32_t rx = (x & s) ? 1 : 0, ry = (y & s) ? 1 : 0;
-        d += static_cast<uint64_t>(s) * s * ((3 * rx) ^ ry);
-        if (ry == 0) {
-            if (rx == 1) {
-                x = n - 1 - x;
-                y = n - 1 - y;
-            }
-            std::swap(x, y);
-        }
+    for (int bit = 15; bit >= 0; --bit) {
+        const uint32_t rx = (x >> bit) & 1, ry = (y >> bit) & 1;
+        d |= static_cast<uint64_t>((3 * rx) ^ ry) << (2 * bit);
+        const uint32_t mirror = (0u - (rx & (ry ^ 1))) & 0xffff;  // rx = 1, ry = 0
+        x ^= mirror;
+        y ^= mirror;
+        const uint32_t transpose = (0u - (ry ^ 1)) & (x ^ y);  // ry = 0
+        x ^= transpose;
+        y ^= transpose;
     }
     return d;
 }
