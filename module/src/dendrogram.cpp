@@ -20,42 +20,71 @@ struct DisjointSets {
     }
 };
 
-// Sorts by (weight, a, b). Edges that already come in (a, b) order (the 2D graph's pairs do)
-// with non-negative weights take a stable LSD radix sort on the weight's bits (for such
-// doubles the bit patterns order as the values): a few linear passes instead of a
-// comparison sort of the whole graph.
-void sortByWeightThenIds(std::vector<GraphEdge>& edges) {
-    auto byIds = [](const GraphEdge& x, const GraphEdge& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); };
+struct RankedEdge {
+    GraphEdge edge;
+    uint32_t index;  // in the caller's list
+};
+
+// Sorts by (weight, a, b, index). Edges that already come in (a, b) order (the 2D graph's
+// pairs do) with finite non-negative weights take a stable LSD radix sort on the weight: a
+// few linear passes instead of a comparison sort of the whole graph.
+void sortByWeightThenIds(std::vector<RankedEdge>& edges) {
+    auto byIds = [](const RankedEdge& x, const RankedEdge& y) {
+        return std::tie(x.edge.a, x.edge.b, x.index) < std::tie(y.edge.a, y.edge.b, y.index);
+    };
     bool radix = edges.size() > 256 && std::is_sorted(edges.begin(), edges.end(), byIds);
-    for (size_t i = 0; i < edges.size() && radix; ++i)
-        radix = edges[i].weight >= 0 && !std::signbit(edges[i].weight) && std::isfinite(edges[i].weight);
+    for (size_t i = 0; i < edges.size() && radix; ++i) {
+        const double w = edges[i].edge.weight;
+        radix = w >= 0 && !std::signbit(w) && std::isfinite(w);
+    }
     if (!radix) {
-        std::sort(edges.begin(), edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
-            return std::tie(x.weight, x.a, x.b) < std::tie(y.weight, y.a, y.b);
+        std::sort(edges.begin(), edges.end(), [](const RankedEdge& x, const RankedEdge& y) {
+            return std::tie(x.edge.weight, x.edge.a, x.edge.b, x.index) < std::tie(y.edge.weight, y.edge.a, y.edge.b, y.index);
         });
         return;
     }
-    detail::radixSortStable(edges, [](const GraphEdge& e) {
-        uint64_t bits;
-        std::memcpy(&bits, &e.weight, sizeof bits);
-        return bits;
-    });
+    // Three passes on the weight rounded to float (monotone for these doubles), then the few
+    // runs of equal floats sorted stably on the double itself.
+    detail::radixSortStable(
+        edges,
+        [](const RankedEdge& e) {
+            const float rounded = static_cast<float>(e.edge.weight);
+            uint32_t bits;
+            std::memcpy(&bits, &rounded, sizeof bits);
+            return static_cast<uint64_t>(bits);
+        },
+        32);
+    auto rounded = [&](size_t i) { return static_cast<float>(edges[i].edge.weight); };
+    for (size_t i = 0; i < edges.size();) {
+        size_t end = i + 1;
+        while (end < edges.size() && rounded(end) == rounded(i)) ++end;
+        if (end - i > 1)
+            std::stable_sort(edges.begin() + i, edges.begin() + end,
+                             [](const RankedEdge& x, const RankedEdge& y) { return x.edge.weight < y.edge.weight; });
+        i = end;
+    }
 }
 
 }  // namespace
 
-std::vector<Merge> kruskalMerges(size_t modelCount, std::vector<GraphEdge> edges) {
-    for (GraphEdge& e : edges)
-        if (e.a > e.b) std::swap(e.a, e.b);
-    sortByWeightThenIds(edges);
+std::vector<Merge> kruskalMerges(size_t modelCount, const std::vector<GraphEdge>& edges, std::vector<uint32_t>* mergeEdge) {
+    std::vector<RankedEdge> ranked(edges.size());
+    for (size_t i = 0; i < edges.size(); ++i) {
+        ranked[i] = {edges[i], static_cast<uint32_t>(i)};
+        if (ranked[i].edge.a > ranked[i].edge.b) std::swap(ranked[i].edge.a, ranked[i].edge.b);
+    }
+    sortByWeightThenIds(ranked);
     DisjointSets sets(modelCount);
     std::vector<Merge> merges;
-    for (const GraphEdge& e : edges) {
+    if (mergeEdge) mergeEdge->clear();
+    for (const RankedEdge& r : ranked) {
+        const GraphEdge& e = r.edge;
         if (e.a >= modelCount || e.b >= modelCount || e.a == e.b) continue;
         uint32_t ra = sets.find(e.a), rb = sets.find(e.b);
         if (ra == rb) continue;
         sets.parent[std::max(ra, rb)] = std::min(ra, rb);
         merges.push_back(Merge{e.weight, e.a, e.b});
+        if (mergeEdge) mergeEdge->push_back(r.index);
     }
     return merges;
 }

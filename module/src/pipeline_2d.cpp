@@ -270,16 +270,27 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
     const size_t faceBlocks = std::clamp<size_t>(faceCount / 8192, 1, 64);
-    // Part of each vertex and of each interior face.
+    // Part of each vertex and of each interior face (parallel blocks, each writing its own slots).
+    auto forBlocks = [&](size_t count, auto&& body) {
+        const size_t blocks = std::clamp<size_t>(count / 16384, 1, 64);
+        parallelFor(blocks, threadCount, [&](size_t block) {
+            for (size_t i = count * block / blocks; i < count * (block + 1) / blocks; ++i) body(i);
+        });
+    };
     std::vector<int> vertexPart(vertexCount, -1);
-    for (size_t v = 0; v < vertexCount; ++v)
+    forBlocks(vertexCount, [&](size_t v) {
         if (tri.vertexInput[v] >= 0) vertexPart[v] = static_cast<int>(in.part[tri.vertexInput[v]]);
+    });
     std::vector<int> facePart(faceCount, -1);
-    for (size_t f = 0; f < faceCount; ++f) {
-        if (winding[f] < 1) continue;
-        for (int k = 0; k < 3 && facePart[f] < 0; ++k) facePart[f] = vertexPart[tri.faces[3 * f + k]];
-    }
-    for (bool changed = true; changed;) {  // interior faces with only Steiner vertices
+    std::vector<char> unowned(faceBlocks, 0);  // per block: an interior face with only Steiner vertices
+    parallelFor(faceBlocks, threadCount, [&](size_t block) {
+        for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
+            if (winding[f] < 1) continue;
+            for (int k = 0; k < 3 && facePart[f] < 0; ++k) facePart[f] = vertexPart[tri.faces[3 * f + k]];
+            if (facePart[f] < 0) unowned[block] = 1;
+        }
+    });
+    for (bool changed = std::count(unowned.begin(), unowned.end(), 1) > 0; changed;) {  // take a neighbour's part
         changed = false;
         for (size_t f = 0; f < faceCount; ++f) {
             if (winding[f] < 1 || facePart[f] >= 0) continue;
@@ -302,18 +313,24 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
         if (checked.partFeature[p] == checked.partFeature[p - 1]) unite(parent, p, p - 1);
     std::vector<char>& partTouches = models.partTouches;
     partTouches.assign(partCount, 0);
-    for (auto [a, b] : checked.touchingParts) {
+    auto join = [&](uint32_t a, uint32_t b) {
         if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
         unite(parent, a, b);
-    }
-    for (size_t f = 0; f < faceCount; ++f)
-        for (int j = 0; j < 3; ++j) {
-            const int n = tri.neighbors[3 * f + j];
-            if (n < 0 || facePart[f] < 0 || facePart[n] < 0 || facePart[f] == facePart[n]) continue;
-            const uint32_t a = facePart[f], b = facePart[n];
-            if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
-            unite(parent, a, b);
-        }
+    };
+    for (auto [a, b] : checked.touchingParts) join(a, b);
+    // Interior faces of two parts side by side (found in parallel, joined in block order; the
+    // models do not depend on the order).
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> adjacentParts(faceBlocks);
+    parallelFor(faceBlocks, threadCount, [&](size_t block) {
+        for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f)
+            for (int j = 0; j < 3; ++j) {
+                const int n = tri.neighbors[3 * f + j];
+                if (n < 0 || facePart[f] < 0 || facePart[n] < 0 || facePart[f] == facePart[n]) continue;
+                adjacentParts[block].emplace_back(facePart[f], facePart[n]);
+            }
+    });
+    for (const auto& list : adjacentParts)
+        for (auto [a, b] : list) join(a, b);
     std::vector<int>& partModel = models.partModel;
     std::vector<int> modelOfRoot(partCount, -1);
     partModel.assign(partCount, -1);
@@ -323,13 +340,17 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
         partModel[p] = modelOfRoot[r];
     }
     space.vertexModel.assign(vertexCount, -1);
-    for (size_t v = 0; v < vertexCount; ++v)
+    forBlocks(vertexCount, [&](size_t v) {
         if (vertexPart[v] >= 0) space.vertexModel[v] = partModel[vertexPart[v]];
-    space.cornerModel.resize(3 * faceCount);
-    for (size_t c = 0; c < 3 * faceCount; ++c) space.cornerModel[c] = space.vertexModel[tri.faces[c]];
+    });
     space.faceModel.assign(faceCount, -1);
-    for (size_t f = 0; f < faceCount; ++f)
+    forBlocks(faceCount, [&](size_t f) {
         if (winding[f] >= 1) space.faceModel[f] = facePart[f] >= 0 ? partModel[facePart[f]] : 0;
+    });
+    if (!graphOnly) {  // read by every level
+        space.cornerModel.resize(3 * faceCount);
+        forBlocks(3 * faceCount, [&](size_t c) { space.cornerModel[c] = space.vertexModel[tri.faces[c]]; });
+    }
     if (withModelPoints) space.modelPoints.resize(space.modelCount);
     for (size_t v = 0; v < in.part.size() && withModelPoints; ++v) {
         auto& pts = space.modelPoints[partModel[in.part[v]]];
@@ -339,8 +360,11 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
 
     // Voids: free faces not reachable from the hull through free faces (input holes, or
     // gaps enclosed by touching polygons) and owned by one model only: never filled.
+    // Without holes and touching polygons the free space is connected: no voids.
     space.faceVoid.assign(faceCount, 0);
-    if (!graphOnly) {
+    bool voidsPossible = !checked.touchingParts.empty();
+    for (const Polygon2D& poly : checked.parts) voidsPossible = voidsPossible || !poly.holes.empty();
+    if (!graphOnly && voidsPossible) {
         std::vector<char> reached(faceCount, 0);
         std::vector<int> stack;
         for (size_t f = 0; f < faceCount; ++f)
@@ -591,10 +615,19 @@ void setShared(InputVertices& in, const Triangulation2D& tri) {
     for (size_t i = 0; i < in.shared.size(); ++i) in.shared[i] = count[tri.inputVertex[i]] > 1;
 }
 
-/// Input vertices of the checked polygons (in.shared is set by setShared); splits[s] lists parameters in (0, 1) at which the
-/// ring segment starting at original vertex s gets an extra (collinear) vertex.
-InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<std::vector<double>>& splits,
-                            bool withGrid = true) {
+/// Steiner points on the ring segments, flat: the segment starting at original input vertex s
+/// gets an extra (collinear) vertex at each parameter of t[first[s], first[s] + count[s]),
+/// ascending, in (0, 1).
+struct SegmentSplits {
+    std::vector<uint32_t> first, count;
+    std::vector<double> t;
+    size_t size(size_t s) const { return s < count.size() ? count[s] : 0; }
+    const double* at(size_t s) const { return t.data() + first[s]; }
+};
+
+/// Input vertices of the checked polygons (in.shared is set by setShared), with the Steiner
+/// points of `splits` (optional) after their segment's start.
+InputVertices inputVertices(const CheckedPolygons& checked, const SegmentSplits* splits, bool withGrid = true) {
     InputVertices in;
     size_t original = 0;
     for (uint32_t p = 0; p < checked.parts.size(); ++p) {
@@ -607,12 +640,12 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
                 in.points.push_back(ring[2 * i]);
                 in.points.push_back(ring[2 * i + 1]);
                 in.part.push_back(p);
-                if (original < splits.size())
-                    for (double t : splits[original]) {
-                        in.points.push_back(ring[2 * i] + t * (ring[2 * j] - ring[2 * i]));
-                        in.points.push_back(ring[2 * i + 1] + t * (ring[2 * j + 1] - ring[2 * i + 1]));
-                        in.part.push_back(p);
-                    }
+                for (size_t k = 0, count = splits ? splits->size(original) : 0; k < count; ++k) {
+                    const double t = splits->at(original)[k];
+                    in.points.push_back(ring[2 * i] + t * (ring[2 * j] - ring[2 * i]));
+                    in.points.push_back(ring[2 * i + 1] + t * (ring[2 * j + 1] - ring[2 * i + 1]));
+                    in.part.push_back(p);
+                }
             }
             const uint32_t size = static_cast<uint32_t>(in.part.size()) - start;
             for (uint32_t i = 0; i < size; ++i) {
@@ -630,13 +663,14 @@ InputVertices inputVertices(const CheckedPolygons& checked, const std::vector<st
 /// Steiner points for the shortest connection of every merge (DESIGN 2.4 step 4): where a
 /// connection ends at a vertex, its boundary edges longer than 3 d get a point at distance d
 /// (d = the connection's length); where it ends inside an edge, the edge gets the foot point
-/// and points d to either side. Returns, per original input vertex, the split parameters of
-/// the segment it starts (ascending). Only called on the unsplit input.
-std::vector<std::vector<double>> connectionSplits(const InputVertices& in, const FreeSpace2D& space,
-                                                  const std::vector<Merge>& merges) {
-    std::vector<std::vector<double>> splits(in.part.size());
+/// and points d to either side. mergePair: per merge, its index in space.pairs. Only called
+/// on the unsplit input.
+SegmentSplits connectionSplits(const InputVertices& in, const FreeSpace2D& space, const std::vector<Merge>& merges,
+                               const std::vector<uint32_t>& mergePair) {
+    std::vector<std::pair<uint32_t, double>> found;  // (segment, parameter)
+    found.reserve(2 * merges.size());
     const Triangulation2D& tri = space.tri;
-    auto addAt = [&](size_t segmentStart, double t) { splits[segmentStart].push_back(t); };
+    auto addAt = [&](size_t segmentStart, double t) { found.emplace_back(static_cast<uint32_t>(segmentStart), t); };
     auto segmentLength = [&](size_t s) { return std::hypot(in.x(in.next(s)) - in.x(s), in.y(in.next(s)) - in.y(s)); };
     // Split both boundary edges at vertex v (input vertex) at distance d from it.
     auto splitAroundVertex = [&](size_t v, double d) {
@@ -645,10 +679,8 @@ std::vector<std::vector<double>> connectionSplits(const InputVertices& in, const
         if (lOut > 3 * d) addAt(v, d / lOut);
         if (lIn > 3 * d) addAt(prev, 1 - d / lIn);
     };
-    for (const Merge& m : merges) {
-        const int pi = space.pairIndex(m.modelA, m.modelB);
-        if (pi < 0) continue;
-        const ModelPair2D& pair = space.pairs[pi];
+    for (size_t k = 0; k < merges.size(); ++k) {
+        const ModelPair2D& pair = space.pairs[mergePair[k]];
         const double d = pair.minDistance;
         if (!(d > 0)) continue;
         const int* c = pair.connection;
@@ -675,14 +707,24 @@ std::vector<std::vector<double>> connectionSplits(const InputVertices& in, const
         for (double u : {t - d / len, t, t + d / len})
             if (u > margin && u < 1 - margin) addAt(s, u);
     }
-    for (auto& list : splits) {
-        if (list.size() < 2) continue;
-        std::sort(list.begin(), list.end());
-        // Drop near-duplicates (two connections at one place), in place.
-        size_t kept = 1;
-        for (size_t i = 1; i < list.size(); ++i)
+    // By segment (counting sort), each segment's parameters ascending without near-duplicates
+    // (two connections at one place).
+    SegmentSplits splits;
+    const size_t segmentCount = in.part.size();
+    splits.first.assign(segmentCount + 1, 0);
+    splits.count.assign(segmentCount, 0);
+    for (const auto& [segment, t] : found) ++splits.first[segment + 1];
+    for (size_t v = 0; v < segmentCount; ++v) splits.first[v + 1] += splits.first[v];
+    splits.t.resize(found.size());
+    for (const auto& [segment, t] : found) splits.t[splits.first[segment] + splits.count[segment]++] = t;
+    for (size_t v = 0; v < segmentCount; ++v) {
+        if (splits.count[v] < 2) continue;
+        double* list = splits.t.data() + splits.first[v];
+        std::sort(list, list + splits.count[v]);
+        uint32_t kept = 1;
+        for (uint32_t i = 1; i < splits.count[v]; ++i)
             if (list[i] - list[kept - 1] > 1e-6) list[kept++] = list[i];
-        list.resize(kept);
+        splits.count[v] = kept;
     }
     return splits;
 }
@@ -718,7 +760,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     PolygonCheckProgress checkProgress;
     cleanPolygons(features, checked, out.diagnostics, checkProgress);
     const size_t cleanedParts = checked.parts.size();
-    InputVertices in = inputVertices(checked, {}, /*withGrid=*/false);
+    InputVertices in = inputVertices(checked, nullptr, /*withGrid=*/false);
     std::vector<Diagnostic> contactDiagnostics;
     auto checkContacts = [&] {
         checkPolygonContacts(features, checked, contactDiagnostics, checkProgress);
@@ -745,7 +787,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     out.diagnostics.insert(out.diagnostics.end(), contactDiagnostics.begin(), contactDiagnostics.end());
     if (checked.parts.empty()) return fail("no usable polygon in the input");
     if (checked.parts.size() != cleanedParts) {  // a polygon was dropped: triangulate without it
-        in = inputVertices(checked, {});
+        in = inputVertices(checked, nullptr);
         triangulated = triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount);
     }
     if (!triangulated) return fail(error);
@@ -772,17 +814,20 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             out.freeEdgeMax = std::max(out.freeEdgeMax, space.edgeLength[3 * f + j]);
         }
     if (!std::isfinite(out.freeEdgeMin)) out.freeEdgeMin = 0;
-    out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+    std::vector<uint32_t> mergePair;  // per merge: its index in space.pairs
+    out.merges = kruskalMerges(space.modelCount, graphEdges(space), &mergePair);
     endStage("free space and graph");
-    std::vector<std::vector<double>> splits = connectionSplits(in, space, out.merges);
+    SegmentSplits splits = connectionSplits(in, space, out.merges, mergePair);
     std::vector<ConstraintSplit> requests;
     std::vector<size_t> requestSegment;
-    for (size_t v = 0; v < splits.size(); ++v) {
-        if (splits[v].empty()) continue;
+    for (size_t v = 0; v < in.part.size(); ++v) {
+        if (splits.size(v) == 0) continue;
         ConstraintSplit r;
         r.from = v;
         r.to = in.next(v);
-        for (double t : splits[v]) {  // the same arithmetic as inputVertices()
+        r.points.reserve(2 * splits.size(v));
+        for (size_t k = 0; k < splits.size(v); ++k) {  // the same arithmetic as inputVertices()
+            const double t = splits.at(v)[k];
             r.points.push_back(in.x(v) + t * (in.x(r.to) - in.x(v)));
             r.points.push_back(in.y(v) + t * (in.y(r.to) - in.y(v)));
         }
@@ -798,7 +843,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         InputVertices split;
         std::future<InputVertices> splitLater;
         if (settings.threadCount != 1)
-            splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, splits, /*withGrid=*/false); });
+            splitLater = std::async(std::launch::async, [&] { return inputVertices(checked, &splits, /*withGrid=*/false); });
         std::vector<uint32_t> appliedCount;
         std::vector<int> firstVertex;
         bool inserted = true;
@@ -808,12 +853,12 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             inserted = false;
             error = std::string("2D triangulation failed while adding points: ") + e.what();
         }
-        split = splitLater.valid() ? splitLater.get() : inputVertices(checked, splits, /*withGrid=*/false);
+        split = splitLater.valid() ? splitLater.get() : inputVertices(checked, &splits, /*withGrid=*/false);
         if (!inserted) return fail(error);
         bool allApplied = true;
         for (size_t k = 0; k < requests.size(); ++k)
-            if (appliedCount[k] < splits[requestSegment[k]].size()) {
-                splits[requestSegment[k]].resize(appliedCount[k]);
+            if (appliedCount[k] < splits.size(requestSegment[k])) {
+                splits.count[requestSegment[k]] = appliedCount[k];
                 allApplied = false;
             }
         // The new input numbering: every original vertex followed by its segment's new points.
@@ -821,19 +866,19 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         std::vector<size_t> newInputIndex(originalCount);
         for (size_t v = 0, next = 0; v < originalCount; ++v) {
             newInputIndex[v] = next;
-            next += 1 + splits[v].size();
+            next += 1 + splits.size(v);
         }
         std::vector<long long> splitFirstIndex(requests.size(), -1);
         for (size_t k = 0; k < requests.size(); ++k)
             if (appliedCount[k] > 0) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
-        in = allApplied ? std::move(split) : inputVertices(checked, splits, /*withGrid=*/false);
+        in = allApplied ? std::move(split) : inputVertices(checked, &splits, /*withGrid=*/false);
         renumberAfterSplits2D(tri, newInputIndex, splitFirstIndex, appliedCount, firstVertex, in.part.size(),
                               settings.threadCount, &winding);
         space.tri = std::move(tri);
         setShared(in, space.tri);
         endStage("triangulate with Steiner points");
         buildFreeSpace(in, checked, winding, space, models, /*graphOnly=*/false, settings.threadCount, needHulls);
-        out.merges = kruskalMerges(space.modelCount, graphEdges(space));
+        out.merges = kruskalMerges(space.modelCount, graphEdges(space), &mergePair);
         endStage("free space and graph again");
     } else {
         Triangulation2D tri = std::move(space.tri);
@@ -872,10 +917,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
                                                               : makeAggregateFunction(settings.function);
     const AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
-    std::vector<int> mergePair;  // per merge: its index in space.pairs
-    for (const Merge& m : out.merges) mergePair.push_back(space.pairIndex(m.modelA, m.modelB));
     const ConnectionFans2D fans = settings.shape == Shape2D::Sculpted || settings.computeBaselines
-                                      ? computeConnectionFans2D(space, mergePair, settings.threadCount)
+                                      ? computeConnectionFans2D(space, std::vector<int>(mergePair.begin(), mergePair.end()), settings.threadCount)
                                       : ConnectionFans2D{};
     // F of every pair at every level: a custom function (user code) on the calling thread, the
     // built-in ones inside the parallel level loop below.

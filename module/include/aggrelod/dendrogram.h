@@ -15,9 +15,11 @@ struct GraphEdge {
     double weight = 0;  ///< distance between the models, world units
 };
 
-/// Kruskal merges: edges sorted by (weight, smaller id, larger id), merged with union-find.
-/// Returns the dendrogram's merges in ascending height (at most modelCount - 1).
-std::vector<Merge> kruskalMerges(size_t modelCount, std::vector<GraphEdge> edges);
+/// Kruskal merges: edges sorted by (weight, smaller id, larger id, position in `edges`),
+/// merged with union-find. Returns the dendrogram's merges in ascending height (at most
+/// modelCount - 1). mergeEdge (optional): per merge, the index into `edges` of its edge.
+std::vector<Merge> kruskalMerges(size_t modelCount, const std::vector<GraphEdge>& edges,
+                                 std::vector<uint32_t>* mergeEdge = nullptr);
 
 /// Groups at threshold delta: models joined by merges with height < delta.
 /// Returns, per model, its group index; groups are numbered 0.. in order of their smallest model.
