@@ -872,8 +872,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         for (size_t k = 0; k < requests.size(); ++k)
             if (appliedCount[k] > 0) splitFirstIndex[k] = static_cast<long long>(newInputIndex[requestSegment[k]] + 1);
         in = allApplied ? std::move(split) : inputVertices(checked, &splits, /*withGrid=*/false);
-        renumberAfterSplits2D(tri, newInputIndex, splitFirstIndex, appliedCount, firstVertex, in.part.size(),
-                              settings.threadCount, &winding);
+        renumberAfterSplits2D(tri, newInputIndex, splitFirstIndex, appliedCount, firstVertex, in.part.size());
         space.tri = std::move(tri);
         setShared(in, space.tri);
         endStage("triangulate with Steiner points");

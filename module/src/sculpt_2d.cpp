@@ -66,6 +66,8 @@ EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const A
         stats(pair.lengthCount, meanAll, in.sigmaAllEdges);
         limits.pair[p] = function(in);
     }
+    limits.smallest = std::min(limits.sameModel, limits.unpaired);
+    for (double limit : limits.pair) limits.smallest = std::min(limits.smallest, limit);
     return limits;
 }
 
@@ -157,11 +159,15 @@ struct Sculptor2D {
         return false;
     }
 
+    // Only a face with an edge longer than the level's smallest limit can ever be carved: the
+    // others are left off the stack (carving is monotone, so this changes nothing).
+    bool mayCarve(int f) const { return space.faceLongest[f] > limits.smallest; }
+
     void carve() {
         const size_t faceCount = tri().faceCount();
         std::vector<int> stack;
         for (size_t f = 0; f < faceCount; ++f)
-            if (space.faceModel[f] < 0 && label[f] >= 0) stack.push_back(static_cast<int>(f));
+            if (space.faceModel[f] < 0 && label[f] >= 0 && mayCarve(static_cast<int>(f))) stack.push_back(static_cast<int>(f));
         while (!stack.empty()) {
             const int f = stack.back();
             stack.pop_back();
@@ -170,7 +176,7 @@ struct Sculptor2D {
             label[f] = -1;
             for (int j = 0; j < 3; ++j) {
                 const int n = tri().neighbors[3 * f + j];
-                if (isKeptFree(n, group)) stack.push_back(n);
+                if (isKeptFree(n, group) && mayCarve(n)) stack.push_back(n);
             }
         }
     }

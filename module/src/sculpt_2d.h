@@ -14,6 +14,7 @@ struct EdgeLimits2D {
     double unpaired = 0;       ///< F for an edge with a Steiner end
     double delta = 0;          ///< the level threshold
     std::vector<double> pair;  ///< per FreeSpace2D::pairs entry
+    double smallest = 0;       ///< the least of all these limits: no face whose edges are all this short is carved
 };
 
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function);

@@ -295,8 +295,7 @@ void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit
 
 void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newInputIndex,
                            const std::vector<long long>& splitFirstIndex, const std::vector<uint32_t>& appliedCount,
-                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount,
-                           std::vector<int>* faceValues) {
+                           const std::vector<int>& firstVertex, size_t inputCount) {
     const size_t vertexCount = tri.vertexCount();
     // Smallest new input point of every vertex (-1: an intersection vertex).
     std::vector<long long> input(vertexCount, -1);
@@ -334,7 +333,6 @@ void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newI
     tri.points = std::move(points);
     tri.vertexInput = std::move(vertexInput);
     tri.inputVertex = std::move(inputVertex);
-    canonicalizeFaces2D(tri, threadCount, faceValues);
 }
 
 }  // namespace aggrelod::detail

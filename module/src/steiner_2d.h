@@ -42,14 +42,15 @@ void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit
                          std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex,
                          std::vector<int>* faceWinding = nullptr);
 
-/// The numbering the export gives, after insertSplitPoints2D(): build() input point i becomes
-/// input point newInputIndex[i], point j of splits[k] input point splitFirstIndex[k] + j
-/// (j < appliedCount[k]). Vertices are numbered by their smallest input point, the
-/// intersection vertices CGAL made (vertexInput -1) after them in their old order; then
-/// canonicalizeFaces2D() (faceValues reordered along). inputCount: the size of the new input.
+/// Vertex numbering after insertSplitPoints2D(), as the export numbers vertices: build()
+/// input point i becomes input point newInputIndex[i], point j of splits[k] input point
+/// splitFirstIndex[k] + j (j < appliedCount[k]); vertices are numbered by their smallest
+/// input point, the intersection vertices CGAL made (vertexInput -1) after them in their old
+/// order. Faces keep their order (the insertion is deterministic, so that order is too);
+/// canonicalizeFaces2D() gives the order a fresh export would have. inputCount: the size of
+/// the new input.
 void renumberAfterSplits2D(Triangulation2D& tri, const std::vector<size_t>& newInputIndex,
                            const std::vector<long long>& splitFirstIndex, const std::vector<uint32_t>& appliedCount,
-                           const std::vector<int>& firstVertex, size_t inputCount, int threadCount,
-                           std::vector<int>* faceValues = nullptr);
+                           const std::vector<int>& firstVertex, size_t inputCount);
 
 }  // namespace aggrelod::detail
