@@ -216,13 +216,13 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
     return true;
 }
 
-int orientation2D(const double* a, const double* b, const double* c) {
+int exactOrientation2D(const double* a, const double* b, const double* c) {
     return static_cast<int>(CGAL::orientation(Point(a[0], a[1]), Point(b[0], b[1]), Point(c[0], c[1])));
 }
 
 // Triangulation_2::side_of_oriented_circle(p0, p1, p2, p, perturb = true) of CGAL 5.5, the
 // test of every Delaunay flip CGAL's constrained Delaunay triangulation makes.
-int perturbedSideOfCircle2D(const double* a, const double* b, const double* c, const double* d) {
+int exactPerturbedSideOfCircle2D(const double* a, const double* b, const double* c, const double* d) {
     const Point p0(a[0], a[1]), p1(b[0], b[1]), p2(c[0], c[1]), p(d[0], d[1]);
     const CGAL::Oriented_side side = Kernel().side_of_oriented_circle_2_object()(p0, p1, p2, p);
     if (side != CGAL::ON_ORIENTED_BOUNDARY) return static_cast<int>(side);

@@ -2,6 +2,7 @@
 // (DESIGN 2.1, 2D; paper Section 3.1). The only place that knows CGAL's 2D triangulation.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <utility>
@@ -30,11 +31,43 @@ struct ConstraintSplit {
 
 /// CGAL's exact orientation of the triangle a b c (x y pairs): 1 counter-clockwise, -1
 /// clockwise, 0 collinear.
-int orientation2D(const double* a, const double* b, const double* c);
+int exactOrientation2D(const double* a, const double* b, const double* c);
 
 /// CGAL's in-circle test with the symbolic perturbation its Delaunay flips use: 1 when p is
 /// inside the circle through the counter-clockwise triangle p0 p1 p2, -1 outside (never 0).
-int perturbedSideOfCircle2D(const double* p0, const double* p1, const double* p2, const double* p);
+int exactPerturbedSideOfCircle2D(const double* p0, const double* p1, const double* p2, const double* p);
+
+/// The same as exactOrientation2D: the determinant in doubles when its sign is certain (the
+/// error bound of Shewchuk's orient2d, "Adaptive Precision Floating-Point Arithmetic and Fast
+/// Robust Geometric Predicates", 1997), else the exact predicate.
+inline int orientation2D(const double* a, const double* b, const double* c) {
+    constexpr double epsilon = 0x1p-53;
+    constexpr double bound = (3.0 + 16.0 * epsilon) * epsilon;
+    const double left = (b[0] - a[0]) * (c[1] - a[1]), right = (b[1] - a[1]) * (c[0] - a[0]);
+    const double det = left - right, error = bound * (std::fabs(left) + std::fabs(right));
+    if (det > error) return 1;
+    if (det < -error) return -1;
+    return exactOrientation2D(a, b, c);
+}
+
+/// The same as exactPerturbedSideOfCircle2D: the determinant in doubles when its sign is
+/// certain (Shewchuk's incircle error bound), else the exact, perturbed predicate.
+inline int perturbedSideOfCircle2D(const double* a, const double* b, const double* c, const double* d) {
+    constexpr double epsilon = 0x1p-53;
+    constexpr double bound = (10.0 + 96.0 * epsilon) * epsilon;
+    const double adx = a[0] - d[0], ady = a[1] - d[1], bdx = b[0] - d[0], bdy = b[1] - d[1];
+    const double cdx = c[0] - d[0], cdy = c[1] - d[1];
+    const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy, cdxady = cdx * ady;
+    const double adxcdy = adx * cdy, adxbdy = adx * bdy, bdxady = bdx * ady;
+    const double alift = adx * adx + ady * ady, blift = bdx * bdx + bdy * bdy, clift = cdx * cdx + cdy * cdy;
+    const double det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady);
+    const double permanent = (std::fabs(bdxcdy) + std::fabs(cdxbdy)) * alift + (std::fabs(cdxady) + std::fabs(adxcdy)) * blift +
+                             (std::fabs(adxbdy) + std::fabs(bdxady)) * clift;
+    const double error = bound * permanent;
+    if (det > error) return 1;
+    if (det < -error) return -1;
+    return exactPerturbedSideOfCircle2D(a, b, c, d);
+}
 
 /// A constrained Delaunay triangulation (CGAL's, hidden behind this class).
 class ConstrainedTriangulation2D {

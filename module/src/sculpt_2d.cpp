@@ -313,11 +313,16 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
         std::vector<HalfEdge> bucketed(edges.size());
         std::vector<uint32_t> fill(start.begin(), start.end() - 1);
         for (const HalfEdge& e : edges) bucketed[fill[e.group]++] = e;
-        for (size_t g = 0; g < groupCount; ++g)
-            std::sort(bucketed.begin() + start[g], bucketed.begin() + start[g + 1], [](const HalfEdge& a, const HalfEdge& b) {
-                if (a.from != b.from) return a.from < b.from;
-                return a.to < b.to;
-            });
+        auto less = [](const HalfEdge& a, const HalfEdge& b) { return a.from != b.from ? a.from < b.from : a.to < b.to; };
+        for (size_t g = 0; g < groupCount; ++g) {
+            const auto first = bucketed.begin() + start[g], last = bucketed.begin() + start[g + 1];
+            if (last - first > 32) {
+                std::sort(first, last, less);
+                continue;
+            }
+            for (auto i = first + (first != last); i < last; ++i)  // the usual case: a few edges
+                for (auto j = i; j > first && less(*j, *(j - 1)); --j) std::iter_swap(j - 1, j);
+        }
         edges = std::move(bucketed);
     }
     // Face components (edge-connected kept faces of one group): holes join the exterior of
@@ -351,17 +356,22 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
     size_t groupBegin = 0;
     std::vector<size_t> trace, stack, polygonComponent, exteriorLoop;
     std::vector<size_t> stackPos(tri.vertexCount(), SIZE_MAX);  // per vertex: its place on the stack
+    std::vector<size_t> firstOut(tri.vertexCount(), SIZE_MAX);   // per vertex: its first edge in the current group
     while (groupBegin < edges.size()) {
         const int g = edges[groupBegin].group;
         size_t groupEnd = groupBegin;
         while (groupEnd < edges.size() && edges[groupEnd].group == g) ++groupEnd;
+        for (size_t i = groupBegin; i < groupEnd; ++i)
+            if (i == groupBegin || edges[i].from != edges[i - 1].from) firstOut[static_cast<size_t>(edges[i].from)] = i;
         loops.clear();
+        // The group's edges leaving v: a run of the sorted edges (empty when there is none;
+        // firstOut entries left from earlier groups lie before this group's range).
         auto outgoing = [&](int v) {
-            auto lo = std::lower_bound(edges.begin() + groupBegin, edges.begin() + groupEnd, v,
-                                       [](const HalfEdge& e, int x) { return e.from < x; });
-            auto hi = lo;
-            while (hi != edges.begin() + groupEnd && hi->from == v) ++hi;
-            return std::make_pair(static_cast<size_t>(lo - edges.begin()), static_cast<size_t>(hi - edges.begin()));
+            const size_t lo = firstOut[static_cast<size_t>(v)];
+            if (lo < groupBegin || lo >= groupEnd || edges[lo].from != v) return std::make_pair(groupEnd, groupEnd);
+            size_t hi = lo + 1;
+            while (hi < groupEnd && edges[hi].from == v) ++hi;
+            return std::make_pair(lo, hi);
         };
         for (size_t start = groupBegin; start < groupEnd; ++start) {
             if (used[start]) continue;
