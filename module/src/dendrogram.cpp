@@ -20,71 +20,65 @@ struct DisjointSets {
     }
 };
 
-struct RankedEdge {
-    GraphEdge edge;
-    uint32_t index;  // in the caller's list
-};
-
-// Sorts by (weight, a, b, index). Edges that already come in (a, b) order (the 2D graph's
-// pairs do) with finite non-negative weights take a stable LSD radix sort on the weight: a
-// few linear passes instead of a comparison sort of the whole graph.
-void sortByWeightThenIds(std::vector<RankedEdge>& edges) {
-    auto byIds = [](const RankedEdge& x, const RankedEdge& y) {
-        return std::tie(x.edge.a, x.edge.b, x.index) < std::tie(y.edge.a, y.edge.b, y.index);
-    };
-    bool radix = edges.size() > 256 && std::is_sorted(edges.begin(), edges.end(), byIds);
-    for (size_t i = 0; i < edges.size() && radix; ++i) {
-        const double w = edges[i].edge.weight;
-        radix = w >= 0 && !std::signbit(w) && std::isfinite(w);
+// Edge indices by (weight, smaller id, larger id, index). Edges that already come in
+// (smaller id, larger id) order (the 2D graph's pairs do) with finite non-negative weights
+// take a stable LSD radix sort of (weight rounded to float, index) keys, three linear passes
+// instead of a comparison sort of the whole graph; float rounding is monotone for such
+// doubles, and the few runs of equal floats are then sorted stably on the double itself.
+std::vector<uint32_t> edgeOrder(const std::vector<GraphEdge>& edges) {
+    const size_t n = edges.size();
+    auto lo = [&](size_t i) { return std::min(edges[i].a, edges[i].b); };
+    auto hi = [&](size_t i) { return std::max(edges[i].a, edges[i].b); };
+    bool radix = n > 256;
+    for (size_t i = 0; i < n && radix; ++i) {
+        const double w = edges[i].weight;
+        radix = w >= 0 && !std::signbit(w) && std::isfinite(w) &&
+                (i == 0 || std::make_pair(lo(i - 1), hi(i - 1)) <= std::make_pair(lo(i), hi(i)));
     }
+    std::vector<uint32_t> order(n);
     if (!radix) {
-        std::sort(edges.begin(), edges.end(), [](const RankedEdge& x, const RankedEdge& y) {
-            return std::tie(x.edge.weight, x.edge.a, x.edge.b, x.index) < std::tie(y.edge.weight, y.edge.a, y.edge.b, y.index);
+        std::iota(order.begin(), order.end(), 0u);
+        std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+            return std::make_tuple(edges[x].weight, lo(x), hi(x), x) < std::make_tuple(edges[y].weight, lo(y), hi(y), y);
         });
-        return;
+        return order;
     }
-    // Three passes on the weight rounded to float (monotone for these doubles), then the few
-    // runs of equal floats sorted stably on the double itself.
-    detail::radixSortStable(
-        edges,
-        [](const RankedEdge& e) {
-            const float rounded = static_cast<float>(e.edge.weight);
-            uint32_t bits;
-            std::memcpy(&bits, &rounded, sizeof bits);
-            return static_cast<uint64_t>(bits);
-        },
-        32);
-    auto rounded = [&](size_t i) { return static_cast<float>(edges[i].edge.weight); };
-    for (size_t i = 0; i < edges.size();) {
+    auto rounded = [&](size_t i) { return static_cast<float>(edges[i].weight); };
+    std::vector<uint64_t> keyed(n);  // float bits << 32 | index
+    for (size_t i = 0; i < n; ++i) {
+        const float r = rounded(i);
+        uint32_t bits;
+        std::memcpy(&bits, &r, sizeof bits);
+        keyed[i] = static_cast<uint64_t>(bits) << 32 | i;
+    }
+    detail::radixSortStable(keyed, [](uint64_t k) { return k >> 32; }, 32);
+    for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(keyed[i]);
+    for (size_t i = 0; i < n;) {
         size_t end = i + 1;
-        while (end < edges.size() && rounded(end) == rounded(i)) ++end;
+        while (end < n && (keyed[end] >> 32) == (keyed[i] >> 32)) ++end;
         if (end - i > 1)
-            std::stable_sort(edges.begin() + i, edges.begin() + end,
-                             [](const RankedEdge& x, const RankedEdge& y) { return x.edge.weight < y.edge.weight; });
+            std::stable_sort(order.begin() + i, order.begin() + end,
+                             [&](uint32_t x, uint32_t y) { return edges[x].weight < edges[y].weight; });
         i = end;
     }
+    return order;
 }
 
 }  // namespace
 
 std::vector<Merge> kruskalMerges(size_t modelCount, const std::vector<GraphEdge>& edges, std::vector<uint32_t>* mergeEdge) {
-    std::vector<RankedEdge> ranked(edges.size());
-    for (size_t i = 0; i < edges.size(); ++i) {
-        ranked[i] = {edges[i], static_cast<uint32_t>(i)};
-        if (ranked[i].edge.a > ranked[i].edge.b) std::swap(ranked[i].edge.a, ranked[i].edge.b);
-    }
-    sortByWeightThenIds(ranked);
     DisjointSets sets(modelCount);
     std::vector<Merge> merges;
     if (mergeEdge) mergeEdge->clear();
-    for (const RankedEdge& r : ranked) {
-        const GraphEdge& e = r.edge;
-        if (e.a >= modelCount || e.b >= modelCount || e.a == e.b) continue;
-        uint32_t ra = sets.find(e.a), rb = sets.find(e.b);
+    const std::vector<uint32_t> order = edgeOrder(edges);
+    for (const uint32_t i : order) {
+        const uint32_t a = std::min(edges[i].a, edges[i].b), b = std::max(edges[i].a, edges[i].b);
+        if (b >= modelCount || a == b) continue;
+        uint32_t ra = sets.find(a), rb = sets.find(b);
         if (ra == rb) continue;
         sets.parent[std::max(ra, rb)] = std::min(ra, rb);
-        merges.push_back(Merge{e.weight, e.a, e.b});
-        if (mergeEdge) mergeEdge->push_back(r.index);
+        merges.push_back(Merge{edges[i].weight, a, b});
+        if (mergeEdge) mergeEdge->push_back(i);
     }
     return merges;
 }

@@ -262,6 +262,16 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
     }
     fans.slotBegin.push_back(static_cast<uint32_t>(fans.pathArea.size()));
     fans.pathBegin.push_back(static_cast<uint32_t>(fans.faces.size()));
+    // Levels visit their merges in face order: each merge's protection reads only labels, so
+    // the order does not matter, and neighbouring faces are read together.
+    std::vector<uint64_t> keyed;  // first best face << 32 | merge
+    keyed.reserve(mergeCount);
+    for (size_t k = 0; k < mergeCount; ++k)
+        if (mergePair[k] >= 0)
+            keyed.push_back(static_cast<uint64_t>(static_cast<uint32_t>(space.pairs[mergePair[k]].bestFace[0])) << 32 | k);
+    std::sort(keyed.begin(), keyed.end());
+    fans.byFace.reserve(keyed.size());
+    for (uint64_t key : keyed) fans.byFace.push_back(static_cast<uint32_t>(key));
     return fans;
 }
 
@@ -269,7 +279,8 @@ void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelG
                    const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel) {
     Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
     s.initialLabels();
-    for (size_t k = 0; k < joinedMerges && k < fans.pair.size(); ++k) s.protectConnection(fans, k);
+    for (uint32_t k : fans.byFace)  // the level's merges are the first joinedMerges
+        if (k < joinedMerges) s.protectConnection(fans, k);
     s.carve();
 }
 

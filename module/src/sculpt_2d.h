@@ -31,6 +31,7 @@ struct ConnectionFans2D {
     std::vector<double> pathArea;     ///< per candidate: total area of its faces
     std::vector<double> pathLongest;  ///< per candidate: longest edge of its faces (0 if none)
     std::vector<int> faces;
+    std::vector<uint32_t> byFace;     ///< merges with a pair, ordered by the pair's first best face (for locality)
 };
 
 /// mergePair: per merge of the dendrogram (ascending height), its index into space.pairs.
