@@ -20,65 +20,74 @@ struct DisjointSets {
     }
 };
 
-// Edge indices by (weight, smaller id, larger id, index). Edges that already come in
-// (smaller id, larger id) order (the 2D graph's pairs do) with finite non-negative weights
-// take a stable LSD radix sort of (weight rounded to float, index) keys, three linear passes
-// instead of a comparison sort of the whole graph; float rounding is monotone for such
-// doubles, and the few runs of equal floats are then sorted stably on the double itself.
-std::vector<uint32_t> edgeOrder(const std::vector<GraphEdge>& edges) {
+struct SortedEdge {
+    uint32_t index, a, b;  // a < b
+    uint32_t rounded;      // bits of the weight rounded to float (radix path)
+};
+
+// Edges by (weight, smaller id, larger id, index). Edges that already come in (smaller id,
+// larger id) order (the 2D graph's pairs do) with finite non-negative weights take a stable
+// LSD radix sort on the weight rounded to float (monotone for such doubles), a few linear
+// passes instead of a comparison sort of the whole graph; the few runs of equal floats are
+// then sorted stably on the double itself. The ids travel with the keys, so the merge loop
+// reads the sorted list in order.
+std::vector<SortedEdge> sortEdges(const std::vector<GraphEdge>& edges) {
     const size_t n = edges.size();
-    auto lo = [&](size_t i) { return std::min(edges[i].a, edges[i].b); };
-    auto hi = [&](size_t i) { return std::max(edges[i].a, edges[i].b); };
+    std::vector<SortedEdge> sorted(n);
+    for (size_t i = 0; i < n; ++i)
+        sorted[i] = {static_cast<uint32_t>(i), std::min(edges[i].a, edges[i].b), std::max(edges[i].a, edges[i].b), 0};
     bool radix = n > 256;
     for (size_t i = 0; i < n && radix; ++i) {
         const double w = edges[i].weight;
         radix = w >= 0 && !std::signbit(w) && std::isfinite(w) &&
-                (i == 0 || std::make_pair(lo(i - 1), hi(i - 1)) <= std::make_pair(lo(i), hi(i)));
+                (i == 0 || std::tie(sorted[i - 1].a, sorted[i - 1].b) <= std::tie(sorted[i].a, sorted[i].b));
     }
-    std::vector<uint32_t> order(n);
     if (!radix) {
-        std::iota(order.begin(), order.end(), 0u);
-        std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
-            return std::make_tuple(edges[x].weight, lo(x), hi(x), x) < std::make_tuple(edges[y].weight, lo(y), hi(y), y);
+        std::sort(sorted.begin(), sorted.end(), [&](const SortedEdge& x, const SortedEdge& y) {
+            return std::tie(edges[x.index].weight, x.a, x.b, x.index) < std::tie(edges[y.index].weight, y.a, y.b, y.index);
         });
-        return order;
+        return sorted;
     }
-    auto rounded = [&](size_t i) { return static_cast<float>(edges[i].weight); };
-    std::vector<uint64_t> keyed(n);  // float bits << 32 | index
-    for (size_t i = 0; i < n; ++i) {
-        const float r = rounded(i);
-        uint32_t bits;
-        std::memcpy(&bits, &r, sizeof bits);
-        keyed[i] = static_cast<uint64_t>(bits) << 32 | i;
+    for (SortedEdge& e : sorted) {
+        const float r = static_cast<float>(edges[e.index].weight);
+        std::memcpy(&e.rounded, &r, sizeof e.rounded);
     }
-    detail::radixSortStable(keyed, [](uint64_t k) { return k >> 32; }, 32);
-    for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(keyed[i]);
+    detail::radixSortStable(sorted, [](const SortedEdge& e) { return static_cast<uint64_t>(e.rounded); }, 32);
     for (size_t i = 0; i < n;) {
         size_t end = i + 1;
-        while (end < n && (keyed[end] >> 32) == (keyed[i] >> 32)) ++end;
-        if (end - i > 1)
-            std::stable_sort(order.begin() + i, order.begin() + end,
-                             [&](uint32_t x, uint32_t y) { return edges[x].weight < edges[y].weight; });
+        while (end < n && sorted[end].rounded == sorted[i].rounded) ++end;
+        auto lighter = [&](const SortedEdge& x, const SortedEdge& y) { return edges[x.index].weight < edges[y.index].weight; };
+        if (end - i > 16) std::stable_sort(sorted.begin() + i, sorted.begin() + end, lighter);
+        else  // the usual case: two or three edges (an insertion sort, stable)
+            for (size_t j = i + 1; j < end; ++j)
+                for (size_t k = j; k > i && lighter(sorted[k], sorted[k - 1]); --k) std::swap(sorted[k], sorted[k - 1]);
         i = end;
     }
-    return order;
+    return sorted;
 }
 
 }  // namespace
 
 std::vector<Merge> kruskalMerges(size_t modelCount, const std::vector<GraphEdge>& edges, std::vector<uint32_t>* mergeEdge) {
+    // Union by size (the partition is all that matters here): short trees, whatever the
+    // order of the merges.
     DisjointSets sets(modelCount);
+    std::vector<uint32_t> size(modelCount, 1);
     std::vector<Merge> merges;
-    if (mergeEdge) mergeEdge->clear();
-    const std::vector<uint32_t> order = edgeOrder(edges);
-    for (const uint32_t i : order) {
-        const uint32_t a = std::min(edges[i].a, edges[i].b), b = std::max(edges[i].a, edges[i].b);
-        if (b >= modelCount || a == b) continue;
-        uint32_t ra = sets.find(a), rb = sets.find(b);
+    merges.reserve(modelCount > 0 ? modelCount - 1 : 0);
+    if (mergeEdge) {
+        mergeEdge->clear();
+        mergeEdge->reserve(merges.capacity());
+    }
+    for (const SortedEdge& e : sortEdges(edges)) {
+        if (e.b >= modelCount || e.a == e.b) continue;
+        uint32_t ra = sets.find(e.a), rb = sets.find(e.b);
         if (ra == rb) continue;
-        sets.parent[std::max(ra, rb)] = std::min(ra, rb);
-        merges.push_back(Merge{edges[i].weight, a, b});
-        if (mergeEdge) mergeEdge->push_back(i);
+        if (size[ra] < size[rb]) std::swap(ra, rb);
+        sets.parent[rb] = ra;
+        size[ra] += size[rb];
+        merges.push_back(Merge{edges[e.index].weight, e.a, e.b});
+        if (mergeEdge) mergeEdge->push_back(e.index);
     }
     return merges;
 }

@@ -131,18 +131,17 @@ struct Sculptor2D {
         for (uint32_t i = fans.pathBegin[best]; i < fans.pathBegin[best + 1]; ++i) isProtected[fans.faces[i]] = 1;
     }
 
-    void protectConnection(const ConnectionFans2D& fans, size_t merge) {
-        const int pairIndex = fans.pair[merge];
-        if (pairIndex < 0) return;
-        const ModelPair2D& pair = space.pairs[pairIndex];
+    // The merge at position p of fans.order.
+    void protectConnection(const ConnectionFans2D& fans, size_t p) {
+        const ModelPair2D& pair = space.pairs[fans.pair[fans.order[p]]];
         const int group = groupOfModel(static_cast<int>(pair.a));
         if (group < 0 || group != groupOfModel(static_cast<int>(pair.b))) return;
         for (int i = 0; i < 2; ++i) {
             const int f = pair.bestFace[i];
             if (!isKeptFree(f, group)) continue;
             isProtected[f] = 1;
-            protectFan(fans, 4 * merge + 2 * i, group);
-            protectFan(fans, 4 * merge + 2 * i + 1, group);
+            protectFan(fans, 4 * p + 2 * i, group);
+            protectFan(fans, 4 * p + 2 * i + 1, group);
             return;
         }
     }
@@ -190,20 +189,27 @@ struct HalfEdge {
 
 ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<int>& mergePair, int threadCount) {
     const Triangulation2D& tri = space.tri;
-    const size_t mergeCount = mergePair.size();
+    // The merges with a pair by their first best face (key: face << 32 | merge).
+    std::vector<uint64_t> keyed;
+    keyed.reserve(mergePair.size());
+    for (size_t k = 0; k < mergePair.size(); ++k)
+        if (mergePair[k] >= 0)
+            keyed.push_back(static_cast<uint64_t>(static_cast<uint32_t>(space.pairs[mergePair[k]].bestFace[0])) << 32 | k);
+    std::sort(keyed.begin(), keyed.end());
+    std::vector<uint32_t> order(keyed.size());
+    for (size_t p = 0; p < keyed.size(); ++p) order[p] = static_cast<uint32_t>(keyed[p]);
+    const size_t count = order.size();
     // Blocks of merges on all threads, each filling its own arrays; joined in block order.
-    const size_t blockCount = std::clamp<size_t>(mergeCount / 512, 1, 64);
+    const size_t blockCount = std::clamp<size_t>(count / 512, 1, 64);
     std::vector<ConnectionFans2D> blocks(blockCount);
     parallelFor(blockCount, threadCount, [&](size_t block) {
         ConnectionFans2D& out = blocks[block];
         std::vector<int> path;
-        const size_t first = mergeCount * block / blockCount, last = mergeCount * (block + 1) / blockCount;
-        for (size_t k = first; k < last; ++k) {
-            const int pairIndex = mergePair[k];
+        const size_t first = count * block / blockCount, last = count * (block + 1) / blockCount;
+        for (size_t p = first; p < last; ++p) {
+            const ModelPair2D& pair = space.pairs[mergePair[order[p]]];
             for (int slot = 0; slot < 4; ++slot) {
                 out.slotBegin.push_back(static_cast<uint32_t>(out.pathArea.size()));
-                if (pairIndex < 0) continue;
-                const ModelPair2D& pair = space.pairs[pairIndex];
                 const int f = pair.bestFace[slot / 2];
                 const int model = static_cast<int>(slot % 2 == 0 ? pair.a : pair.b);
                 if (f < 0 || space.faceModel[f] >= 0) continue;
@@ -250,7 +256,8 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
     });
     ConnectionFans2D fans;
     fans.pair = mergePair;
-    fans.slotBegin.reserve(4 * mergeCount + 1);
+    fans.order = std::move(order);
+    fans.slotBegin.reserve(4 * count + 1);
     for (const ConnectionFans2D& b : blocks) {
         const uint32_t candidateOffset = static_cast<uint32_t>(fans.pathArea.size());
         const uint32_t faceOffset = static_cast<uint32_t>(fans.faces.size());
@@ -262,16 +269,6 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
     }
     fans.slotBegin.push_back(static_cast<uint32_t>(fans.pathArea.size()));
     fans.pathBegin.push_back(static_cast<uint32_t>(fans.faces.size()));
-    // Levels visit their merges in face order: each merge's protection reads only labels, so
-    // the order does not matter, and neighbouring faces are read together.
-    std::vector<uint64_t> keyed;  // first best face << 32 | merge
-    keyed.reserve(mergeCount);
-    for (size_t k = 0; k < mergeCount; ++k)
-        if (mergePair[k] >= 0)
-            keyed.push_back(static_cast<uint64_t>(static_cast<uint32_t>(space.pairs[mergePair[k]].bestFace[0])) << 32 | k);
-    std::sort(keyed.begin(), keyed.end());
-    fans.byFace.reserve(keyed.size());
-    for (uint64_t key : keyed) fans.byFace.push_back(static_cast<uint32_t>(key));
     return fans;
 }
 
@@ -279,8 +276,10 @@ void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelG
                    const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel) {
     Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
     s.initialLabels();
-    for (uint32_t k : fans.byFace)  // the level's merges are the first joinedMerges
-        if (k < joinedMerges) s.protectConnection(fans, k);
+    // The level's merges are the first joinedMerges; visited in face order (each protection
+    // only reads labels, so the order does not matter).
+    for (size_t p = 0; p < fans.order.size(); ++p)
+        if (fans.order[p] < joinedMerges) s.protectConnection(fans, p);
     s.carve();
 }
 
