@@ -184,7 +184,7 @@ void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputV
 
 bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
                                        const std::vector<std::pair<size_t, size_t>>& segments, Triangulation2D& out,
-                                       std::string& error, int threadCount) {
+                                       std::string& error, int threadCount, const std::atomic<bool>* cancel) {
     const size_t n = points.size() / 2;
     try {
         Cdt& cdt = impl_->cdt;
@@ -199,12 +199,22 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         std::vector<Cdt::Vertex_handle>& handle = impl_->inputHandle;
         handle.assign(n, Cdt::Vertex_handle());
         Cdt::Face_handle hint;
-        for (const uint32_t i : order) {
+        auto cancelled = [&] { return cancel && cancel->load(std::memory_order_relaxed); };
+        for (size_t k = 0; k < order.size(); ++k) {
+            if (k % 4096 == 0 && cancelled()) {
+                error.clear();
+                return false;
+            }
+            const uint32_t i = order[k];
             const Cdt::Vertex_handle v = cdt.insert(pts[i], hint);
             handle[i] = v;
             hint = v->face();
             // Duplicate points share one vertex: it carries the smallest of their indices.
             if (v->info().input < 0 || static_cast<int>(i) < v->info().input) v->info().input = static_cast<int>(i);
+        }
+        if (cancelled()) {
+            error.clear();
+            return false;
         }
         for (const auto& [a, b] : segments)
             if (handle[a] != handle[b]) insertConstraint(cdt, handle[a], handle[b]);

@@ -2,6 +2,7 @@
 // (DESIGN 2.1, 2D; paper Section 3.1). The only place that knows CGAL's 2D triangulation.
 #pragma once
 
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -82,8 +83,10 @@ public:
     /// constraints are split at their intersections (new Steiner vertices). Duplicate points
     /// become one vertex. Returns false with a message when the triangulator fails (never throws).
     /// threadCount: threads for the export (0 = all cores; same result for any count).
+    /// cancel (optional): when another thread sets it, the build stops soon and returns false
+    /// with an empty message (the caller no longer wants this triangulation).
     bool build(const std::vector<double>& points, const std::vector<std::pair<size_t, size_t>>& segments,
-               Triangulation2D& out, std::string& error, int threadCount = 0);
+               Triangulation2D& out, std::string& error, int threadCount = 0, const std::atomic<bool>* cancel = nullptr);
 
 private:
     struct Impl;

@@ -12,6 +12,7 @@
 #include <aggrelod/dendrogram.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -753,8 +754,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     // 1. Input checks, in two steps: the rings are cleaned and oriented first; the contact
     // checks (self-intersections, crossings, touching polygons) then run on another thread
     // while CGAL triangulates the cleaned rings, followed there by the segment grid of the
-    // free-space pass (they touch different members of `in`). Only when the contact checks
-    // drop a polygon is the triangulation made again, without it.
+    // free-space pass (they touch different members of `in`). When the contact checks drop a
+    // polygon they cancel that triangulation, which is then made again without it.
     progress("checking input", 0);
     CheckedPolygons checked;
     PolygonCheckProgress checkProgress;
@@ -762,9 +763,13 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     const size_t cleanedParts = checked.parts.size();
     InputVertices in = inputVertices(checked, nullptr, /*withGrid=*/false);
     std::vector<Diagnostic> contactDiagnostics;
+    std::atomic<bool> partsDropped{false};
     auto checkContacts = [&] {
         checkPolygonContacts(features, checked, contactDiagnostics, checkProgress);
-        if (checked.parts.size() != cleanedParts) return;  // `in` is made again below
+        if (checked.parts.size() != cleanedParts) {  // `in` is made again below
+            partsDropped = true;
+            return;
+        }
         markTouchingParts(in, checked);
         buildSegmentGrid(in);
     };
@@ -782,7 +787,8 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     FreeSpaceModels models;
     std::string error;
     ConstrainedTriangulation2D triangulation;
-    bool triangulated = cleanedParts > 0 && triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount);
+    bool triangulated = cleanedParts > 0 && !partsDropped &&
+                        triangulation.build(in.points, in.segments, space.tri, error, settings.threadCount, &partsDropped);
     if (contactsLater.valid()) contactsLater.get();
     out.diagnostics.insert(out.diagnostics.end(), contactDiagnostics.begin(), contactDiagnostics.end());
     if (checked.parts.empty()) return fail("no usable polygon in the input");

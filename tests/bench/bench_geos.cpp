@@ -21,7 +21,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <map>
 #include <cstdarg>
 #include <cmath>
 #include <cstdio>
@@ -38,7 +37,7 @@ double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 GEOSContextHandle_t H;
 constexpr int kRuns = 9;                         // aggrelod runs per figure (median)
 constexpr int kGeosRuns = 3;                     // GEOS runs per figure (median; its time varies by ~20%)
-std::map<std::string, double> eightLevelSeconds;  // case -> aggrelod seconds, 8 levels
+constexpr int kScalingPairs = 9;                 // alternating 10k / 40k runs for the scaling figure
 
 std::string lastGeosError;
 
@@ -185,47 +184,38 @@ double totalArea(const std::vector<Polygon2D>& polys) {
     return a;
 }
 
-void runCase(const std::string& name, const std::vector<Feature2D>& features, double delta, bool runGeos) {
-    std::vector<Polygon2D> inputs;
-    for (const Feature2D& f : features) inputs.insert(inputs.end(), f.polygons.begin(), f.polygons.end());
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0 : v[v.size() / 2];
+}
 
-    // aggrelod: all 8 levels.
+Settings2D eightLevels(double delta) {
     Settings2D settings;
     settings.function = AggregateFunctionKind::Constant;
     settings.computeBaselines = false;
     for (double k : {0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0}) settings.deltas.push_back(k * delta);
-    // Each aggrelod figure is the median of kRuns runs, each GEOS figure of kGeosRuns.
-    auto median = [](std::vector<double> v) {
-        std::sort(v.begin(), v.end());
-        return v[v.size() / 2];
-    };
+    return settings;
+}
+
+double timedBuild(const std::vector<Feature2D>& features, const Settings2D& settings, Hierarchy2D& h, bool& ok) {
+    h = Hierarchy2D{};
+    const auto t0 = Clock::now();
+    ok = buildHierarchy2D(features, settings, h);
+    return secondsSince(t0);
+}
+
+void runCase(const std::string& name, const std::vector<Feature2D>& features, double delta, bool runGeos) {
+    const Settings2D settings = eightLevels(delta);
+    // A first, untimed run gives the polygons aggrelod accepted (land data has a few invalid
+    // ones) and the checks below.
     Hierarchy2D h;
-    std::vector<double> runs;
     bool ok = true;
-    for (int r = 0; r < kRuns && ok; ++r) {
-        h = Hierarchy2D{};
-        const auto t0 = Clock::now();
-        ok = buildHierarchy2D(features, settings, h);
-        runs.push_back(secondsSince(t0));
-    }
+    timedBuild(features, settings, h, ok);
     if (!ok) {
         std::printf("| %s | aggrelod failed |\n", name.c_str());
         return;
     }
-    const double ours = median(runs);
-    // aggrelod: the compared level alone.
-    Settings2D one = settings;
-    one.deltas = {delta};
-    runs.clear();
-    for (int r = 0; r < kRuns; ++r) {
-        Hierarchy2D h1;
-        const auto t1level = Clock::now();
-        buildHierarchy2D(features, one, h1);
-        runs.push_back(secondsSince(t1level));
-    }
-    const double oursOne = median(runs);
-    eightLevelSeconds[name] = ours;
-    std::vector<Polygon2D> inputsUsed;  // polygons aggrelod accepted (land data has a few invalid ones)
+    std::vector<Polygon2D> inputsUsed;
     for (size_t f = 0; f < features.size(); ++f)
         if (h.featureModel[f] >= 0)
             for (const Polygon2D& p : features[f].polygons) {
@@ -234,6 +224,45 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
                 GEOSGeom_destroy_r(H, g);
             }
     const double inputArea = totalArea(inputsUsed);
+    GEOSGeometry* inputGeom = multiPolygon(inputsUsed);
+    // GEOS needs a valid MultiPolygon: touching inputs (land data) are unioned first (not
+    // timed; the grids are already valid).
+    GEOSGeometry* geosInput = nullptr;
+    double geosLength = NAN, ratio = 0;  // GEOS's edge-length threshold L and its length ratio
+    if (runGeos) {
+        geosInput = GEOSisValid_r(H, inputGeom) == 1 ? GEOSGeom_clone_r(H, inputGeom) : GEOSUnaryUnion_r(H, inputGeom);
+        std::vector<std::vector<double>> shells;
+        if (geosInput)
+            for (const Polygon2D& p : polygonsOf(geosInput)) shells.push_back(p.exterior);
+        const auto [edgeMin, edgeMax] = geosEdgeRange(shells);
+        ratio = std::clamp((delta - edgeMin) / (edgeMax - edgeMin), 0.0, 1.0);
+        geosLength = ratio * (edgeMax - edgeMin) + edgeMin;  // GEOS's own formula
+    }
+    // Timed runs, interleaved so that both peers see the same machine: kGeosRuns rounds of
+    // kRuns / kGeosRuns aggrelod runs and one GEOS run (aggrelod alone when GEOS is skipped).
+    std::vector<double> runs, geosRuns;
+    GEOSGeometry* hull = nullptr;
+    bool geosFailed = false;
+    for (int round = 0; round < kGeosRuns; ++round) {
+        for (int r = 0; r < kRuns / kGeosRuns; ++r) runs.push_back(timedBuild(features, settings, h, ok));
+        if (!geosInput || geosFailed) continue;
+        if (hull) GEOSGeom_destroy_r(H, hull);
+        const auto t1 = Clock::now();
+        hull = GEOSConcaveHullOfPolygons_r(H, geosInput, ratio, 1, 1);
+        geosRuns.push_back(secondsSince(t1));
+        geosFailed = hull == nullptr;  // a failure does not get faster by repeating it
+    }
+    const double ours = median(runs);
+    // aggrelod: the compared level alone.
+    Settings2D one = settings;
+    one.deltas = {delta};
+    std::vector<double> oneRuns;
+    for (int r = 0; r < kRuns; ++r) {
+        Hierarchy2D h1;
+        oneRuns.push_back(timedBuild(features, one, h1, ok));
+    }
+    const double oursOne = median(oneRuns);
+
     const Level2D* level = nullptr;
     for (const Level2D& l : h.levels)
         if (l.delta == delta) level = &l;
@@ -246,36 +275,15 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
         GEOSGeom_destroy_r(H, g);
     }
     // Input boundaries, for "edge on an input boundary".
-    GEOSGeometry* inputGeom = multiPolygon(inputsUsed);
     GEOSGeometry* boundary = GEOSBoundary_r(H, inputGeom);
     const GEOSPreparedGeometry* prepared = GEOSPrepare_r(H, boundary);
     const double tol = 1e-9 * std::max(1.0, h.freeEdgeMax);
     const double oursLongest = longestFreeEdge(oursOut, prepared, tol);
     const double oursAdded = (level->measures.area - inputArea) / inputArea;
 
-    double geosLength = NAN;  // GEOS's edge-length threshold L
     std::string geosTime = "skipped", geosAdded = "-", geosValid = "-", geosLongest = "-", speedup = "-";
     if (runGeos) {
-        // GEOS needs a valid MultiPolygon: touching inputs (land data) are unioned first
-        // (not timed; the grids are already valid).
-        GEOSGeometry* geosInput = GEOSisValid_r(H, inputGeom) == 1 ? GEOSGeom_clone_r(H, inputGeom)
-                                                                   : GEOSUnaryUnion_r(H, inputGeom);
-        std::vector<std::vector<double>> shells;
-        if (geosInput)
-            for (const Polygon2D& p : polygonsOf(geosInput)) shells.push_back(p.exterior);
-        const auto [edgeMin, edgeMax] = geosEdgeRange(shells);
-        const double ratio = std::clamp((delta - edgeMin) / (edgeMax - edgeMin), 0.0, 1.0);
-        geosLength = ratio * (edgeMax - edgeMin) + edgeMin;  // GEOS's own formula
-        GEOSGeometry* hull = nullptr;
-        std::vector<double> geosRuns;
-        for (int r = 0; r < kGeosRuns && geosInput; ++r) {
-            if (hull) GEOSGeom_destroy_r(H, hull);
-            const auto t1 = Clock::now();
-            hull = GEOSConcaveHullOfPolygons_r(H, geosInput, ratio, 1, 1);
-            geosRuns.push_back(secondsSince(t1));
-            if (!hull) break;  // a failure does not get faster by repeating it
-        }
-        const double geos = geosRuns.empty() ? 0 : median(geosRuns);
+        const double geos = median(geosRuns);
         char buf[64];
         std::snprintf(buf, sizeof buf, "%.3f", geos);
         geosTime = buf;
@@ -304,6 +312,28 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
     GEOSGeom_destroy_r(H, inputGeom);
 }
 
+// time(40k squares) / time(10k squares), all 8 levels: runs of the two alternate, so that a
+// slower spell of the shared machine weighs on both; ratio of the medians, and the range of
+// the per-pair ratios.
+void scaling() {
+    const std::vector<Feature2D> small = samples::makeSquareGrid(10000, 1.0, 0.5, 0.2, 1);
+    const std::vector<Feature2D> large = samples::makeSquareGrid(40000, 1.0, 0.5, 0.2, 1);
+    const Settings2D settings = eightLevels(0.45);
+    std::vector<double> smallRuns, largeRuns, pairRatios;
+    Hierarchy2D h;
+    bool ok = true;
+    for (int r = 0; r < kScalingPairs; ++r) {
+        smallRuns.push_back(timedBuild(small, settings, h, ok));
+        largeRuns.push_back(timedBuild(large, settings, h, ok));
+        pairRatios.push_back(largeRuns.back() / smallRuns.back());
+    }
+    std::sort(pairRatios.begin(), pairRatios.end());
+    std::printf("\naggrelod 8 levels: 40k / 10k squares = %.2fx (goal <= 5x; %d alternating pairs, medians %.3f s / %.3f s, "
+                "per-pair %.2f-%.2fx)\n",
+                median(largeRuns) / median(smallRuns), kScalingPairs, median(largeRuns), median(smallRuns), pairRatios.front(),
+                pairRatios.back());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -313,7 +343,8 @@ int main(int argc, char** argv) {
     std::printf("GEOS %s; aggrelod builds 8 levels (0.25..8 x delta), GEOS one; GEOS skipped above %d polygons\n"
                 "Timed: buildHierarchy2D (input checks, triangulation, graph, dendrogram, sculpting and polygons of\n"
                 "every level with their area / perimeter; no baselines) versus GEOSConcaveHullOfPolygons_r; input\n"
-                "conversion and validity checks are not timed. aggrelod: median of %d runs; GEOS: median of %d runs.\n\n",
+                "conversion and validity checks are not timed. aggrelod: median of %d runs; GEOS: median of %d runs,\n"
+                "one after every third aggrelod run.\n\n",
                 GEOSversion(), geosLimit, kRuns, kGeosRuns);
     std::printf("| case | polygons | delta | aggrelod s (8 levels) | aggrelod s (1 level) | aggrelod added area | aggrelod valid | aggrelod longest free edge | "
                 "GEOS L | GEOS s (1 level) | GEOS added area | GEOS valid | GEOS longest free edge | GEOS / aggrelod time |\n"
@@ -326,9 +357,7 @@ int main(int argc, char** argv) {
     const std::string path = std::string(AGGRELOD_SHARED_DATA) + "/2d/land50m_islands.wkt";
     if (io::readPolygonFile(path, land, error)) runCase("land50m_islands", land.features, 0.5, true);
     else std::printf("%s\n", error.c_str());
-    if (eightLevelSeconds.count("grid 10k") && eightLevelSeconds.count("grid 40k"))
-        std::printf("\naggrelod 8 levels: 40k / 10k squares = %.2fx (goal <= 5x)\n",
-                    eightLevelSeconds["grid 40k"] / eightLevelSeconds["grid 10k"]);
+    scaling();
     GEOS_finish_r(H);
     return 0;
 }
