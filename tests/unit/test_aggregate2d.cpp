@@ -220,6 +220,34 @@ TEST(Aggregate2D, SharedBordersMergeAtDeltaZero) {
     EXPECT_LT(h.levels[0].measures.perimeter, 0.5 * h.originals.perimeter) << "inner borders are gone";
 }
 
+// With more than one thread the contact checks run beside a first triangulation of all
+// cleaned rings; a self-intersecting polygon they drop cancels it and the triangulation is
+// made again without that polygon: the result must equal the one-thread run, which checks
+// first.
+TEST(Aggregate2D, DroppedPolygonGivesTheSameResultForAnyThreadCount) {
+    std::vector<Feature2D> features = samples::makeSquareGrid(3000, 1.0, 0.5, 0.2, 3);
+    Feature2D bowtie;
+    bowtie.name = "bowtie";
+    bowtie.id = static_cast<uint32_t>(features.size());
+    bowtie.polygons.push_back(Polygon2D{{10.2, -3, 12.2, -1, 12.2, -3, 10.2, -2}, {}});  // AB crosses CD
+    features.insert(features.begin() + 1500, bowtie);
+    std::string first;
+    for (int threads : {1, 2}) {
+        Settings2D settings;
+        settings.automaticLevelCount = 4;
+        settings.threadCount = threads;
+        Hierarchy2D h;
+        ASSERT_TRUE(buildHierarchy2D(features, settings, h));
+        EXPECT_EQ(h.featureModel[1500], -1) << "the self-intersecting polygon is left out";
+        bool reported = false;
+        for (const Diagnostic& d : h.diagnostics) reported = reported || (d.object == "bowtie" && d.message.find("self-intersecting") != std::string::npos);
+        EXPECT_TRUE(reported);
+        const std::string text = io::formatLevelsGeoJson(h, features);
+        if (first.empty()) first = text;
+        else EXPECT_EQ(text, first) << threads << " threads";
+    }
+}
+
 TEST(Aggregate2D, SameResultForAnyThreadCount) {
     const std::vector<Feature2D> features = samples::makeEnvironment2D(samples::Environment2D::Forest, 2);
     std::string first;

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <string>
 #include <utility>
 #include <vector>
@@ -171,4 +172,17 @@ TEST(Steiner2D, PointOffItsSegmentIsRefusedAndChangesNothing) {
     EXPECT_EQ(tri.faces, before.faces);
     EXPECT_EQ(tri.neighbors, before.neighbors);
     EXPECT_EQ(tri.constrained, before.constrained);
+}
+
+TEST(ConstrainedTriangulation2D, CancelledBuildStopsWithoutAMessage) {
+    const Rings rings = ringsOf(samples::makeSquareGrid(500, 1.0, 0.5, 0.2, 1));
+    ConstrainedTriangulation2D cgal;
+    Triangulation2D tri;
+    std::string error = "unchanged";
+    const std::atomic<bool> cancel{true};
+    EXPECT_FALSE(cgal.build(rings.points, rings.segments, tri, error, 1, &cancel));
+    EXPECT_TRUE(error.empty());
+    const std::atomic<bool> goOn{false};
+    EXPECT_TRUE(cgal.build(rings.points, rings.segments, tri, error, 1, &goOn)) << error;
+    EXPECT_GT(tri.faceCount(), 1000u);
 }
