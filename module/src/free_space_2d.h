@@ -41,6 +41,12 @@ struct FreeSpace2D {
     std::vector<double> pairPrefixSum;         ///< per pair: running sums of its lengths, from 0
     std::vector<double> pairPrefixSumSquares;  ///< per pair: running sums of its squared lengths, from 0
     std::vector<std::vector<double>> modelPoints;  ///< per model: all its ring vertices (x y pairs); only when hulls are needed
+    /// Per model whose boundary in the triangulation is exactly its input rings (no touching or
+    /// overlapping polygon, no vertex shared with another ring): its polygons as the polygon
+    /// extraction traces them (rings with their Steiner points, each from its first vertex;
+    /// parts and holes in input order). Empty for the other models. A group of such a model
+    /// alone, with no kept free face, is exactly these polygons.
+    std::vector<std::vector<Polygon2D>> modelPolygons;
 
     /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.
     int pairIndex(uint32_t a, uint32_t b) const;

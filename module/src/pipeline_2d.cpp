@@ -282,25 +282,53 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     forBlocks(vertexCount, [&](size_t v) {
         if (tri.vertexInput[v] >= 0) vertexPart[v] = static_cast<int>(in.part[tri.vertexInput[v]]);
     });
+    // The part of each interior face: a face beside a ring edge that has it on its left (the
+    // ring's interior side) is in that ring's part; the others take the part of the face
+    // they share an unconstrained edge with (the same region: no ring between them). So a
+    // polygon nested inside another's interior leaves the faces between the two rings to the
+    // outer one, and the two meet face to face (joined into one model below).
     std::vector<int> facePart(faceCount, -1);
-    std::vector<char> unowned(faceBlocks, 0);  // per block: an interior face with only Steiner vertices
+    std::vector<char> unowned(faceBlocks, 0);  // per block: an interior face left without a part
     parallelFor(faceBlocks, threadCount, [&](size_t block) {
         for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
             if (winding[f] < 1) continue;
-            for (int k = 0; k < 3 && facePart[f] < 0; ++k) facePart[f] = vertexPart[tri.faces[3 * f + k]];
+            for (int j = 0; j < 3 && facePart[f] < 0; ++j) {
+                if (!tri.constrained[3 * f + j]) continue;
+                const int iu = tri.vertexInput[tri.faces[3 * f + (j + 1) % 3]], iv = tri.vertexInput[tri.faces[3 * f + (j + 2) % 3]];
+                if (iu >= 0 && iv >= 0 && in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv))
+                    facePart[f] = static_cast<int>(in.part[iu]);  // the ring runs iu -> iv, f on its left
+            }
             if (facePart[f] < 0) unowned[block] = 1;
         }
     });
-    for (bool changed = std::count(unowned.begin(), unowned.end(), 1) > 0; changed;) {  // take a neighbour's part
-        changed = false;
-        for (size_t f = 0; f < faceCount; ++f) {
-            if (winding[f] < 1 || facePart[f] >= 0) continue;
+    if (std::count(unowned.begin(), unowned.end(), 1) > 0) {
+        std::vector<int> queue;
+        for (size_t f = 0; f < faceCount; ++f)
+            if (facePart[f] >= 0) queue.push_back(static_cast<int>(f));
+        for (size_t head = 0; head < queue.size(); ++head) {  // across unconstrained edges only
+            const int f = queue[head];
             for (int j = 0; j < 3; ++j) {
                 const int n = tri.neighbors[3 * f + j];
-                if (n >= 0 && winding[n] >= 1 && facePart[n] >= 0) {
-                    facePart[f] = facePart[n];
-                    changed = true;
-                    break;
+                if (n < 0 || tri.constrained[3 * f + j] || winding[n] < 1 || facePart[n] >= 0) continue;
+                facePart[n] = facePart[f];
+                queue.push_back(n);
+            }
+        }
+        // Left over (a region whose every ring edge ends at a crossing vertex): the part of a
+        // corner, or of any interior neighbour.
+        for (size_t f = 0; f < faceCount; ++f)
+            for (int k = 0; k < 3 && winding[f] >= 1 && facePart[f] < 0; ++k) facePart[f] = vertexPart[tri.faces[3 * f + k]];
+        for (bool changed = true; changed;) {
+            changed = false;
+            for (size_t f = 0; f < faceCount; ++f) {
+                if (winding[f] < 1 || facePart[f] >= 0) continue;
+                for (int j = 0; j < 3; ++j) {
+                    const int n = tri.neighbors[3 * f + j];
+                    if (n >= 0 && winding[n] >= 1 && facePart[n] >= 0) {
+                        facePart[f] = facePart[n];
+                        changed = true;
+                        break;
+                    }
                 }
             }
         }
@@ -357,6 +385,29 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
         auto& pts = space.modelPoints[partModel[in.part[v]]];
         pts.push_back(in.x(v));
         pts.push_back(in.y(v));
+    }
+    if (!graphOnly) {
+        // The models whose boundary is exactly their rings: none of their parts touches,
+        // overlaps or lies inside another part (the triangulation would split or hide a ring
+        // edge there), and no ring vertex is shared. Their polygons, ring by ring of `in`
+        // (each part's exterior, then its holes), as the extraction would trace them.
+        std::vector<char> modelPlain(space.modelCount, 1);
+        for (auto [a, b] : checked.touchingParts) modelPlain[partModel[a]] = modelPlain[partModel[b]] = 0;
+        for (const auto& list : adjacentParts)
+            for (auto [a, b] : list) modelPlain[partModel[a]] = modelPlain[partModel[b]] = 0;
+        for (size_t v = 0; v < in.part.size(); ++v)
+            if (v >= in.shared.size() || in.shared[v]) modelPlain[partModel[in.part[v]]] = 0;
+        for (size_t f = 0; f < faceCount; ++f)  // inside two polygons: nested or overlapping parts
+            if (winding[f] >= 2 && space.faceModel[f] >= 0) modelPlain[space.faceModel[f]] = 0;
+        space.modelPolygons.assign(space.modelCount, {});
+        for (size_t v = 0; v < in.part.size(); v += in.ringSize[v]) {
+            const uint32_t p = in.part[v];
+            const int m = partModel[p];
+            if (!modelPlain[m]) continue;
+            std::vector<double> ring(in.points.begin() + 2 * v, in.points.begin() + 2 * (v + in.ringSize[v]));
+            if (v == 0 || in.part[v - 1] != p) space.modelPolygons[m].push_back(Polygon2D{std::move(ring), {}});
+            else space.modelPolygons[m].back().holes.push_back(std::move(ring));
+        }
     }
 
     // Voids: free faces not reachable from the hull through free faces (input holes, or
@@ -984,7 +1035,13 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
             }
         } else {
             sculptLevel2D(space, modelGroup, primaryLimits[li], fans, joined, label);
-            extractPolygons2D(space, label, groupCount, level.aggregates);
+            std::vector<int> groupModel(groupCount, -1);  // its model when it has one only
+            std::vector<uint32_t> groupSize(groupCount, 0);
+            for (size_t m = 0; m < space.modelCount; ++m)
+                if (groupSize[modelGroup[m]]++ == 0) groupModel[modelGroup[m]] = static_cast<int>(m);
+            for (size_t g = 0; g < groupCount; ++g)
+                if (groupSize[g] != 1) groupModel[g] = -1;
+            extractPolygons2D(space, label, groupCount, level.aggregates, &groupModel);
         }
         for (const Aggregate2D& agg : level.aggregates) {
             level.measures.area += agg.measures.area;

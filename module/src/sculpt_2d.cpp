@@ -299,16 +299,30 @@ Measures2D measureLabels2D(const FreeSpace2D& space, const std::vector<int>& fac
 }
 
 void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLabel, size_t groupCount,
-                       std::vector<Aggregate2D>& aggregates) {
+                       std::vector<Aggregate2D>& aggregates, const std::vector<int>* groupModel) {
     const Triangulation2D& tri = space.tri;
     const size_t faceCount = tri.faceCount();
     aggregates.resize(groupCount);
+    // Groups that are one model with nothing kept around it: that model's own polygons (at
+    // fine levels, most groups), copied instead of traced.
+    std::vector<char> copied(groupCount, 0);
+    if (groupModel && !space.modelPolygons.empty()) {
+        std::vector<char> filled(groupCount, 0);
+        for (size_t f = 0; f < faceCount; ++f)
+            if (space.faceModel[f] < 0 && faceLabel[f] >= 0) filled[faceLabel[f]] = 1;
+        for (size_t g = 0; g < groupCount; ++g) {
+            const int m = (*groupModel)[g];
+            if (m < 0 || filled[g] || space.modelPolygons[m].empty()) continue;
+            copied[g] = 1;
+            aggregates[g].polygons = space.modelPolygons[m];
+        }
+    }
     // Boundary half-edges, the kept face on their left.
     std::vector<HalfEdge> edges;
     edges.reserve(faceCount);
     for (size_t f = 0; f < faceCount; ++f) {
         const int g = faceLabel[f];
-        if (g < 0) continue;
+        if (g < 0 || copied[g]) continue;
         for (int j = 0; j < 3; ++j) {
             const int n = tri.neighbors[3 * f + j];
             if (n >= 0 && faceLabel[n] == g) continue;

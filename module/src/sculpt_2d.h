@@ -49,9 +49,11 @@ void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelG
 Measures2D measureLabels2D(const FreeSpace2D& space, const std::vector<int>& faceLabel);
 
 /// Polygons with holes of every group: aggregates[g].polygons (exterior CCW, holes CW,
-/// parts touching at a point split apart) and aggregates[g].measures.
+/// parts touching at a point split apart) and aggregates[g].measures. groupModel (optional,
+/// per group): its model when it has only one, else -1; such a group with no kept free face
+/// takes space.modelPolygons (when there are any) instead of being traced.
 void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLabel, size_t groupCount,
-                       std::vector<Aggregate2D>& aggregates);
+                       std::vector<Aggregate2D>& aggregates, const std::vector<int>* groupModel = nullptr);
 
 /// Convex hull (counter-clockwise, open ring) of x y pairs; Andrew's monotone chain.
 std::vector<double> convexHull2D(std::vector<double> points);

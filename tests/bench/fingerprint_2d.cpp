@@ -4,7 +4,7 @@
 // print the same lines give byte-identical outputs on these inputs. Cases: the five paper
 // environments (adaptive, constant, hull), jittered square grids, the real data sets of
 // ../shared/data/2d and 300 random overlapping / touching / holed polygon sets, with 1 and
-// 2 threads. Usage: fingerprint_2d [random seeds=300]
+// 2 threads. Usage: fingerprint_2d [random seeds=300] [--each (a line per random set)]
 #include "geo_io.h"
 
 #include <aggrelod/aggregate2d.h>
@@ -81,6 +81,7 @@ void run(const std::string& name, const std::vector<Feature2D>& features, Settin
 
 int main(int argc, char** argv) {
     const uint32_t randomSeeds = argc > 1 ? static_cast<uint32_t>(std::atoi(argv[1])) : 300;
+    const bool eachSeed = argc > 2 && std::strcmp(argv[2], "--each") == 0;  // one line per random set
     const std::pair<AggregateFunctionKind, const char*> functions[] = {{AggregateFunctionKind::Adaptive, "adaptive"},
                                                                        {AggregateFunctionKind::Constant, "constant"}};
     for (samples::Environment2D env : samples::allEnvironments2D()) {
@@ -128,6 +129,8 @@ int main(int argc, char** argv) {
         Hierarchy2D h;
         const bool ok = buildHierarchy2D(samples::makeRandomOverlappingPolygons(seed), s, h);
         all.u(fingerprint(h, ok));
+        if (eachSeed)
+            std::printf("random polygons seed %u  %016llx\n", seed, static_cast<unsigned long long>(fingerprint(h, ok)));
     }
     std::printf("%-40s           %016llx\n", ("random polygons x" + std::to_string(randomSeeds)).c_str(),
                 static_cast<unsigned long long>(all.h));

@@ -220,6 +220,33 @@ TEST(Aggregate2D, SharedBordersMergeAtDeltaZero) {
     EXPECT_LT(h.levels[0].measures.perimeter, 0.5 * h.originals.perimeter) << "inner borders are gone";
 }
 
+// A polygon inside another's interior, without touching it, is one model with it (README:
+// nested polygons are merged), whichever comes first in the input and however the faces
+// between the two rings are numbered; the level shows the outer polygon once.
+TEST(Aggregate2D, NestedPolygonJoinsTheModelAroundIt) {
+    auto square = [](const std::string& name, uint32_t id, double x0, double y0, double side) {
+        Feature2D f;
+        f.name = name;
+        f.id = id;
+        f.polygons.push_back(Polygon2D{{x0, y0, x0 + side, y0, x0 + side, y0 + side, x0, y0 + side}, {}});
+        return f;
+    };
+    const std::vector<Feature2D> features = {square("inner", 0, 4, 4, 2), square("outer", 1, 0, 0, 10),
+                                             square("far", 2, 30, 0, 3)};
+    Settings2D settings;
+    settings.deltas = {0.5};
+    Hierarchy2D h;
+    ASSERT_TRUE(buildHierarchy2D(features, settings, h));
+    EXPECT_EQ(h.featureModel[0], h.featureModel[1]);
+    EXPECT_NE(h.featureModel[0], h.featureModel[2]);
+    ASSERT_EQ(h.levels.size(), 1u);
+    ASSERT_EQ(h.levels[0].aggregates.size(), 2u);
+    const Aggregate2D& both = h.levels[0].aggregates[0];
+    EXPECT_EQ(both.sourceFeatures, (std::vector<uint32_t>{0, 1}));
+    EXPECT_NEAR(both.measures.area, 100.0, 1e-9);
+    EXPECT_EQ(geosValidity(both.polygons), "Valid Geometry");
+}
+
 // With more than one thread the contact checks run beside a first triangulation of all
 // cleaned rings; a self-intersecting polygon they drop cancels it and the triangulation is
 // made again without that polygon: the result must equal the one-thread run, which checks
