@@ -27,6 +27,9 @@
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 using namespace aggrelod;
 
 namespace {
@@ -184,6 +187,55 @@ double totalArea(const std::vector<Polygon2D>& polys) {
     return a;
 }
 
+/// One GEOS run, measured in a child process.
+struct GeosRun {
+    double seconds = 0;
+    bool ok = false, valid = false;
+    double addedArea = 0, longestFreeEdge = 0;  // of the output (withMeasures only)
+    char error[256] = "";
+};
+
+/// Forks; the child times GEOSConcaveHullOfPolygons_r on its copy of `input`, measures the
+/// output when asked (untimed), writes the result to a pipe and exits.
+GeosRun geosInChild(const GEOSGeometry* input, double ratio, double inputArea, const GEOSPreparedGeometry* inputBoundary,
+                    double tol, bool withMeasures) {
+    GeosRun result;
+    int fds[2];
+    if (pipe(fds) != 0) {
+        std::snprintf(result.error, sizeof result.error, "pipe failed");
+        return result;
+    }
+    std::fflush(stdout);
+    const pid_t pid = fork();
+    if (pid == 0) {
+        close(fds[0]);
+        GeosRun child;
+        const auto t0 = Clock::now();
+        GEOSGeometry* hull = GEOSConcaveHullOfPolygons_r(H, input, ratio, 1, 1);
+        child.seconds = secondsSince(t0);
+        child.ok = hull != nullptr;
+        if (!hull) std::snprintf(child.error, sizeof child.error, "%s", lastGeosError.c_str());
+        if (hull && withMeasures) {
+            double a = 0;
+            GEOSArea_r(H, hull, &a);
+            child.addedArea = (a - inputArea) / inputArea;
+            child.valid = GEOSisValid_r(H, hull) == 1;
+            child.longestFreeEdge = longestFreeEdge(polygonsOf(hull), inputBoundary, tol);
+        }
+        const ssize_t written = write(fds[1], &child, sizeof child);
+        _exit(written == static_cast<ssize_t>(sizeof child) ? 0 : 1);
+    }
+    close(fds[1]);
+    const ssize_t got = pid > 0 ? read(fds[0], &result, sizeof result) : -1;
+    close(fds[0]);
+    if (pid > 0) waitpid(pid, nullptr, 0);
+    if (got != static_cast<ssize_t>(sizeof result)) {
+        result = GeosRun{};
+        std::snprintf(result.error, sizeof result.error, "GEOS child process gave no result");
+    }
+    return result;
+}
+
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v.empty() ? 0 : v[v.size() / 2];
@@ -238,19 +290,21 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
         ratio = std::clamp((delta - edgeMin) / (edgeMax - edgeMin), 0.0, 1.0);
         geosLength = ratio * (edgeMax - edgeMin) + edgeMin;  // GEOS's own formula
     }
-    // Timed runs, interleaved so that both peers see the same machine: kGeosRuns rounds of
-    // kRuns / kGeosRuns aggrelod runs and one GEOS run (aggrelod alone when GEOS is skipped).
+    // Input boundaries, for "edge on an input boundary".
+    GEOSGeometry* boundary = GEOSBoundary_r(H, inputGeom);
+    const GEOSPreparedGeometry* prepared = GEOSPrepare_r(H, boundary);
+    const double tol = 1e-9 * std::max(1.0, h.freeEdgeMax);
+    // Timed runs, interleaved so that both peers see the same spells of the shared machine:
+    // kGeosRuns rounds of kRuns / kGeosRuns aggrelod runs and one GEOS run (aggrelod alone when
+    // GEOS is skipped). Each GEOS run is a child process of its own, so that its heap (it
+    // allocates and frees far more than aggrelod) leaves this process's heap as it was.
     std::vector<double> runs, geosRuns;
-    GEOSGeometry* hull = nullptr;
-    bool geosFailed = false;
+    GeosRun geosResult;
     for (int round = 0; round < kGeosRuns; ++round) {
         for (int r = 0; r < kRuns / kGeosRuns; ++r) runs.push_back(timedBuild(features, settings, h, ok));
-        if (!geosInput || geosFailed) continue;
-        if (hull) GEOSGeom_destroy_r(H, hull);
-        const auto t1 = Clock::now();
-        hull = GEOSConcaveHullOfPolygons_r(H, geosInput, ratio, 1, 1);
-        geosRuns.push_back(secondsSince(t1));
-        geosFailed = hull == nullptr;  // a failure does not get faster by repeating it
+        if (!geosInput || (round > 0 && !geosResult.ok)) continue;  // a failure does not get faster by repeating it
+        geosResult = geosInChild(geosInput, ratio, inputArea, prepared, tol, round + 1 == kGeosRuns);
+        geosRuns.push_back(geosResult.seconds);
     }
     const double ours = median(runs);
     // aggrelod: the compared level alone.
@@ -274,10 +328,6 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
         oursInvalid += GEOSisValid_r(H, g) != 1;
         GEOSGeom_destroy_r(H, g);
     }
-    // Input boundaries, for "edge on an input boundary".
-    GEOSGeometry* boundary = GEOSBoundary_r(H, inputGeom);
-    const GEOSPreparedGeometry* prepared = GEOSPrepare_r(H, boundary);
-    const double tol = 1e-9 * std::max(1.0, h.freeEdgeMax);
     const double oursLongest = longestFreeEdge(oursOut, prepared, tol);
     const double oursAdded = (level->measures.area - inputArea) / inputArea;
 
@@ -289,17 +339,14 @@ void runCase(const std::string& name, const std::vector<Feature2D>& features, do
         geosTime = buf;
         std::snprintf(buf, sizeof buf, "%.1fx", geos / ours);
         speedup = buf;
-        if (hull) {
-            double a = 0;
-            GEOSArea_r(H, hull, &a);
-            std::snprintf(buf, sizeof buf, "%.4f", (a - inputArea) / inputArea);
+        if (geosResult.ok) {
+            std::snprintf(buf, sizeof buf, "%.4f", geosResult.addedArea);
             geosAdded = buf;
-            geosValid = GEOSisValid_r(H, hull) == 1 ? "valid" : "INVALID";
-            std::snprintf(buf, sizeof buf, "%.4g", longestFreeEdge(polygonsOf(hull), prepared, tol));
+            geosValid = geosResult.valid ? "valid" : "INVALID";
+            std::snprintf(buf, sizeof buf, "%.4g", geosResult.longestFreeEdge);
             geosLongest = buf;
-            GEOSGeom_destroy_r(H, hull);
         } else {
-            geosValid = "failed: " + lastGeosError;
+            geosValid = std::string("failed: ") + geosResult.error;
         }
         if (geosInput) GEOSGeom_destroy_r(H, geosInput);
     }
