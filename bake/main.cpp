@@ -443,7 +443,7 @@ CLI::App* addAggregate2DCommand(CLI::App& app, cli::Aggregate2DOptions& o) {
     cmd->add_option("--svg", o.svgPath, "Write an SVG picture (originals filled, aggregates outlined)");
     cmd->add_option("--png", o.pngPath, "Write a PNG picture (originals filled, aggregates outlined)");
     cmd->add_option("--stats", o.statsPath, "Write the measures of every level to this JSON file");
-    cmd->add_option("--threads", o.threads, "Threads for sculpting levels (default 0: all cores); output is identical for any count")
+    cmd->add_option("--threads", o.threads, "Threads (default 0: all cores); output is identical for any count")
         ->check(CLI::Range(0, 1024));
     cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
     return cmd;

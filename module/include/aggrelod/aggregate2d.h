@@ -48,7 +48,7 @@ struct Settings2D {
     Shape2D shape = Shape2D::Sculpted;
     bool computeBaselines = true;        ///< measure constant function and convex hulls at the same groups
     ProgressCallback progress;           ///< optional, called from the calling thread
-    int threadCount = 0;                 ///< threads for sculpting levels; 0 = hardware concurrency.
+    int threadCount = 0;                 ///< threads (contact checks, free-space passes, levels); 0 = hardware concurrency.
                                          ///< Results are identical for every thread count.
 };
 
