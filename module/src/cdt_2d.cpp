@@ -102,7 +102,11 @@ std::vector<uint32_t> hilbertOrder(const std::vector<double>& points) {
     // Biased randomized rounds (BRIO, as CGAL's spatial_sort): a point joins an earlier round
     // with probability 1/4 per round, from a hash of its index (deterministic); rounds go in
     // from the smallest, each along the curve.
-    std::vector<uint64_t> keyed(n);  // (round, curve position) << 32 | point index
+    struct Keyed {
+        uint64_t key;  // round << 32 | curve position
+        uint32_t point;
+    };
+    std::vector<Keyed> keyed(n);
     for (size_t i = 0; i < n; ++i) {
         uint64_t h = i + 0x9e3779b97f4a7c15ull;  // splitmix64
         h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -110,12 +114,12 @@ std::vector<uint32_t> hilbertOrder(const std::vector<double>& points) {
         h ^= h >> 31;
         uint64_t earlier = 0;
         while (earlier < 8 && ((h >> (62 - 2 * earlier)) & 3) == 3) ++earlier;
-        const uint64_t key = (8 - earlier) << 32 | hilbertIndex(cell(points[2 * i], minX), cell(points[2 * i + 1], minY));
-        keyed[i] = key << 28 | i;  // n < 2^28
+        keyed[i] = {(8 - earlier) << 32 | hilbertIndex(cell(points[2 * i], minX), cell(points[2 * i + 1], minY)),
+                    static_cast<uint32_t>(i)};
     }
-    radixSortStable(keyed, [](uint64_t k) { return k >> 28; }, 36);
+    radixSortStable(keyed, [](const Keyed& k) { return k.key; }, 36);
     std::vector<uint32_t> order(n);
-    for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(keyed[i] & ((1u << 28) - 1));
+    for (size_t i = 0; i < n; ++i) order[i] = keyed[i].point;
     return order;
 }
 
