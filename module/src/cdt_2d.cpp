@@ -41,7 +41,6 @@ using Point = Kernel::Point_2;
 
 struct ConstrainedTriangulation2D::Impl {
     Cdt cdt;
-    std::vector<Cdt::Vertex_handle> inputHandle;  // per build() input point
 };
 
 ConstrainedTriangulation2D::ConstrainedTriangulation2D() : impl_(new Impl) {}
@@ -202,8 +201,7 @@ bool ConstrainedTriangulation2D::build(const std::vector<double>& points,
         // step by step to keep the vertex of every input point: spatially sorted insertion
         // (hilbertOrder), then the constraints between the vertices.
         const std::vector<uint32_t> order = hilbertOrder(points);
-        std::vector<Cdt::Vertex_handle>& handle = impl_->inputHandle;
-        handle.assign(n, Cdt::Vertex_handle());
+        std::vector<Cdt::Vertex_handle> handle(n);  // per input point
         // The points go into a plain Delaunay triangulation on the same data structure (about
         // a quarter faster than the constrained one's insertion, with the same flips and
         // symbolic perturbation, so the same triangulation), which then becomes the

@@ -36,7 +36,6 @@ struct FreeSpace2D {
     std::vector<double> faceLongest; ///< per face: its longest edge
     std::vector<int> edgePair;       ///< 3 * faceCount: index into pairs, or kSameModelEdge2D / kUnpairedEdge2D
     std::vector<ModelPair2D> pairs;  ///< sorted by (a, b)
-    std::vector<uint64_t> pairKeys;  ///< per pair: a << 32 | b (compact, for pairIndex)
     std::vector<double> pairLengths;           ///< per pair: lengths of the free edges joining a and b, ascending
     std::vector<double> pairPrefixSum;         ///< per pair: running sums of its lengths, from 0
     std::vector<double> pairPrefixSumSquares;  ///< per pair: running sums of its squared lengths, from 0
@@ -48,8 +47,6 @@ struct FreeSpace2D {
     /// alone, with no kept free face, is exactly these polygons.
     std::vector<std::vector<Polygon2D>> modelPolygons;
 
-    /// Index of the pair (a, b) in `pairs`, -1 if the models share no free edge.
-    int pairIndex(uint32_t a, uint32_t b) const;
 };
 
 }  // namespace aggrelod::detail

@@ -399,6 +399,24 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
             if (v >= in.shared.size() || in.shared[v]) modelPlain[partModel[in.part[v]]] = 0;
         for (size_t f = 0; f < faceCount; ++f)  // inside two polygons: nested or overlapping parts
             if (winding[f] >= 2 && space.faceModel[f] >= 0) modelPlain[space.faceModel[f]] = 0;
+        // And every ring segment is still one constrained edge, with the model's face on its
+        // left (a vertex of another of its rings on it, e.g. a hole touching the exterior,
+        // splits it): count those edges per model against its segments.
+        std::vector<uint8_t> faceRingEdges(faceCount, 0);
+        forBlocks(faceCount, [&](size_t f) {
+            if (space.faceModel[f] < 0) return;
+            for (int j = 0; j < 3; ++j) {
+                if (!tri.constrained[3 * f + j]) continue;
+                const int iu = tri.vertexInput[tri.faces[3 * f + (j + 1) % 3]], iv = tri.vertexInput[tri.faces[3 * f + (j + 2) % 3]];
+                if (iu >= 0 && iv >= 0 && in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) ++faceRingEdges[f];
+            }
+        });
+        std::vector<size_t> intactSegments(space.modelCount, 0), ringSegments(space.modelCount, 0);
+        for (size_t f = 0; f < faceCount; ++f)
+            if (space.faceModel[f] >= 0) intactSegments[space.faceModel[f]] += faceRingEdges[f];
+        for (size_t v = 0; v < in.part.size(); ++v) ++ringSegments[partModel[in.part[v]]];
+        for (size_t m = 0; m < space.modelCount; ++m)
+            if (intactSegments[m] != ringSegments[m]) modelPlain[m] = 0;
         space.modelPolygons.assign(space.modelCount, {});
         for (size_t v = 0; v < in.part.size(); v += in.ringSize[v]) {
             const uint32_t p = in.part[v];
@@ -493,7 +511,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     // the least entry of the run by (distance, face, edge, connection).
     const size_t threads = threadCount > 0 ? static_cast<size_t>(threadCount)
                                            : std::max<size_t>(1, std::thread::hardware_concurrency());
-    const size_t chunks = std::min(faceBlocks, 2 * threads);
+    const size_t chunks = std::min({faceBlocks, 2 * threads, size_t{16}});  // chunks x models counters
     std::vector<std::vector<uint32_t>> chunkPlace(chunks, std::vector<uint32_t>(space.modelCount, 0));
     auto chunkFaces = [&](size_t c) { return std::make_pair(faceCount * c / chunks, faceCount * (c + 1) / chunks); };
     parallelFor(chunks, threadCount, [&](size_t c) {
@@ -587,7 +605,6 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     }
     const size_t pairCount = blockPairs[modelBlocks];
     space.pairs.resize(pairCount);
-    space.pairKeys.resize(pairCount);
     if (!graphOnly) {
         space.pairLengths.resize(blockLengths[modelBlocks]);
         space.pairPrefixSum.resize(blockLengths[modelBlocks] + pairCount);
@@ -613,7 +630,6 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
                 if (entries[k].distance == pair.minDistance && entries[k].face != pair.bestFace[0] &&
                     (pair.bestFace[1] < 0 || entries[k].face < pair.bestFace[1]))
                     pair.bestFace[1] = entries[k].face;
-            space.pairKeys[pairIndex] = static_cast<uint64_t>(pair.a) << 32 | pair.b;
             if (graphOnly) continue;
             pair.firstLength = static_cast<uint32_t>(lengthAt);
             for (size_t k = i; k < e; ++k)

@@ -29,14 +29,6 @@ uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
 
 }  // namespace
 
-int FreeSpace2D::pairIndex(uint32_t a, uint32_t b) const {
-    if (a > b) std::swap(a, b);
-    const uint64_t key = static_cast<uint64_t>(a) << 32 | b;
-    auto it = std::lower_bound(pairKeys.begin(), pairKeys.end(), key);
-    if (it == pairKeys.end() || *it != key) return -1;
-    return static_cast<int>(it - pairKeys.begin());
-}
-
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function) {
     EdgeLimits2D limits;
     AggregateFunctionInput same;
@@ -66,8 +58,14 @@ EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const A
         stats(pair.lengthCount, meanAll, in.sigmaAllEdges);
         limits.pair[p] = function(in);
     }
-    limits.smallest = std::min(limits.sameModel, limits.unpaired);
-    for (double limit : limits.pair) limits.smallest = std::min(limits.smallest, limit);
+    // (A NaN limit never carves, so it is left out.)
+    limits.smallest = INFINITY;
+    auto least = [&](double limit) {
+        if (limit < limits.smallest) limits.smallest = limit;
+    };
+    least(limits.sameModel);
+    least(limits.unpaired);
+    for (double limit : limits.pair) least(limit);
     return limits;
 }
 

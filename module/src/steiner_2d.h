@@ -16,9 +16,8 @@ namespace aggrelod::detail {
 /// triangulation, not on how it was built: each face's corners rotated to start at its
 /// smallest vertex (still counter-clockwise; neighbors and constrained rotate along), faces
 /// sorted by their sorted vertex triple, neighbour indices renumbered. threadCount: 0 = all
-/// cores; the result is the same for every count. faceValues (optional, one per face) are
-/// reordered along.
-void canonicalizeFaces2D(Triangulation2D& tri, int threadCount, std::vector<int>* faceValues = nullptr);
+/// cores; the result is the same for every count.
+void canonicalizeFaces2D(Triangulation2D& tri, int threadCount);
 
 /// Inserts the points of every split into `tri` (as build() exported it: vertexInput and
 /// inputVertex refer to build()'s input), each on the constrained edge from input point
@@ -30,13 +29,14 @@ void canonicalizeFaces2D(Triangulation2D& tri, int threadCount, std::vector<int>
 /// error off its segment is kept where it is: the chain bends by that error, as in CGAL.
 /// Only a segment that is still one constrained edge is split (not one already split by
 /// another ring's vertex); its points go in in order, and a point that would make a flat or
-/// inverted triangle (next to a sliver) ends that split. appliedCount[k]: how many points of
+/// inverted triangle (next to a sliver), or whose rounding error would make CGAL triangulate
+/// around it otherwise, ends that split. appliedCount[k]: how many points of
 /// splits[k] went in (a prefix). firstVertex[k]: the vertex of its first point; the others
 /// follow, consecutive. New vertices are appended with vertexInput -1; faces are changed in
 /// place or appended: call renumberAfterSplits2D() before reading the result.
 /// faceWinding (optional, one per face): winding numbers of the input rings, or any label
 /// that changes only across constrained edges; kept up to date (the pieces of a split face
-/// keep its value, a flip keeps its faces' common value, the flat face on a hull edge lies
+/// keep its value, a flip keeps its faces' common value, the thin face on a hull edge lies
 /// outside every ring: 0), so they need not be computed again.
 void insertSplitPoints2D(Triangulation2D& tri, const std::vector<ConstraintSplit>& splits,
                          std::vector<uint32_t>& appliedCount, std::vector<int>& firstVertex,

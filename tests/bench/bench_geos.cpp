@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cstdarg>
 #include <cmath>
 #include <cstdio>
@@ -228,7 +229,8 @@ GeosRun geosInChild(const GEOSGeometry* input, double ratio, double inputArea, c
     close(fds[1]);
     const ssize_t got = pid > 0 ? read(fds[0], &result, sizeof result) : -1;
     close(fds[0]);
-    if (pid > 0) waitpid(pid, nullptr, 0);
+    while (pid > 0 && waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+    }
     if (got != static_cast<ssize_t>(sizeof result)) {
         result = GeosRun{};
         std::snprintf(result.error, sizeof result.error, "GEOS child process gave no result");

@@ -247,6 +247,30 @@ TEST(Aggregate2D, NestedPolygonJoinsTheModelAroundIt) {
     EXPECT_EQ(geosValidity(both.polygons), "Valid Geometry");
 }
 
+// A hole touching its exterior at a vertex splits the exterior edge there: the output is
+// traced (the exterior keeps that vertex), not copied from the input rings.
+TEST(Aggregate2D, HoleTouchingItsExteriorKeepsTheTouchingVertex) {
+    Feature2D notched;
+    notched.name = "notched";
+    notched.polygons.push_back(Polygon2D{{0, 0, 4, 0, 4, 4, 0, 4}, {{2, 0, 1, 1, 3, 1}}});
+    Feature2D far;
+    far.name = "far";
+    far.id = 1;
+    far.polygons.push_back(Polygon2D{{20, 0, 22, 0, 22, 2, 20, 2}, {}});
+    Settings2D settings;
+    settings.deltas = {0.1};
+    Hierarchy2D h;
+    ASSERT_TRUE(buildHierarchy2D({notched, far}, settings, h));
+    ASSERT_EQ(h.levels[0].aggregates.size(), 2u);
+    const Aggregate2D& a = h.levels[0].aggregates[0];
+    EXPECT_EQ(geosValidity(a.polygons), "Valid Geometry");
+    EXPECT_NEAR(a.measures.area, 15.0, 1e-12);
+    bool touching = false;
+    for (const Polygon2D& p : a.polygons)
+        for (size_t i = 0; i + 1 < p.exterior.size(); i += 2) touching = touching || (p.exterior[i] == 2 && p.exterior[i + 1] == 0);
+    EXPECT_TRUE(touching) << "the exterior ring passes through the vertex the hole touches";
+}
+
 // With more than one thread the contact checks run beside a first triangulation of all
 // cleaned rings; a self-intersecting polygon they drop cancels it and the triangulation is
 // made again without that polygon: the result must equal the one-thread run, which checks
