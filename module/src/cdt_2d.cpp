@@ -171,15 +171,12 @@ void exportTriangulation(Cdt& cdt, const std::vector<Cdt::Vertex_handle>& inputV
     out.faces.resize(3 * faceCount);
     out.neighbors.resize(3 * faceCount);
     out.constrained.resize(3 * faceCount);
-    const size_t blocks = std::clamp<size_t>(faceCount / 16384, 1, 64);
-    parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i) {
-            const Cdt::Face_handle f = handles[i];
-            for (int k = 0; k < 3; ++k) {
-                out.faces[3 * i + k] = f->vertex(k)->info().index;
-                out.neighbors[3 * i + k] = f->neighbor(k)->info();
-                out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
-            }
+    parallelForEach(faceCount, threadCount, [&](size_t i) {
+        const Cdt::Face_handle f = handles[i];
+        for (int k = 0; k < 3; ++k) {
+            out.faces[3 * i + k] = f->vertex(k)->info().index;
+            out.neighbors[3 * i + k] = f->neighbor(k)->info();
+            out.constrained[3 * i + k] = f->is_constrained(k) ? 1 : 0;
         }
     });
     canonicalizeFaces2D(out, threadCount);

@@ -42,4 +42,15 @@ inline void parallelFor(size_t count, int threadCount, const std::function<void(
     if (failure) std::rethrow_exception(failure);
 }
 
+/// body(i) for i in [0, count), in contiguous blocks of about `grain` indices on up to
+/// threadCount threads; every index must write only its own output slots (the same result
+/// for any thread count).
+template <class Body>
+void parallelForEach(size_t count, int threadCount, Body&& body, size_t grain = 16384) {
+    const size_t blocks = std::clamp<size_t>(count / grain, 1, 64);
+    parallelFor(blocks, threadCount, [&](size_t block) {
+        for (size_t i = count * block / blocks; i < count * (block + 1) / blocks; ++i) body(i);
+    });
+}
+
 }  // namespace aggrelod::detail

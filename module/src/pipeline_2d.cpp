@@ -272,12 +272,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     const size_t faceCount = tri.faceCount(), vertexCount = tri.vertexCount();
     const size_t faceBlocks = std::clamp<size_t>(faceCount / 8192, 1, 64);
     // Part of each vertex and of each interior face (parallel blocks, each writing its own slots).
-    auto forBlocks = [&](size_t count, auto&& body) {
-        const size_t blocks = std::clamp<size_t>(count / 16384, 1, 64);
-        parallelFor(blocks, threadCount, [&](size_t block) {
-            for (size_t i = count * block / blocks; i < count * (block + 1) / blocks; ++i) body(i);
-        });
-    };
+    auto forBlocks = [&](size_t count, auto&& body) { parallelForEach(count, threadCount, body); };
     std::vector<int> vertexPart(vertexCount, -1);
     forBlocks(vertexCount, [&](size_t v) {
         if (tri.vertexInput[v] >= 0) vertexPart[v] = static_cast<int>(in.part[tri.vertexInput[v]]);
@@ -288,15 +283,17 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     // polygon nested inside another's interior leaves the faces between the two rings to the
     // outer one, and the two meet face to face (joined into one model below).
     std::vector<int> facePart(faceCount, -1);
+    std::vector<uint8_t> faceRingEdges(faceCount, 0);  // per interior face: whole ring segments on its edges
     std::vector<char> unowned(faceBlocks, 0);  // per block: an interior face left without a part
     parallelFor(faceBlocks, threadCount, [&](size_t block) {
         for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f) {
             if (winding[f] < 1) continue;
-            for (int j = 0; j < 3 && facePart[f] < 0; ++j) {
+            for (int j = 0; j < 3; ++j) {
                 if (!tri.constrained[3 * f + j]) continue;
                 const int iu = tri.vertexInput[tri.faces[3 * f + (j + 1) % 3]], iv = tri.vertexInput[tri.faces[3 * f + (j + 2) % 3]];
-                if (iu >= 0 && iv >= 0 && in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv))
-                    facePart[f] = static_cast<int>(in.part[iu]);  // the ring runs iu -> iv, f on its left
+                if (iu < 0 || iv < 0 || in.next(static_cast<size_t>(iu)) != static_cast<size_t>(iv)) continue;
+                ++faceRingEdges[f];  // the ring runs iu -> iv, f on its left
+                if (facePart[f] < 0) facePart[f] = static_cast<int>(in.part[iu]);
             }
             if (facePart[f] < 0) unowned[block] = 1;
         }
@@ -401,16 +398,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
             if (winding[f] >= 2 && space.faceModel[f] >= 0) modelPlain[space.faceModel[f]] = 0;
         // And every ring segment is still one constrained edge, with the model's face on its
         // left (a vertex of another of its rings on it, e.g. a hole touching the exterior,
-        // splits it): count those edges per model against its segments.
-        std::vector<uint8_t> faceRingEdges(faceCount, 0);
-        forBlocks(faceCount, [&](size_t f) {
-            if (space.faceModel[f] < 0) return;
-            for (int j = 0; j < 3; ++j) {
-                if (!tri.constrained[3 * f + j]) continue;
-                const int iu = tri.vertexInput[tri.faces[3 * f + (j + 1) % 3]], iv = tri.vertexInput[tri.faces[3 * f + (j + 2) % 3]];
-                if (iu >= 0 && iv >= 0 && in.next(static_cast<size_t>(iu)) == static_cast<size_t>(iv)) ++faceRingEdges[f];
-            }
-        });
+        // splits it): the faces' whole ring segments, per model, against its segments.
         std::vector<size_t> intactSegments(space.modelCount, 0), ringSegments(space.modelCount, 0);
         for (size_t f = 0; f < faceCount; ++f)
             if (space.faceModel[f] >= 0) intactSegments[space.faceModel[f]] += faceRingEdges[f];
@@ -652,12 +640,11 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
         }
     });
     if (!graphOnly) {
-        parallelFor(faceBlocks, threadCount, [&](size_t block) {
-            for (size_t f = faceCount * block / faceBlocks; f < faceCount * (block + 1) / faceBlocks; ++f)
-                for (int j = 0; j < 3; ++j) {
-                    const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
-                    if (space.vertexModel[u] < 0 || space.vertexModel[w] < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
-                }
+        forBlocks(faceCount, [&](size_t f) {
+            for (int j = 0; j < 3; ++j) {
+                const int u = tri.faces[3 * f + (j + 1) % 3], w = tri.faces[3 * f + (j + 2) % 3];
+                if (space.vertexModel[u] < 0 || space.vertexModel[w] < 0) space.edgePair[3 * f + j] = kUnpairedEdge2D;
+            }
         });
     }
 }
@@ -990,7 +977,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
     const AggregateFunction constant = makeAggregateFunction(AggregateFunctionKind::Constant);
     const AggregateFunction adaptive = makeAggregateFunction(AggregateFunctionKind::Adaptive);
     const ConnectionFans2D fans = settings.shape == Shape2D::Sculpted || settings.computeBaselines
-                                      ? computeConnectionFans2D(space, std::vector<int>(mergePair.begin(), mergePair.end()), settings.threadCount)
+                                      ? computeConnectionFans2D(space, mergePair, settings.threadCount)
                                       : ConnectionFans2D{};
     // F of every pair at every level: a custom function (user code) on the calling thread, the
     // built-in ones inside the parallel level loop below.

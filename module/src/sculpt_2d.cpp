@@ -185,14 +185,12 @@ struct HalfEdge {
 
 }  // namespace
 
-ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<int>& mergePair, int threadCount) {
+ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<uint32_t>& mergePair, int threadCount) {
     const Triangulation2D& tri = space.tri;
-    // The merges with a pair by their first best face (key: face << 32 | merge).
-    std::vector<uint64_t> keyed;
-    keyed.reserve(mergePair.size());
+    // The merges by their first best face (key: face << 32 | merge).
+    std::vector<uint64_t> keyed(mergePair.size());
     for (size_t k = 0; k < mergePair.size(); ++k)
-        if (mergePair[k] >= 0)
-            keyed.push_back(static_cast<uint64_t>(static_cast<uint32_t>(space.pairs[mergePair[k]].bestFace[0])) << 32 | k);
+        keyed[k] = static_cast<uint64_t>(static_cast<uint32_t>(space.pairs[mergePair[k]].bestFace[0])) << 32 | k;
     std::sort(keyed.begin(), keyed.end());
     std::vector<uint32_t> order(keyed.size());
     for (size_t p = 0; p < keyed.size(); ++p) order[p] = static_cast<uint32_t>(keyed[p]);

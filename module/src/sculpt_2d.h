@@ -20,15 +20,15 @@ struct EdgeLimits2D {
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function);
 
 /// The fans of free faces that can carry each merge's shortest connection to its two models
-/// (DESIGN 2.4 step 4), walked once for all levels. The merges with a pair are kept in
-/// `order`, by their pair's first best face (neighbouring merges touch neighbouring faces).
+/// (DESIGN 2.4 step 4), walked once for all levels. The merges are kept in `order`, by their
+/// pair's first best face (neighbouring merges touch neighbouring faces).
 /// For the merge at position p of `order`, best face i (of the pair's two) and model s (0:
 /// pair.a, 1: pair.b), slot 4p + 2i + s lists the walks around the model's vertices from that
 /// face that reach the model's interior, in walk order. A level keeps the least-area one whose
 /// faces are all kept in the group and no longer than delta.
 struct ConnectionFans2D {
-    std::vector<int> pair;            ///< per merge: index into space.pairs, -1 if none
-    std::vector<uint32_t> order;      ///< merges with a pair, by first best face
+    std::vector<uint32_t> pair;       ///< per merge: index into space.pairs
+    std::vector<uint32_t> order;      ///< the merges, by their pair's first best face
     std::vector<uint32_t> slotBegin;  ///< 4 * order.size() + 1: candidates of each slot
     std::vector<uint32_t> pathBegin;  ///< per candidate, + 1: its faces are faces[pathBegin[c], pathBegin[c + 1])
     std::vector<double> pathArea;     ///< per candidate: total area of its faces
@@ -37,7 +37,7 @@ struct ConnectionFans2D {
 };
 
 /// mergePair: per merge of the dendrogram (ascending height), its index into space.pairs.
-ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<int>& mergePair, int threadCount);
+ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::vector<uint32_t>& mergePair, int threadCount);
 
 /// Labels every face with the group whose aggregate contains it (-1: in none).
 /// The first `joinedMerges` merges (those of this level) keep their shortest connection

@@ -19,17 +19,14 @@ void canonicalizeFaces2D(Triangulation2D& tri, int threadCount) {
     std::vector<uint8_t> rotation(faceCount);  // corner that comes first: the smallest
     std::vector<uint32_t> smallest(faceCount);
     std::vector<uint64_t> rest(faceCount);
-    const size_t blocks = std::clamp<size_t>(faceCount / 16384, 1, 64);
-    parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t f = faceCount * block / blocks; f < faceCount * (block + 1) / blocks; ++f) {
-            const uint32_t c[3] = {static_cast<uint32_t>(tri.faces[3 * f]), static_cast<uint32_t>(tri.faces[3 * f + 1]),
-                                   static_cast<uint32_t>(tri.faces[3 * f + 2])};
-            const int r = c[1] < c[0] ? (c[2] < c[1] ? 2 : 1) : (c[2] < c[0] ? 2 : 0);
-            rotation[f] = static_cast<uint8_t>(r);
-            smallest[f] = c[r];
-            const uint32_t u = c[(r + 1) % 3], w = c[(r + 2) % 3];
-            rest[f] = u < w ? static_cast<uint64_t>(u) << 32 | w : static_cast<uint64_t>(w) << 32 | u;
-        }
+    parallelForEach(faceCount, threadCount, [&](size_t f) {
+        const uint32_t c[3] = {static_cast<uint32_t>(tri.faces[3 * f]), static_cast<uint32_t>(tri.faces[3 * f + 1]),
+                               static_cast<uint32_t>(tri.faces[3 * f + 2])};
+        const int r = c[1] < c[0] ? (c[2] < c[1] ? 2 : 1) : (c[2] < c[0] ? 2 : 0);
+        rotation[f] = static_cast<uint8_t>(r);
+        smallest[f] = c[r];
+        const uint32_t u = c[(r + 1) % 3], w = c[(r + 2) % 3];
+        rest[f] = u < w ? static_cast<uint64_t>(u) << 32 | w : static_cast<uint64_t>(w) << 32 | u;
     });
     // Counting sort on the smallest corner, then insertion sorts of the (tiny) buckets.
     std::vector<uint32_t> bucketStart(vertexCount + 1, 0);
@@ -40,32 +37,27 @@ void canonicalizeFaces2D(Triangulation2D& tri, int threadCount) {
         std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
         for (size_t f = 0; f < faceCount; ++f) sorted[fill[smallest[f]]++] = static_cast<uint32_t>(f);
     }
-    const size_t vertexBlocks = std::clamp<size_t>(vertexCount / 8192, 1, 64);
-    parallelFor(vertexBlocks, threadCount, [&](size_t block) {
-        for (size_t v = vertexCount * block / vertexBlocks; v < vertexCount * (block + 1) / vertexBlocks; ++v) {
+    parallelForEach(
+        vertexCount, threadCount,
+        [&](size_t v) {
             uint32_t* first = sorted.data() + bucketStart[v];
             uint32_t* last = sorted.data() + bucketStart[v + 1];
             for (uint32_t* i = first + 1; i < last; ++i)
                 for (uint32_t* j = i; j > first && rest[*(j - 1)] > rest[*j]; --j) std::swap(*(j - 1), *j);
-        }
-    });
+        },
+        8192);
     std::vector<int> newIndex(faceCount);
-    parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t i = faceCount * block / blocks; i < faceCount * (block + 1) / blocks; ++i)
-            newIndex[sorted[i]] = static_cast<int>(i);
-    });
+    parallelForEach(faceCount, threadCount, [&](size_t i) { newIndex[sorted[i]] = static_cast<int>(i); });
     std::vector<int> faces(3 * faceCount), neighbors(3 * faceCount);
     std::vector<char> constrained(3 * faceCount);
     // Old faces in order (sequential reads), each writing its new slots.
-    parallelFor(blocks, threadCount, [&](size_t block) {
-        for (size_t f = faceCount * block / blocks; f < faceCount * (block + 1) / blocks; ++f) {
-            const size_t i = static_cast<size_t>(newIndex[f]);
-            for (int k = 0; k < 3; ++k) {
-                const size_t from = 3 * f + (k + rotation[f]) % 3;
-                faces[3 * i + k] = tri.faces[from];
-                neighbors[3 * i + k] = tri.neighbors[from] < 0 ? -1 : newIndex[static_cast<size_t>(tri.neighbors[from])];
-                constrained[3 * i + k] = tri.constrained[from];
-            }
+    parallelForEach(faceCount, threadCount, [&](size_t f) {
+        const size_t i = static_cast<size_t>(newIndex[f]);
+        for (int k = 0; k < 3; ++k) {
+            const size_t from = 3 * f + (k + rotation[f]) % 3;
+            faces[3 * i + k] = tri.faces[from];
+            neighbors[3 * i + k] = tri.neighbors[from] < 0 ? -1 : newIndex[static_cast<size_t>(tri.neighbors[from])];
+            constrained[3 * i + k] = tri.constrained[from];
         }
     });
     tri.faces = std::move(faces);
