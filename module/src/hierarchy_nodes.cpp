@@ -250,6 +250,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
         std::vector<const detail::PreparedOriginal*> originals;
         for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
+        n.budget = settings.simplifyFraction * n.delta;  // not yet enforced
         n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals,
                                                     settings.toleranceFraction * n.delta,
                                                     settings.maxRefinementsPerDirection);

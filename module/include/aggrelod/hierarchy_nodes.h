@@ -59,6 +59,10 @@ struct HierarchyNode {
     std::vector<uint32_t> children;    ///< node indices, ascending (all smaller than this node's)
     std::vector<uint32_t> sources;     ///< original object indices, ascending
     bool leaf = false;                 ///< an original object (node index = object index)
+    /// 0 for leaves and aggregates; j >= 1 for the j-th simplified version of a single object
+    /// (per-object LOD below the aggregation levels; sources holds that one object, firstLevel
+    /// and lastLevel are -1, j rises towards the root of its chain).
+    int objectLod = 0;
     int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
     int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
     uint32_t aggregateIndex = 0;       ///< index in levels[firstLevel].aggregates (aggregates only)
@@ -71,6 +75,8 @@ struct HierarchyNode {
     std::vector<float> faceColors;
     size_t exactTriangleCount = 0;     ///< triangles of the unsimplified aggregate (leaf: of the object)
     ProxyError error;                  ///< measured error of this node's proxy (zeros for leaves)
+    /// Error budget the proxy was made for, world units (0 for leaves): error.bound() <= budget.
+    double budget = 0;
     /// Stored geometric error, world units: max(error.bound(), every child's geometricError),
     /// so it never decreases towards the roots. Exactly representable as a float (rounded up).
     double geometricError = 0;
