@@ -4,7 +4,8 @@
 // measures its error (proxy_error.cpp), colours its faces after the nearest original surface
 // (surface_colors.cpp), and makes bounds nested and errors monotone so that
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
-#include "mesh_simplify.h"
+#include "conservative_simplify.h"
+#include "mesh_preparation.h"
 #include "parallel_for.h"
 #include "proxy_error.h"
 #include "surface_colors.h"
@@ -96,6 +97,91 @@ bool sameSolid(const Aggregate& a, const Aggregate& b) {
     if (a.indices == b.indices && a.positions == b.positions) return true;
     return nearlyEqual(a.measures.volume, b.measures.volume) && nearlyEqual(a.measures.area, b.measures.area) &&
            sortedVertices(a) == sortedVertices(b);
+}
+
+
+std::vector<float> toFloats(const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); }
+
+/// Error budgets tried for a proxy, as fractions of its budget, coarsest first: the
+/// simplification's estimate counts only the push-out from the exact aggregate, the
+/// certified error adds the fill's own distance to the originals.
+constexpr double kProxyTargetFractions[] = {1.0 / 32, 1.0 / 16, 1.0 / 8, 1.0 / 4, 1.0 / 2, 1.0};
+
+/// The proxy of an aggregate node: the coarsest conservative simplification of the exact
+/// aggregate that does not intersect itself and whose certified error is within
+/// node.budget; the exact aggregate itself when none is (the budget is then raised to its
+/// error: nothing that encloses the aggregate can do better).
+void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::PreparedOriginal*>& originals,
+                        const ProxySettings& settings, HierarchyNode& n) {
+    const double tolerance = settings.toleranceFraction * n.delta;
+    std::vector<double> targets;
+    for (double f : kProxyTargetFractions) targets.push_back(f * n.budget);
+    std::vector<detail::ConservativeSnapshot> snapshots;
+    if (n.budget > 0) detail::simplifyConservativeSeries(agg.positions, agg.indices, targets, 0, snapshots);
+    for (size_t i = snapshots.size(); i-- > 0;) {
+        const detail::ConservativeSnapshot& s = snapshots[i];
+        if (s.indices.size() >= agg.indices.size()) break;  // no coarser than the exact one
+        if (i + 1 < snapshots.size() && s.indices.size() == snapshots[i + 1].indices.size()) continue;  // same mesh
+        if (detail::meshSelfIntersects(s.positions, s.indices)) continue;
+        std::vector<float> positions = toFloats(s.positions);
+        const ProxyError e = detail::measureProxyErrorPrepared(positions, s.indices, originals, tolerance,
+                                                                settings.maxRefinementsPerDirection);
+        if (e.bound() <= n.budget) {
+            n.positions = std::move(positions);
+            n.indices = s.indices;
+            n.error = e;
+            return;
+        }
+    }
+    n.positions = toFloats(agg.positions);
+    n.indices = agg.indices;
+    n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals, tolerance,
+                                                settings.maxRefinementsPerDirection);
+    n.budget = std::max(n.budget, n.error.bound());
+}
+
+/// Per-object LOD below an object's first aggregate (DESIGN section 2.6): conservative
+/// simplifications of the object at errors halving down from its parent's error, each kept
+/// when it is a valid enclosure, fits its budget and saves a quarter of the triangles of
+/// the finer one. Returned finest first; empty for an object that is not a closed solid
+/// (only a closed mesh can be simplified into an enclosure of it).
+std::vector<HierarchyNode> objectLodChain(const InputObject& object, const detail::PreparedOriginal& original,
+                                          double parentError, const ProxySettings& settings) {
+    std::vector<HierarchyNode> chain;
+    if (!(parentError > 0) || settings.objectLodCount <= 0) return chain;
+    detail::PreparedObject prepared;
+    std::vector<Diagnostic> ignored;  // the bake reported the object's problems already
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i + 2 < object.positions.size(); i += 3) growBox(lo, hi, &object.positions[i]);
+    const double diagonal = distance(lo, hi);
+    detail::prepareObject(object, 1e-14 * diagonal * diagonal, prepared, ignored);
+    if (!prepared.validSolid()) return chain;
+    std::vector<double> targets;  // ascending
+    for (int j = settings.objectLodCount; j >= 1; --j) targets.push_back(parentError * std::ldexp(1.0, -j));
+    std::vector<detail::ConservativeSnapshot> snapshots;
+    detail::simplifyConservativeSeries(prepared.positions, prepared.triangles, targets, 0, snapshots);
+    size_t finerTriangles = object.indices.size() / 3;
+    const std::vector<const detail::PreparedOriginal*> originals{&original};
+    for (size_t i = 0; i < snapshots.size(); ++i) {
+        const detail::ConservativeSnapshot& s = snapshots[i];
+        const size_t triangles = s.indices.size() / 3;
+        if (4 * triangles > 3 * finerTriangles) continue;
+        if (detail::meshSelfIntersects(s.positions, s.indices)) continue;
+        HierarchyNode n;
+        n.objectLod = static_cast<int>(chain.size()) + 1;
+        n.sources = {object.id};
+        n.budget = std::min(2 * targets[i], parentError);
+        n.positions = toFloats(s.positions);
+        n.indices = s.indices;
+        n.exactTriangleCount = object.indices.size() / 3;
+        n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals,
+                                                    settings.toleranceFraction * targets[i],
+                                                    settings.maxRefinementsPerDirection);
+        if (!(n.error.bound() <= n.budget) || !(n.error.bound() < parentError)) continue;
+        finerTriangles = triangles;
+        chain.push_back(std::move(n));
+    }
+    return chain;
 }
 
 }  // namespace
@@ -243,20 +329,64 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     detail::parallelFor(nodes.size() - objectCount, settings.threadCount, [&](size_t j) {
         HierarchyNode& n = nodes[objectCount + j];
         const Aggregate& agg = aggregateOf(n);
-        const std::vector<float> exact(agg.positions.begin(), agg.positions.end());
-        detail::simplifyMesh(exact, agg.indices, settings.simplifyFraction * n.delta, n.positions, n.indices);
+        std::vector<const detail::PreparedOriginal*> originals;
+        for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
+        n.budget = settings.simplifyFraction * n.delta;
+        makeAggregateProxy(agg, originals, settings, n);
         std::vector<const InputObject*> sourceObjects;
         for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
         detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
-        std::vector<const detail::PreparedOriginal*> originals;
-        for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
-        n.budget = settings.simplifyFraction * n.delta;  // not yet enforced
-        n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals,
-                                                    settings.toleranceFraction * n.delta,
-                                                    settings.maxRefinementsPerDirection);
     }, [&](size_t done) {
         if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
     });
+
+    // Per-object LOD chains between each leaf and its first aggregate, then renumbered:
+    // leaves, chains (object by object, finest first), aggregates.
+    std::vector<std::vector<HierarchyNode>> chains(objectCount);
+    detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
+        const uint32_t parent = nodes[o].parent;
+        if (parent == kNoNode || nodes[o].positions.empty()) return;
+        InputObject object = objects[o];
+        object.id = static_cast<uint32_t>(o);  // sources are object indices
+        chains[o] = objectLodChain(object, prepared[o], nodes[parent].error.bound(), settings);
+        std::vector<const InputObject*> source{&objects[o]};
+        for (HierarchyNode& c : chains[o]) detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);
+    });
+    size_t chainCount = 0;
+    for (const auto& c : chains) chainCount += c.size();
+    if (chainCount > 0) {
+        auto shifted = [&](uint32_t i) { return i == kNoNode || i < objectCount ? i : uint32_t(i + chainCount); };
+        std::vector<HierarchyNode> renumbered;
+        renumbered.reserve(nodes.size() + chainCount);
+        for (size_t o = 0; o < objectCount; ++o) renumbered.push_back(std::move(nodes[o]));
+        for (size_t o = 0; o < objectCount; ++o)
+            for (HierarchyNode& c : chains[o]) renumbered.push_back(std::move(c));
+        for (size_t i = objectCount; i < nodes.size(); ++i) renumbered.push_back(std::move(nodes[i]));
+        for (HierarchyNode& n : renumbered) {
+            n.parent = shifted(n.parent);
+            for (uint32_t& c : n.children) c = shifted(c);
+        }
+        for (uint32_t& r : out.roots) r = shifted(r);
+        for (auto& level : out.nodeOfAggregate)
+            for (uint32_t& i : level) i = shifted(i);
+        uint32_t next = static_cast<uint32_t>(objectCount);
+        for (size_t o = 0; o < objectCount; ++o) {
+            uint32_t below = static_cast<uint32_t>(o);
+            const uint32_t top = renumbered[o].parent;
+            for (size_t j = 0; j < chains[o].size(); ++j, ++next) {
+                renumbered[below].parent = next;
+                renumbered[next].children = {below};
+                below = next;
+            }
+            if (below != o) {
+                renumbered[below].parent = top;
+                for (uint32_t& c : renumbered[top].children)
+                    if (c == o) c = below;
+                std::sort(renumbered[top].children.begin(), renumbered[top].children.end());
+            }
+        }
+        nodes = std::move(renumbered);
+    }
 
     // Errors and bounds, children first (children have smaller indices than their parent).
     const std::vector<double> none;
@@ -265,7 +395,9 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         double e = n.leaf ? 0.0 : n.error.bound();
         for (uint32_t c : n.children) e = std::max(e, nodes[c].geometricError);
         n.geometricError = floatUp(e);
-        computeBounds(n, n.leaf ? (n.positions.empty() ? none : objects[i].positions) : aggregateOf(n).positions, nodes);
+        const std::vector<double>& exact = n.leaf ? (n.positions.empty() ? none : objects[i].positions)
+                                           : n.objectLod > 0 ? none : aggregateOf(n).positions;
+        computeBounds(n, exact, nodes);
     }
     return true;
 }

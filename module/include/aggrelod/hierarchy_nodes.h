@@ -25,9 +25,14 @@ namespace aggrelod {
 constexpr uint32_t kNoNode = 0xFFFFFFFFu;
 
 struct ProxySettings {
-    /// meshoptimizer's target error for the proxy of a level-k aggregate, as a fraction of
-    /// delta_k (world units once multiplied). 0 keeps the exact aggregate as its proxy.
-    double simplifyFraction = 0.25;
+    /// Error budget of the proxy of a level-k aggregate, as a fraction of delta_k (world
+    /// units once multiplied): the proxy is the coarsest enclosing simplification whose
+    /// certified error fits it (or the exact aggregate, when even that does not fit: the
+    /// budget is then raised to its error). 0 keeps the exact aggregate as its proxy.
+    double simplifyFraction = 0.5;
+    /// Most simplified versions of one object below its first aggregate (per-object LOD);
+    /// their errors halve down from that aggregate's error. 0 = none.
+    int objectLodCount = 8;
     /// How far (world units, as a fraction of delta_k) the certified upper bound of the
     /// error may exceed the largest distance actually found; the refinement stops there ...
     double toleranceFraction = 0.02;

@@ -1,0 +1,456 @@
+// aggrelod module: conservative simplification of closed meshes (DESIGN section 2.6).
+//
+// Implements progressive hulls (Sander, Gu, Gortler, Hoppe, Snyder, "Silhouette clipping",
+// SIGGRAPH 2000, section 3.3): an edge collapse whose new vertex lies on or outside the
+// plane of every face around the edge (before the collapse) gives a mesh that encloses the
+// one before it, so the whole sequence encloses the input. The feasible positions form a
+// convex polyhedron; candidates (the quadric optimum of Garland and Heckbert, SIGGRAPH 1997,
+// the midpoint and both end points) are pushed along the mean normal of the edge's faces
+// into it, and the one with the smallest error estimate wins.
+//
+// Error estimate: a vertex carries the largest distance by which the surface around it has
+// been pushed out; a collapse adds the largest distance of its new vertex to the planes of
+// the faces it replaces. Collapses run cheapest first (binary heap, lazily re-evaluated:
+// an entry is recomputed when popped and pushed back when its cost rose).
+#include "conservative_simplify.h"
+
+#include "mesh_distance.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <tuple>
+
+namespace aggrelod::detail {
+namespace {
+
+struct V3 {
+    double x = 0, y = 0, z = 0;
+};
+V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
+double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double length(V3 a) { return std::sqrt(dot(a, a)); }
+
+/// Symmetric 4x4 quadric of plane distances: sum of w (n.p + d)^2.
+struct Quadric {
+    double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0, xw = 0, yw = 0, zw = 0, ww = 0;
+    void addPlane(V3 n, double d, double w) {
+        xx += w * n.x * n.x; xy += w * n.x * n.y; xz += w * n.x * n.z;
+        yy += w * n.y * n.y; yz += w * n.y * n.z; zz += w * n.z * n.z;
+        xw += w * n.x * d; yw += w * n.y * d; zw += w * n.z * d; ww += w * d * d;
+    }
+    Quadric& operator+=(const Quadric& q) {
+        xx += q.xx; xy += q.xy; xz += q.xz; yy += q.yy; yz += q.yz; zz += q.zz;
+        xw += q.xw; yw += q.yw; zw += q.zw; ww += q.ww;
+        return *this;
+    }
+    double eval(V3 p) const {
+        return xx * p.x * p.x + 2 * xy * p.x * p.y + 2 * xz * p.x * p.z + yy * p.y * p.y + 2 * yz * p.y * p.z +
+               zz * p.z * p.z + 2 * (xw * p.x + yw * p.y + zw * p.z) + ww;
+    }
+    /// Minimiser of eval, when the 3x3 part is well conditioned.
+    bool optimum(V3& out) const {
+        const double det = xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+        const double scale = std::max({std::fabs(xx), std::fabs(yy), std::fabs(zz)});
+        if (!(std::fabs(det) > 1e-9 * scale * scale * scale)) return false;
+        // Cramer's rule on A p = -b.
+        const double bx = -xw, by = -yw, bz = -zw;
+        out.x = (bx * (yy * zz - yz * yz) - xy * (by * zz - yz * bz) + xz * (by * yz - yy * bz)) / det;
+        out.y = (xx * (by * zz - yz * bz) - bx * (xy * zz - yz * xz) + xz * (xy * bz - by * xz)) / det;
+        out.z = (xx * (yy * bz - by * yz) - xy * (xy * bz - by * xz) + bx * (xy * yz - yy * xz)) / det;
+        return std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.z);
+    }
+};
+
+struct Candidate {
+    V3 position;
+    double cost = 0;  ///< accumulated error estimate of the merged vertex
+    double quadric = 0;
+};
+
+class Simplifier {
+public:
+    Simplifier(const std::vector<double>& positions, const std::vector<uint32_t>& indices) {
+        const size_t n = positions.size() / 3;
+        p_.resize(n);
+        for (size_t v = 0; v < n; ++v) p_[v] = {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
+        faces_.resize(indices.size() / 3);
+        faceAlive_.assign(faces_.size(), 1);
+        vertexFaces_.resize(n);
+        quadric_.resize(n);
+        error_.assign(n, 0.0);
+        stamp_.assign(n, 0);
+        alive_.assign(n, 0);
+        double extent = 0;
+        for (const V3& q : p_) extent = std::max({extent, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+        epsilon_ = 1e-12 * std::max(extent, 1e-300);
+        for (size_t f = 0; f < faces_.size(); ++f) {
+            faces_[f] = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
+            for (uint32_t v : faces_[f]) {
+                vertexFaces_[v].push_back(static_cast<uint32_t>(f));
+                alive_[v] = 1;
+            }
+            V3 nrm = faceNormal(static_cast<uint32_t>(f));
+            const double len = length(nrm);
+            if (len > 0) {
+                nrm = (1 / len) * nrm;
+                const double d = -dot(nrm, p_[faces_[f][0]]);
+                // Area-weighted planes: large faces dominate the placement.
+                for (uint32_t v : faces_[f]) quadric_[v].addPlane(nrm, d, 0.5 * len);
+            }
+        }
+        // A vertex sharing its position with another one (the solid touches itself there)
+        // stays put: moving it would open or overlap the contact.
+        locked_.assign(n, 0);
+        std::vector<uint32_t> order(n);
+        for (uint32_t v = 0; v < n; ++v) order[v] = v;
+        auto key = [&](uint32_t v) { return std::make_tuple(p_[v].x, p_[v].y, p_[v].z); };
+        std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b) || (key(a) == key(b) && a < b); });
+        for (size_t i = 1; i < n; ++i)
+            if (key(order[i]) == key(order[i - 1])) locked_[order[i]] = locked_[order[i - 1]] = 1;
+        liveFaces_ = faces_.size();
+    }
+
+    /// Collapses while the cheapest collapse costs <= maxError and more than minTriangles
+    /// faces are left. Can be called again with a larger maxError to go on from there.
+    void run(double maxError, size_t minTriangles, ConservativeSimplifyResult& result) {
+        if (!started_) {
+            started_ = true;
+            for (uint32_t v = 0; v < p_.size(); ++v)
+                if (alive_[v]) pushEdgesOf(v);
+        }
+        while (!heap_.empty() && liveFaces_ > minTriangles && heap_.top().cost <= maxError) {
+            const Entry e = heap_.top();
+            heap_.pop();
+            if (!alive_[e.a] || !alive_[e.b] || stamp_[e.a] != e.stampA || stamp_[e.b] != e.stampB) continue;
+            Candidate c;
+            if (!evaluate(e.a, e.b, c)) continue;
+            if (c.cost > e.cost + epsilon_) {  // the neighbourhood changed since it was pushed
+                heap_.push(Entry{c.cost, e.a, e.b, e.stampA, e.stampB});
+                continue;
+            }
+            collapse(e.a, e.b, c);
+            ++result.collapses;
+            result.errorEstimate = std::max(result.errorEstimate, c.cost);
+            pushEdgesOf(e.a);
+        }
+    }
+
+    size_t triangleCount() const { return liveFaces_; }
+
+    void output(std::vector<double>& outPositions, std::vector<uint32_t>& outIndices) const {
+        std::vector<uint32_t> remap(p_.size(), UINT32_MAX);
+        outPositions.clear();
+        outIndices.clear();
+        uint32_t next = 0;
+        for (size_t f = 0; f < faces_.size(); ++f) {
+            if (!faceAlive_[f]) continue;
+            for (uint32_t v : faces_[f]) {
+                if (remap[v] == UINT32_MAX) {
+                    remap[v] = next++;
+                    outPositions.insert(outPositions.end(), {p_[v].x, p_[v].y, p_[v].z});
+                }
+                outIndices.push_back(remap[v]);
+            }
+        }
+    }
+
+private:
+    struct Entry {
+        double cost;
+        uint32_t a, b;
+        uint32_t stampA, stampB;
+        bool operator<(const Entry& o) const {  // priority_queue pops the largest: invert
+            if (cost != o.cost) return cost > o.cost;
+            if (a != o.a) return a > o.a;
+            return b > o.b;
+        }
+    };
+
+    V3 faceNormal(uint32_t f) const {
+        const auto& t = faces_[f];
+        return cross(p_[t[1]] - p_[t[0]], p_[t[2]] - p_[t[0]]);
+    }
+
+    void neighbours(uint32_t v, std::vector<uint32_t>& out) const {
+        out.clear();
+        for (uint32_t f : vertexFaces_[v])
+            for (uint32_t w : faces_[f])
+                if (w != v) out.push_back(w);
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
+
+    void pushEdgesOf(uint32_t v) {
+        neighbours(v, scratchNeighbours_);
+        const std::vector<uint32_t> ring = scratchNeighbours_;
+        for (uint32_t w : ring) {
+            Candidate c;
+            if (evaluate(v, w, c)) heap_.push(Entry{c.cost, v, w, stamp_[v], stamp_[w]});
+        }
+    }
+
+    /// Best enclosing position for collapsing edge (a, b) into a; false when the collapse is
+    /// not allowed.
+    bool evaluate(uint32_t a, uint32_t b, Candidate& best) {
+        if (locked_[a] || locked_[b]) return false;
+        // Faces around the edge: exactly two contain both ends (manifold edge).
+        std::vector<uint32_t>& around = scratchFaces_;
+        around.clear();
+        around.insert(around.end(), vertexFaces_[a].begin(), vertexFaces_[a].end());
+        around.insert(around.end(), vertexFaces_[b].begin(), vertexFaces_[b].end());
+        std::sort(around.begin(), around.end());
+        around.erase(std::unique(around.begin(), around.end()), around.end());
+        uint32_t opposite[2];
+        int shared = 0;
+        for (uint32_t f : around) {
+            const auto& t = faces_[f];
+            const bool hasA = t[0] == a || t[1] == a || t[2] == a;
+            const bool hasB = t[0] == b || t[1] == b || t[2] == b;
+            if (hasA && hasB) {
+                if (shared == 2) return false;
+                for (uint32_t w : t)
+                    if (w != a && w != b) opposite[shared] = w;
+                ++shared;
+            }
+        }
+        if (shared != 2 || opposite[0] == opposite[1]) return false;
+        // Link condition (Dey et al.): the only common neighbours are the two opposite
+        // vertices, so the collapse keeps the surface a manifold.
+        neighbours(a, scratchA_);
+        neighbours(b, scratchB_);
+        size_t common = 0;
+        for (size_t i = 0, j = 0; i < scratchA_.size() && j < scratchB_.size();) {
+            if (scratchA_[i] < scratchB_[j]) ++i;
+            else if (scratchB_[j] < scratchA_[i]) ++j;
+            else {
+                if (scratchA_[i] != opposite[0] && scratchA_[i] != opposite[1]) return false;
+                ++common, ++i, ++j;
+            }
+        }
+        if (common != 2) return false;
+        // A tetrahedron (4 vertices) cannot lose an edge and stay closed.
+        if (scratchA_.size() + scratchB_.size() - common <= 4) return false;
+
+        // Constraint planes: unit normal and offset of every face around a or b.
+        planes_.clear();
+        V3 mean{0, 0, 0};
+        for (uint32_t f : around) {
+            const V3 nrm = faceNormal(f);
+            const double len = length(nrm);
+            if (!(len > 0)) continue;  // degenerate: no plane to stay outside of
+            const V3 unit = (1 / len) * nrm;
+            planes_.push_back({unit, dot(unit, p_[faces_[f][0]])});
+            mean = mean + nrm;
+        }
+        const double meanLength = length(mean);
+        if (!(meanLength > 0)) return false;
+        const V3 direction = (1 / meanLength) * mean;
+
+        Quadric q = quadric_[a];
+        q += quadric_[b];
+        V3 candidates[4];
+        int candidateCount = 0;
+        if (q.optimum(candidates[candidateCount])) ++candidateCount;
+        candidates[candidateCount++] = 0.5 * (p_[a] + p_[b]);
+        candidates[candidateCount++] = p_[a];
+        candidates[candidateCount++] = p_[b];
+        const double inherited = std::max(error_[a], error_[b]);
+        bool found = false;
+        for (int i = 0; i < candidateCount; ++i) {
+            V3 position;
+            if (!pushInside(candidates[i], direction, position)) continue;
+            double pushed = 0;
+            for (const Plane& pl : planes_) pushed = std::max(pushed, dot(pl.normal, position) - pl.offset);
+            const double cost = inherited + pushed;
+            const double qv = q.eval(position);
+            if (found && (cost > best.cost || (cost == best.cost && qv >= best.quadric))) continue;
+            if (!facesStayUpright(a, b, position, around)) continue;
+            best = Candidate{position, cost, qv};
+            found = true;
+        }
+        return found;
+    }
+
+    /// Moves c along `direction` (unit) by the least t >= 0 that puts it on or outside every
+    /// constraint plane; false when no such t exists.
+    bool pushInside(V3 c, V3 direction, V3& out) const {
+        double lo = 0, hi = std::numeric_limits<double>::infinity();
+        for (const Plane& pl : planes_) {
+            const double g = dot(pl.normal, c) - pl.offset;
+            const double s = dot(pl.normal, direction);
+            if (s > 1e-12) lo = std::max(lo, -g / s);
+            else if (s < -1e-12) hi = std::min(hi, g / -s);
+            else if (g < 0) return false;
+        }
+        if (!(lo <= hi)) return false;
+        out = c + lo * direction;
+        // Rounding may leave the point a hair inside a plane: step out by what is missing.
+        for (int pass = 0; pass < 4; ++pass) {
+            double worst = 0;
+            for (const Plane& pl : planes_) worst = std::min(worst, dot(pl.normal, out) - pl.offset);
+            if (worst >= 0) return true;
+            out = out + (-worst + epsilon_) * direction;
+        }
+        return false;
+    }
+
+    /// Every face kept by collapsing (a, b) into `position` keeps an area and turns its
+    /// normal by less than ~70 degrees.
+    bool facesStayUpright(uint32_t a, uint32_t b, V3 position, const std::vector<uint32_t>& around) const {
+        for (uint32_t f : around) {
+            const auto& t = faces_[f];
+            const bool hasA = t[0] == a || t[1] == a || t[2] == a;
+            const bool hasB = t[0] == b || t[1] == b || t[2] == b;
+            if (hasA && hasB) continue;  // removed by the collapse
+            V3 c[3];
+            for (int k = 0; k < 3; ++k) c[k] = (t[k] == a || t[k] == b) ? position : p_[t[k]];
+            const V3 before = faceNormal(f);
+            const V3 after = cross(c[1] - c[0], c[2] - c[0]);
+            const double lb = length(before), la = length(after);
+            if (!(la > 1e-12 * lb) || dot(before, after) < 0.34 * lb * la) return false;
+        }
+        return true;
+    }
+
+    void collapse(uint32_t a, uint32_t b, const Candidate& c) {
+        p_[a] = c.position;
+        for (uint32_t f : vertexFaces_[b]) {
+            auto& t = faces_[f];
+            if (t[0] == a || t[1] == a || t[2] == a) {
+                faceAlive_[f] = 0;
+                --liveFaces_;
+                for (uint32_t w : t)
+                    if (w != a && w != b) {
+                        auto& list = vertexFaces_[w];
+                        list.erase(std::remove(list.begin(), list.end(), f), list.end());
+                    }
+            } else {
+                for (uint32_t& w : t)
+                    if (w == b) w = a;
+                vertexFaces_[a].push_back(f);
+            }
+        }
+        auto& listA = vertexFaces_[a];
+        listA.erase(std::remove_if(listA.begin(), listA.end(), [&](uint32_t f) { return !faceAlive_[f]; }), listA.end());
+        std::sort(listA.begin(), listA.end());
+        vertexFaces_[b].clear();
+        alive_[b] = 0;
+        quadric_[a] += quadric_[b];
+        error_[a] = c.cost;
+        ++stamp_[a];
+        ++stamp_[b];
+        // The neighbours' own edges now see other faces: their entries are re-evaluated
+        // when popped, and their stamps are kept so the entries stay valid.
+    }
+
+    struct Plane {
+        V3 normal;
+        double offset;
+    };
+
+    std::vector<V3> p_;
+    std::vector<std::array<uint32_t, 3>> faces_;
+    std::vector<char> faceAlive_, alive_, locked_;
+    std::vector<std::vector<uint32_t>> vertexFaces_;
+    std::vector<Quadric> quadric_;
+    std::vector<double> error_;
+    std::vector<uint32_t> stamp_;
+    std::priority_queue<Entry> heap_;
+    size_t liveFaces_ = 0;
+    double epsilon_ = 0;
+    bool started_ = false;
+    std::vector<uint32_t> scratchFaces_, scratchA_, scratchB_, scratchNeighbours_;
+    std::vector<Plane> planes_;
+};
+
+bool boxesOverlap(const TriangleBvh::Node& x, const TriangleBvh::Node& y) {
+    for (int k = 0; k < 3; ++k)
+        if (x.hi[k] < y.lo[k] || y.hi[k] < x.lo[k]) return false;
+    return true;
+}
+
+bool sharePosition(const double* a, const double* b) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            if (a[3 * i] == b[3 * j] && a[3 * i + 1] == b[3 * j + 1] && a[3 * i + 2] == b[3 * j + 2]) return true;
+    return false;
+}
+
+}  // namespace
+
+ConservativeSimplifyResult simplifyConservative(const std::vector<double>& positions,
+                                                const std::vector<uint32_t>& indices, double maxError,
+                                                size_t minTriangles, std::vector<double>& outPositions,
+                                                std::vector<uint32_t>& outIndices) {
+    std::vector<ConservativeSnapshot> snapshots;
+    const ConservativeSimplifyResult result =
+        simplifyConservativeSeries(positions, indices, {maxError}, minTriangles, snapshots);
+    outPositions = std::move(snapshots[0].positions);
+    outIndices = std::move(snapshots[0].indices);
+    return result;
+}
+
+ConservativeSimplifyResult simplifyConservativeSeries(const std::vector<double>& positions,
+                                                      const std::vector<uint32_t>& indices,
+                                                      const std::vector<double>& maxErrors, size_t minTriangles,
+                                                      std::vector<ConservativeSnapshot>& out) {
+    Simplifier simplifier(positions, indices);
+    ConservativeSimplifyResult result;
+    out.assign(maxErrors.size(), ConservativeSnapshot{});
+    for (size_t i = 0; i < maxErrors.size(); ++i) {
+        if (maxErrors[i] > 0) simplifier.run(maxErrors[i], minTriangles, result);
+        out[i].errorEstimate = result.errorEstimate;
+        simplifier.output(out[i].positions, out[i].indices);
+    }
+    return result;
+}
+
+bool meshSelfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& indices) {
+    const size_t triangleCount = indices.size() / 3;
+    if (triangleCount < 2) return false;
+    TriangleBvh bvh;
+    bvh.build(positions.data(), positions.size() / 3, indices.data(), triangleCount);
+    const auto& nodes = bvh.nodes();
+    // Pairs of nodes whose boxes overlap, each unordered pair once (a node with itself first).
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, 0u}};
+    while (!stack.empty()) {
+        const auto [i, j] = stack.back();
+        stack.pop_back();
+        const TriangleBvh::Node& x = nodes[i];
+        const TriangleBvh::Node& y = nodes[j];
+        if (!boxesOverlap(x, y)) continue;
+        if (x.count && y.count) {
+            for (uint32_t s = x.first; s < x.first + x.count; ++s)
+                for (uint32_t t = (i == j ? s + 1 : y.first); t < y.first + y.count; ++t) {
+                    const double* ta = bvh.slotCorners(s);
+                    const double* tb = bvh.slotCorners(t);
+                    if (sharePosition(ta, tb)) continue;
+                    bool hit = false;
+                    triangleTriangleDistance(ta, ta + 3, ta + 6, tb, tb + 3, tb + 6, nullptr, nullptr, &hit);
+                    if (hit) return true;
+                }
+            continue;
+        }
+        if (i == j) {
+            stack.push_back({x.first, x.first});
+            stack.push_back({x.first + 1, x.first + 1});
+            stack.push_back({x.first, x.first + 1});
+        } else if (!x.count && (y.count || (x.hi[0] - x.lo[0]) + (x.hi[1] - x.lo[1]) + (x.hi[2] - x.lo[2]) >=
+                                                (y.hi[0] - y.lo[0]) + (y.hi[1] - y.lo[1]) + (y.hi[2] - y.lo[2]))) {
+            stack.push_back({x.first, j});
+            stack.push_back({x.first + 1, j});
+        } else {
+            stack.push_back({i, y.first});
+            stack.push_back({i, y.first + 1});
+        }
+    }
+    return false;
+}
+
+}  // namespace aggrelod::detail

@@ -1,0 +1,141 @@
+// Conservative (progressive-hull) simplification: the output is closed, edge-manifold,
+// encloses its input and really is coarser (module/src/conservative_simplify.cpp).
+#include "conservative_simplify.h"
+#include "mesh_distance.h"
+#include "test_support.h"
+
+#include <aggrelod/samples.h>
+
+#include <gtest/gtest.h>
+
+namespace aggrelod::testing {
+namespace {
+
+InputObject asObject(const std::vector<double>& positions, const std::vector<uint32_t>& indices) {
+    InputObject o;
+    o.name = "simplified";
+    o.positions = positions;
+    o.indices = indices;
+    return o;
+}
+
+/// Vertices and triangle centroids of `inner` neither inside `outer` (winding number) nor on
+/// its surface (within 1e-9 of the mesh's size: a point on an edge or corner has a winding
+/// number below one half).
+size_t pointsOutside(const InputObject& inner, const std::vector<double>& outer, const std::vector<uint32_t>& outerIdx) {
+    detail::TriangleBvh bvh;
+    bvh.build(outer.data(), outer.size() / 3, outerIdx.data(), outerIdx.size() / 3);
+    double lo[3], hi[3];
+    bvh.bounds(lo, hi);
+    const double onSurface = 1e-9 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    size_t outside = 0;
+    auto check = [&](const double* q) {
+        if (windingNumber(outer, outerIdx, q) < 0.5 && detail::closestPoint(bvh, q).distance > onSurface) ++outside;
+    };
+    for (size_t v = 0; v < inner.positions.size(); v += 3) check(&inner.positions[v]);
+    for (size_t t = 0; t < inner.indices.size(); t += 3) {
+        double c[3] = {0, 0, 0};
+        for (int k = 0; k < 3; ++k)
+            for (int d = 0; d < 3; ++d) c[d] += inner.positions[3 * inner.indices[t + k] + d] / 3;
+        check(c);
+    }
+    return outside;
+}
+
+void expectValidEnclosure(const InputObject& input, const std::vector<double>& pos, const std::vector<uint32_t>& idx) {
+    const ClosedCheck closed = checkClosedAfterWeld(asObject(pos, idx));
+    EXPECT_EQ(closed.problem, "");
+    EXPECT_EQ(closed.edgesUsedMoreThanTwice, 0u);
+    EXPECT_EQ(closed.components, checkClosedAfterWeld(input).components);
+    EXPECT_GE(signedVolumeOf(asObject(pos, idx)), signedVolumeOf(input) * (1 - 1e-9));
+    EXPECT_EQ(pointsOutside(input, pos, idx), 0u);
+    EXPECT_FALSE(detail::meshSelfIntersects(pos, idx));
+}
+
+TEST(ConservativeSimplify, GriddedBoxBecomesTwelveTriangles) {
+    const InputObject box = samples::makeBox("box", {0, 0, 0}, {2, 1, 1}, 0.1);
+    std::vector<double> pos;
+    std::vector<uint32_t> idx;
+    detail::simplifyConservative(box.positions, box.indices, 1e-3, 0, pos, idx);
+    EXPECT_EQ(idx.size() / 3, 12u);
+    expectValidEnclosure(box, pos, idx);
+    EXPECT_NEAR(signedVolumeOf(asObject(pos, idx)), 2.0, 1e-9);  // flat faces cost nothing
+}
+
+TEST(ConservativeSimplify, SphereEnclosedWithinTheErrorEstimate) {
+    const InputObject sphere = samples::makeUvSphere("sphere", {1, 2, 3}, 1.0, 64, 32);
+    std::vector<double> pos;
+    std::vector<uint32_t> idx;
+    const auto result = detail::simplifyConservative(sphere.positions, sphere.indices, 0.02, 0, pos, idx);
+    EXPECT_LT(idx.size(), sphere.indices.size() / 4);
+    EXPECT_LE(result.errorEstimate, 0.02);
+    expectValidEnclosure(sphere, pos, idx);
+    // The estimate bounds the push-out: no vertex farther from the sphere than it.
+    for (size_t v = 0; v < pos.size(); v += 3) {
+        const double r = std::sqrt((pos[v] - 1) * (pos[v] - 1) + (pos[v + 1] - 2) * (pos[v + 1] - 2) + (pos[v + 2] - 3) * (pos[v + 2] - 3));
+        EXPECT_LE(r, 1.0 + 0.02 + 1e-9);
+    }
+}
+
+TEST(ConservativeSimplify, ConcaveLatheStaysAValidEnclosure) {
+    // A chess-piece-like profile: necks and overhangs where pushing out could fold.
+    const InputObject lathe = samples::makeLathe(
+        "piece", {0, 0, 0}, {{0.5, 0}, {0.5, 0.1}, {0.2, 0.3}, {0.15, 0.6}, {0.35, 0.7}, {0.1, 0.9}, {0.25, 1.1}, {0.05, 1.3}},
+        48);
+    for (double maxError : {0.005, 0.02, 0.08}) {
+        std::vector<double> pos;
+        std::vector<uint32_t> idx;
+        detail::simplifyConservative(lathe.positions, lathe.indices, maxError, 0, pos, idx);
+        SCOPED_TRACE(maxError);
+        EXPECT_LT(idx.size(), lathe.indices.size());
+        expectValidEnclosure(lathe, pos, idx);
+    }
+}
+
+TEST(ConservativeSimplify, SeriesSnapshotsAreNestedAndCoarsening) {
+    const InputObject sphere = samples::makeUvSphere("sphere", {0, 0, 0}, 1.0, 48, 24);
+    std::vector<detail::ConservativeSnapshot> snapshots;
+    detail::simplifyConservativeSeries(sphere.positions, sphere.indices, {0.005, 0.01, 0.04, 0.16}, 0, snapshots);
+    ASSERT_EQ(snapshots.size(), 4u);
+    for (size_t i = 0; i < snapshots.size(); ++i) {
+        SCOPED_TRACE(i);
+        const InputObject finer = i == 0 ? sphere : asObject(snapshots[i - 1].positions, snapshots[i - 1].indices);
+        EXPECT_LT(snapshots[i].indices.size(), finer.indices.size());
+        expectValidEnclosure(finer, snapshots[i].positions, snapshots[i].indices);
+        // Same as a single run to that error.
+        std::vector<double> pos;
+        std::vector<uint32_t> idx;
+        detail::simplifyConservative(sphere.positions, sphere.indices, std::vector<double>{0.005, 0.01, 0.04, 0.16}[i], 0, pos, idx);
+        EXPECT_EQ(pos, snapshots[i].positions);
+        EXPECT_EQ(idx, snapshots[i].indices);
+    }
+}
+
+TEST(ConservativeSimplify, ZeroErrorKeepsTheMesh) {
+    const InputObject sphere = samples::makeUvSphere("sphere", {0, 0, 0}, 1.0, 12, 6);
+    std::vector<double> pos;
+    std::vector<uint32_t> idx;
+    detail::simplifyConservative(sphere.positions, sphere.indices, 0, 0, pos, idx);
+    EXPECT_EQ(idx.size(), sphere.indices.size());
+}
+
+TEST(ConservativeSimplify, SelfIntersectionFoundBetweenOverlappingShells) {
+    InputObject a = samples::makeBox("a", {0, 0, 0}, {1, 1, 1});
+    const InputObject b = samples::makeBox("b", {0.5, 0.5, 0.5}, {1.5, 1.5, 1.5});
+    EXPECT_FALSE(detail::meshSelfIntersects(a.positions, a.indices));
+    const uint32_t base = static_cast<uint32_t>(a.positions.size() / 3);
+    a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+    for (uint32_t i : b.indices) a.indices.push_back(base + i);
+    EXPECT_TRUE(detail::meshSelfIntersects(a.positions, a.indices));
+    // Two shells apart do not intersect.
+    InputObject c = samples::makeBox("c", {0, 0, 0}, {1, 1, 1});
+    const InputObject d = samples::makeBox("d", {2, 0, 0}, {3, 1, 1});
+    const uint32_t base2 = static_cast<uint32_t>(c.positions.size() / 3);
+    c.positions.insert(c.positions.end(), d.positions.begin(), d.positions.end());
+    for (uint32_t i : d.indices) c.indices.push_back(base2 + i);
+    EXPECT_FALSE(detail::meshSelfIntersects(c.positions, c.indices));
+}
+
+}  // namespace
+}  // namespace aggrelod::testing
