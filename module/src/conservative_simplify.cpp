@@ -75,7 +75,8 @@ struct Candidate {
 
 class Simplifier {
 public:
-    Simplifier(const std::vector<double>& positions, const std::vector<uint32_t>& indices) {
+    Simplifier(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
+               const std::vector<char>* pinned = nullptr) {
         const size_t n = positions.size() / 3;
         p_.resize(n);
         for (size_t v = 0; v < n; ++v) p_[v] = {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
@@ -113,6 +114,8 @@ public:
         std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b) || (key(a) == key(b) && a < b); });
         for (size_t i = 1; i < n; ++i)
             if (key(order[i]) == key(order[i - 1])) locked_[order[i]] = locked_[order[i - 1]] = 1;
+        if (pinned)
+            for (size_t v = 0; v < std::min(n, pinned->size()); ++v) locked_[v] |= (*pinned)[v];
         liveFaces_ = faces_.size();
     }
 
@@ -143,10 +146,13 @@ public:
 
     size_t triangleCount() const { return liveFaces_; }
 
-    void output(std::vector<double>& outPositions, std::vector<uint32_t>& outIndices) const {
+    /// sourceVertex (optional): per output vertex, its input vertex.
+    void output(std::vector<double>& outPositions, std::vector<uint32_t>& outIndices,
+                std::vector<uint32_t>* sourceVertex = nullptr) const {
         std::vector<uint32_t> remap(p_.size(), UINT32_MAX);
         outPositions.clear();
         outIndices.clear();
+        if (sourceVertex) sourceVertex->clear();
         uint32_t next = 0;
         for (size_t f = 0; f < faces_.size(); ++f) {
             if (!faceAlive_[f]) continue;
@@ -154,6 +160,7 @@ public:
                 if (remap[v] == UINT32_MAX) {
                     remap[v] = next++;
                     outPositions.insert(outPositions.end(), {p_[v].x, p_[v].y, p_[v].z});
+                    if (sourceVertex) sourceVertex->push_back(v);
                 }
                 outIndices.push_back(remap[v]);
             }
@@ -382,6 +389,26 @@ bool sharePosition(const double* a, const double* b) {
     return false;
 }
 
+/// True when the corners of triangle b lie strictly on one side of triangle a's plane (with a
+/// margin for rounding): then they cannot meet, the common case, decided without the exact
+/// distance.
+bool separatedByPlaneOf(const double* a, const double* b) {
+    const V3 a0{a[0], a[1], a[2]}, a1{a[3], a[4], a[5]}, a2{a[6], a[7], a[8]};
+    const V3 n = cross(a1 - a0, a2 - a0);
+    const double len = length(n);
+    if (!(len > 0)) return false;
+    double lo = INFINITY, hi = -INFINITY, scale = 0;
+    for (int k = 0; k < 3; ++k) {
+        const V3 p{b[3 * k], b[3 * k + 1], b[3 * k + 2]};
+        const double d = dot(n, p - a0) / len;
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+        scale = std::max({scale, length(p - a0), length(a1 - a0), length(a2 - a0)});
+    }
+    const double margin = 1e-9 * scale;
+    return lo > margin || hi < -margin;
+}
+
 }  // namespace
 
 ConservativeSimplifyResult simplifyConservative(const std::vector<double>& positions,
@@ -411,9 +438,11 @@ ConservativeSimplifyResult simplifyConservativeSeries(const std::vector<double>&
     return result;
 }
 
-bool meshSelfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& indices) {
+std::vector<std::pair<uint32_t, uint32_t>> selfIntersectingTriangles(const std::vector<double>& positions,
+                                                                     const std::vector<uint32_t>& indices, size_t maxPairs) {
+    std::vector<std::pair<uint32_t, uint32_t>> found;
     const size_t triangleCount = indices.size() / 3;
-    if (triangleCount < 2) return false;
+    if (triangleCount < 2 || maxPairs == 0) return found;
     TriangleBvh bvh;
     bvh.build(positions.data(), positions.size() / 3, indices.data(), triangleCount);
     const auto& nodes = bvh.nodes();
@@ -430,10 +459,14 @@ bool meshSelfIntersects(const std::vector<double>& positions, const std::vector<
                 for (uint32_t t = (i == j ? s + 1 : y.first); t < y.first + y.count; ++t) {
                     const double* ta = bvh.slotCorners(s);
                     const double* tb = bvh.slotCorners(t);
-                    if (sharePosition(ta, tb)) continue;
+                    if (sharePosition(ta, tb) || separatedByPlaneOf(ta, tb) || separatedByPlaneOf(tb, ta)) continue;
                     bool hit = false;
                     triangleTriangleDistance(ta, ta + 3, ta + 6, tb, tb + 3, tb + 6, nullptr, nullptr, &hit);
-                    if (hit) return true;
+                    if (hit) {
+                        const uint32_t ta0 = bvh.slotTriangle(s), tb0 = bvh.slotTriangle(t);
+                        found.push_back({std::min(ta0, tb0), std::max(ta0, tb0)});
+                        if (found.size() >= maxPairs) return found;
+                    }
                 }
             continue;
         }
@@ -449,6 +482,30 @@ bool meshSelfIntersects(const std::vector<double>& positions, const std::vector<
             stack.push_back({i, y.first});
             stack.push_back({i, y.first + 1});
         }
+    }
+    return found;
+}
+
+bool meshSelfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& indices) {
+    return !selfIntersectingTriangles(positions, indices, 1).empty();
+}
+
+bool simplifyConservativeClean(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
+                               double maxError, std::vector<char>& pinned, int maxRounds, ConservativeSnapshot& out) {
+    pinned.resize(positions.size() / 3, 0);
+    std::vector<uint32_t> source;
+    for (int round = 0; round < maxRounds; ++round) {
+        Simplifier simplifier(positions, indices, &pinned);
+        ConservativeSimplifyResult result;
+        simplifier.run(maxError, 0, result);
+        out.errorEstimate = result.errorEstimate;
+        simplifier.output(out.positions, out.indices, &source);
+        const auto pairs = selfIntersectingTriangles(out.positions, out.indices, 256);
+        if (pairs.empty()) return true;
+        // Keep the corners of the crossing faces where they are: the surface there stays as
+        // fine as it must for the next round.
+        for (const auto& [t, u] : pairs)
+            for (int k = 0; k < 3; ++k) pinned[source[out.indices[3 * t + k]]] = pinned[source[out.indices[3 * u + k]]] = 1;
     }
     return false;
 }

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace aggrelod::detail {
@@ -45,6 +46,19 @@ ConservativeSimplifyResult simplifyConservativeSeries(const std::vector<double>&
                                                       const std::vector<uint32_t>& indices,
                                                       const std::vector<double>& maxErrors, size_t minTriangles,
                                                       std::vector<ConservativeSnapshot>& out);
+
+/// simplifyConservative to maxError, made again with the corners of crossing faces pinned
+/// (never moved) until the output does not intersect itself, at most maxRounds times.
+/// pinned: per input vertex, 1 = never moves; grown by the rounds (pass it on to a finer
+/// maxError of the same mesh). Returns false when the last round still intersects itself
+/// (out holds it). positions, indices as simplifyConservative.
+bool simplifyConservativeClean(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
+                               double maxError, std::vector<char>& pinned, int maxRounds, ConservativeSnapshot& out);
+
+/// Pairs (lower, higher triangle index) of triangles that share no vertex position and
+/// intersect or touch, at most maxPairs of them, in traversal order. Deterministic.
+std::vector<std::pair<uint32_t, uint32_t>> selfIntersectingTriangles(const std::vector<double>& positions,
+                                                                     const std::vector<uint32_t>& indices, size_t maxPairs);
 
 /// True when two triangles of the mesh that share no vertex position intersect or touch.
 /// positions: 3 * vertexCount doubles; indices: 3 * triangleCount. Deterministic.

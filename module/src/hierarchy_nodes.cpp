@@ -1,6 +1,8 @@
 // aggrelod module: hierarchy nodes for real-time use (DESIGN sections 2.5 and 2.6).
 // Builds the tree (leaves = original objects, inner nodes = aggregates, unchanged aggregates
-// collapsed across levels), simplifies every aggregate into a proxy (mesh_simplify.cpp),
+// collapsed across levels), simplifies every aggregate into an enclosing proxy within its
+// error budget and gives each object a chain of enclosing simplifications (per-object LOD;
+// conservative_simplify.cpp),
 // measures its error (proxy_error.cpp), colours its faces after the nearest original surface
 // (surface_colors.cpp), and makes bounds nested and errors monotone so that
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
@@ -102,30 +104,64 @@ bool sameSolid(const Aggregate& a, const Aggregate& b) {
 
 std::vector<float> toFloats(const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); }
 
-/// Error budgets tried for a proxy, as fractions of its budget, coarsest first: the
-/// simplification's estimate counts only the push-out from the exact aggregate, the
-/// certified error adds the fill's own distance to the originals.
-constexpr double kProxyTargetFractions[] = {1.0 / 32, 1.0 / 16, 1.0 / 8, 1.0 / 4, 1.0 / 2, 1.0};
+/// Largest distance a vertex moved when rounded to float (world units). Every point of the
+/// float mesh's surface lies within it of the same point of the double mesh, so a double
+/// enclosure of the originals stays one up to this slack.
+double roundingSlack(const std::vector<double>& exact, const std::vector<float>& rounded) {
+    double worst = 0;
+    for (size_t i = 0; i + 2 < exact.size(); i += 3) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) d2 += (exact[i + k] - double(rounded[i + k])) * (exact[i + k] - double(rounded[i + k]));
+        worst = std::max(worst, std::sqrt(d2));
+    }
+    return worst * (1 + 1e-12);
+}
 
-/// The proxy of an aggregate node: the coarsest conservative simplification of the exact
-/// aggregate that does not intersect itself and whose certified error is within
-/// node.budget; the exact aggregate itself when none is (the budget is then raised to its
-/// error: nothing that encloses the aggregate can do better).
+/// Certified error of an enclosure built in doubles and stored in floats: proxy -> originals
+/// by branch and bound (given up once above giveUpAbove), originals -> proxy is the rounding
+/// slack (the proxy encloses them by construction).
+ProxyError measureEnclosure(const std::vector<double>& exact, const std::vector<float>& positions,
+                            const std::vector<uint32_t>& indices,
+                            const std::vector<const detail::PreparedOriginal*>& originals, double tolerance,
+                            const ProxySettings& settings, double giveUpAbove) {
+    detail::ProxyMeasureOptions options;
+    options.enclosesOriginals = true;
+    options.enclosureSlack = roundingSlack(exact, positions);
+    options.giveUpAbove = giveUpAbove;
+    return detail::measureProxyErrorPrepared(positions, indices, originals, tolerance,
+                                             settings.maxRefinementsPerDirection, options);
+}
+
+/// Push-out allowances tried for a proxy, as fractions of the room its budget leaves above
+/// the exact aggregate's own error, coarsest first (the simplification's estimate is a
+/// vertex-to-plane distance, not the certified one, so the largest can still miss).
+constexpr double kRoomFractions[] = {1.0 / 4, 1.0 / 2, 1.0, 2.0, 4.0};
+/// Rounds of pinning crossing faces before a simplification is given up for a finer one.
+constexpr int kCleanRounds = 6;
+
+/// The proxy of an aggregate node (DESIGN section 2.6). Its budget is the exact aggregate's
+/// own certified error (the fill between the originals: nothing that encloses the aggregate
+/// does better) plus simplifyFraction * delta of room; the proxy is the coarsest
+/// conservative simplification of the aggregate that does not intersect itself and whose
+/// certified error fits the budget, else the exact aggregate.
 void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::PreparedOriginal*>& originals,
                         const ProxySettings& settings, HierarchyNode& n) {
     const double tolerance = settings.toleranceFraction * n.delta;
-    std::vector<double> targets;
-    for (double f : kProxyTargetFractions) targets.push_back(f * n.budget);
-    std::vector<detail::ConservativeSnapshot> snapshots;
-    if (n.budget > 0) detail::simplifyConservativeSeries(agg.positions, agg.indices, targets, 0, snapshots);
-    for (size_t i = snapshots.size(); i-- > 0;) {
-        const detail::ConservativeSnapshot& s = snapshots[i];
+    n.positions = toFloats(agg.positions);
+    n.indices = agg.indices;
+    n.error = measureEnclosure(agg.positions, n.positions, n.indices, originals, tolerance, settings, INFINITY);
+    const double room = settings.simplifyFraction * n.delta;
+    n.budget = n.error.bound() + room;
+    if (!(room > 0)) return;
+    std::vector<char> pinned;
+    for (size_t i = std::size(kRoomFractions); i-- > 0;) {
+        detail::ConservativeSnapshot s;
+        const double target = kRoomFractions[i] * room;
+        const bool clean = detail::simplifyConservativeClean(agg.positions, agg.indices, target, pinned, kCleanRounds, s);
+        if (!clean) continue;
         if (s.indices.size() >= agg.indices.size()) break;  // no coarser than the exact one
-        if (i + 1 < snapshots.size() && s.indices.size() == snapshots[i + 1].indices.size()) continue;  // same mesh
-        if (detail::meshSelfIntersects(s.positions, s.indices)) continue;
         std::vector<float> positions = toFloats(s.positions);
-        const ProxyError e = detail::measureProxyErrorPrepared(positions, s.indices, originals, tolerance,
-                                                                settings.maxRefinementsPerDirection);
+        const ProxyError e = measureEnclosure(s.positions, positions, s.indices, originals, tolerance, settings, n.budget);
         if (e.bound() <= n.budget) {
             n.positions = std::move(positions);
             n.indices = s.indices;
@@ -133,11 +169,6 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
             return;
         }
     }
-    n.positions = toFloats(agg.positions);
-    n.indices = agg.indices;
-    n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals, tolerance,
-                                                settings.maxRefinementsPerDirection);
-    n.budget = std::max(n.budget, n.error.bound());
 }
 
 /// Per-object LOD below an object's first aggregate (DESIGN section 2.6): conservative
@@ -158,15 +189,15 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, const detai
     if (!prepared.validSolid()) return chain;
     std::vector<double> targets;  // ascending
     for (int j = settings.objectLodCount; j >= 1; --j) targets.push_back(parentError * std::ldexp(1.0, -j));
-    std::vector<detail::ConservativeSnapshot> snapshots;
-    detail::simplifyConservativeSeries(prepared.positions, prepared.triangles, targets, 0, snapshots);
     size_t finerTriangles = object.indices.size() / 3;
     const std::vector<const detail::PreparedOriginal*> originals{&original};
-    for (size_t i = 0; i < snapshots.size(); ++i) {
-        const detail::ConservativeSnapshot& s = snapshots[i];
+    std::vector<char> pinned;
+    for (size_t i = 0; i < targets.size(); ++i) {
+        detail::ConservativeSnapshot s;
+        if (!detail::simplifyConservativeClean(prepared.positions, prepared.triangles, targets[i], pinned, kCleanRounds, s))
+            continue;
         const size_t triangles = s.indices.size() / 3;
         if (4 * triangles > 3 * finerTriangles) continue;
-        if (detail::meshSelfIntersects(s.positions, s.indices)) continue;
         HierarchyNode n;
         n.objectLod = static_cast<int>(chain.size()) + 1;
         n.sources = {object.id};
@@ -174,9 +205,8 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, const detai
         n.positions = toFloats(s.positions);
         n.indices = s.indices;
         n.exactTriangleCount = object.indices.size() / 3;
-        n.error = detail::measureProxyErrorPrepared(n.positions, n.indices, originals,
-                                                    settings.toleranceFraction * targets[i],
-                                                    settings.maxRefinementsPerDirection);
+        n.error = measureEnclosure(s.positions, n.positions, n.indices, originals, settings.toleranceFraction * targets[i],
+                                   settings, n.budget);
         if (!(n.error.bound() <= n.budget) || !(n.error.bound() < parentError)) continue;
         finerTriangles = triangles;
         chain.push_back(std::move(n));

@@ -639,8 +639,11 @@ public:
         keepOrDismiss(g);
     }
 
-    DirectionResult run(size_t evaluationLimit) {
-        while (!open_.empty() && open_.top().upper > r_.lower + tolerance_ && r_.evaluations + 4 <= evaluationLimit) {
+    /// Refines until the bound is within the tolerance of the distance found, the limit is
+    /// spent, or the distance found exceeds giveUpAbove (the answer is then "over it").
+    DirectionResult run(size_t evaluationLimit, double giveUpAbove = INFINITY) {
+        while (!open_.empty() && open_.top().upper > r_.lower + tolerance_ && r_.evaluations + 4 <= evaluationLimit &&
+               !(r_.lower > giveUpAbove)) {
             const Region g = open_.top();
             open_.pop();
             // Every part lies in the region: its distance to the surface is below the region's
@@ -928,6 +931,14 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
                                      const std::vector<uint32_t>& proxyIndices,
                                      const std::vector<const PreparedOriginal*>& originals, double tolerance,
                                      size_t maxRefinementsPerDirection) {
+    return measureProxyErrorPrepared(proxyPositions, proxyIndices, originals, tolerance, maxRefinementsPerDirection,
+                                     ProxyMeasureOptions{});
+}
+
+ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
+                                     const std::vector<uint32_t>& proxyIndices,
+                                     const std::vector<const PreparedOriginal*>& originals, double tolerance,
+                                     size_t maxRefinementsPerDirection, const ProxyMeasureOptions& options) {
     ProxyError e;
     e.tolerance = tolerance;
     size_t originalTriangles = 0;
@@ -965,7 +976,14 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
             for (int k = 0; k < 3; ++k) c[size_t(3 * v + k)] = proxy.corner(t, v)[k];
         forward.evaluateTriangle(c);
     }
-    const DirectionResult f = forward.run(proxy.triangleCount() + maxRefinementsPerDirection);
+    const DirectionResult f = forward.run(proxy.triangleCount() + maxRefinementsPerDirection, options.giveUpAbove);
+    e.proxyToOriginals = f.upper;
+    e.proxyToOriginalsLower = f.lower;
+    if (options.enclosesOriginals || f.lower > options.giveUpAbove) {
+        e.originalsToProxy = options.enclosesOriginals ? options.enclosureSlack : INFINITY;
+        e.evaluationCount = f.evaluations;
+        return e;
+    }
 
     // originals -> proxy solid: the root box of every object's BVH is a seed, so originals
     // deep inside the proxy or well within the tolerance are dismissed a box at a time.
@@ -978,9 +996,7 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
         if (originals[i]->bvh.triangleCount() > 0) backward.evaluateBox(uint32_t(i), 0);
     const DirectionResult b = backward.run(originalTriangles + maxRefinementsPerDirection);
 
-    e.proxyToOriginals = f.upper;
     e.originalsToProxy = b.upper;
-    e.proxyToOriginalsLower = f.lower;
     e.originalsToProxyLower = b.lower;
     e.evaluationCount = f.evaluations + b.evaluations;
     return e;

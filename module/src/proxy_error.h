@@ -8,6 +8,7 @@
 
 #include <aggrelod/hierarchy_nodes.h>
 
+#include <cmath>
 #include <vector>
 
 namespace aggrelod::detail {
@@ -53,11 +54,30 @@ void prepareOriginal(const InputObject& object, PreparedOriginal& out);
 /// positions: 3 * vertexCount; indices: 3 * triangleCount (each < vertexCount).
 std::vector<uint32_t> trianglesAcrossEdges(const double* positions, const uint32_t* indices, size_t triangleCount);
 
+struct ProxyMeasureOptions {
+    /// The proxy is known to enclose its originals up to enclosureSlack (world units: e.g.
+    /// an enclosure built in doubles whose vertices were then rounded to floats moves no
+    /// surface point farther than the largest rounding). originals -> proxy is then that
+    /// slack, not measured.
+    bool enclosesOriginals = false;
+    double enclosureSlack = 0;
+    /// Stop refining once a distance above this is found (world units): the caller only
+    /// needs to know the error is over it. Bounds stay valid; the other direction is not
+    /// measured then (its bound is enclosureSlack, or infinite for a proxy not known to
+    /// enclose).
+    double giveUpAbove = INFINITY;
+};
+
 /// measureProxyError against prepared originals (same results as the public function,
 /// which prepares them itself).
 ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
                                      const std::vector<uint32_t>& proxyIndices,
                                      const std::vector<const PreparedOriginal*>& originals, double tolerance,
                                      size_t maxRefinementsPerDirection);
+/// The same with options (ProxyMeasureOptions).
+ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
+                                     const std::vector<uint32_t>& proxyIndices,
+                                     const std::vector<const PreparedOriginal*>& originals, double tolerance,
+                                     size_t maxRefinementsPerDirection, const ProxyMeasureOptions& options);
 
 }  // namespace aggrelod::detail

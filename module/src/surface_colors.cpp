@@ -43,16 +43,34 @@ void colorsOfNearest(const std::vector<Real>& positions, const std::vector<uint3
     if (soupIndices.empty()) return;
     TriangleBvh bvh;
     bvh.build(soupPositions.data(), soupPositions.size() / 3, soupIndices.data(), soupIndices.size() / 3);
+    // Seven points spread over the face (its centroid first); the colour most of them are
+    // nearest to wins, so a large coarse face takes the colour of most of the surface it
+    // stands for rather than of whatever lies under its centroid.
+    constexpr double kSamples[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3},   {2.0 / 3, 1.0 / 6, 1.0 / 6},
+                                       {1.0 / 6, 2.0 / 3, 1.0 / 6},   {1.0 / 6, 1.0 / 6, 2.0 / 3},
+                                       {1.0 / 6, 5.0 / 12, 5.0 / 12}, {5.0 / 12, 1.0 / 6, 5.0 / 12},
+                                       {5.0 / 12, 5.0 / 12, 1.0 / 6}};
     for (size_t f = 0; f < faceCount; ++f) {
-        double centroid[3] = {0, 0, 0};
-        for (int c = 0; c < 3; ++c)
-            for (int k = 0; k < 3; ++k) centroid[k] += double(positions[3 * size_t(indices[3 * f + c]) + k]) / 3.0;
-        const ClosestPoint nearest = closestPoint(bvh, centroid);
-        if (nearest.triangle == ~0u) continue;  // non-finite centroid: stays white
-        std::copy_n(&soupColors[4 * size_t(nearest.triangle)], 4, &faceColors[4 * f]);
+        uint32_t nearestTriangle[7];
+        int found = 0;
+        for (const auto& w : kSamples) {
+            double p[3] = {0, 0, 0};
+            for (int c = 0; c < 3; ++c)
+                for (int k = 0; k < 3; ++k) p[k] += w[c] * double(positions[3 * size_t(indices[3 * f + c]) + k]);
+            const ClosestPoint nearest = closestPoint(bvh, p);
+            if (nearest.triangle != ~0u) nearestTriangle[found++] = nearest.triangle;
+        }
+        if (found == 0) continue;  // non-finite face: stays white
+        auto colorOf = [&](int i) { return &soupColors[4 * size_t(nearestTriangle[i])]; };
+        int best = 0, bestVotes = 0;
+        for (int i = 0; i < found; ++i) {
+            int votes = 0;
+            for (int j = 0; j < found; ++j) votes += std::equal(colorOf(i), colorOf(i) + 4, colorOf(j));
+            if (votes > bestVotes) best = i, bestVotes = votes;
+        }
+        std::copy_n(colorOf(best), 4, &faceColors[4 * f]);
     }
 }
-
 }  // namespace
 
 void nearestSurfaceColors(const std::vector<double>& positions, const std::vector<uint32_t>& indices,

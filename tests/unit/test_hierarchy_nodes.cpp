@@ -73,12 +73,25 @@ TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
     ASSERT_GT(nodes.size(), b.objects.size());
     size_t aggregates = 0;
     for (const Level& l : b.hierarchy.levels) aggregates += l.aggregates.size();
-    std::printf("spheres15: %zu objects, %zu aggregates over %zu levels -> %zu aggregate nodes, %zu roots\n",
-                b.objects.size(), aggregates, b.hierarchy.levels.size(), nodes.size() - b.objects.size(),
+    size_t aggregateNodes = 0, objectLodNodes = 0;
+    for (const HierarchyNode& n : nodes) {
+        if (n.leaf) continue;
+        ++(n.objectLod > 0 ? objectLodNodes : aggregateNodes);
+        if (n.objectLod > 0) {  // per-object LOD: one object, no level, within its budget
+            EXPECT_EQ(n.sources.size(), 1u);
+            EXPECT_EQ(n.firstLevel, -1);
+            EXPECT_EQ(n.children.size(), 1u);
+        }
+        EXPECT_LE(n.error.bound(), n.budget);
+    }
+    std::printf("spheres15: %zu objects, %zu aggregates over %zu levels -> %zu aggregate nodes, %zu per-object LOD "
+                "nodes, %zu roots\n",
+                b.objects.size(), aggregates, b.hierarchy.levels.size(), aggregateNodes, objectLodNodes,
                 b.nodes.roots.size());
+    EXPECT_GT(objectLodNodes, 0u);
     // Unchanged aggregates are collapsed: fewer nodes than aggregates, and each aggregate maps
     // to a node spanning its level with the same objects.
-    EXPECT_LT(nodes.size() - b.objects.size(), aggregates);
+    EXPECT_LT(aggregateNodes, aggregates);
     for (size_t k = 0; k < b.hierarchy.levels.size(); ++k)
         for (size_t g = 0; g < b.hierarchy.levels[k].aggregates.size(); ++g) {
             const HierarchyNode& n = nodes[b.nodes.nodeOfAggregate[k][g]];

@@ -25,11 +25,12 @@ namespace aggrelod {
 constexpr uint32_t kNoNode = 0xFFFFFFFFu;
 
 struct ProxySettings {
-    /// Error budget of the proxy of a level-k aggregate, as a fraction of delta_k (world
-    /// units once multiplied): the proxy is the coarsest enclosing simplification whose
-    /// certified error fits it (or the exact aggregate, when even that does not fit: the
-    /// budget is then raised to its error). 0 keeps the exact aggregate as its proxy.
-    double simplifyFraction = 0.5;
+    /// Room the proxy of a level-k aggregate gets for simplification, as a fraction of
+    /// delta_k (world units once multiplied): its error budget is the certified error of the
+    /// exact aggregate (the fill's own distance to the originals, which nothing enclosing
+    /// the aggregate can undercut) plus this. The proxy is the coarsest enclosing
+    /// simplification whose certified error fits the budget. 0 keeps the exact aggregate.
+    double simplifyFraction = 0.25;
     /// Most simplified versions of one object below its first aggregate (per-object LOD);
     /// their errors halve down from that aggregate's error. 0 = none.
     int objectLodCount = 8;
