@@ -7,6 +7,7 @@
 // (surface_colors.cpp), and makes bounds nested and errors monotone so that
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
 #include "conservative_simplify.h"
+#include "mesh_optimize.h"
 #include "mesh_preparation.h"
 #include "parallel_for.h"
 #include "proxy_error.h"
@@ -366,6 +367,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         std::vector<const InputObject*> sourceObjects;
         for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
         detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
+        detail::optimizeVertexCache(n.positions, n.indices, n.faceColors);
     }, [&](size_t done) {
         if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
     });
@@ -380,7 +382,10 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         object.id = static_cast<uint32_t>(o);  // sources are object indices
         chains[o] = objectLodChain(object, prepared[o], nodes[parent].error.bound(), settings);
         std::vector<const InputObject*> source{&objects[o]};
-        for (HierarchyNode& c : chains[o]) detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);
+        for (HierarchyNode& c : chains[o]) {
+            detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);
+            detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
+        }
     });
     size_t chainCount = 0;
     for (const auto& c : chains) chainCount += c.size();
