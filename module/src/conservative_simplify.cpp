@@ -73,6 +73,128 @@ struct Candidate {
     double quadric = 0;
 };
 
+/// Dynamic bounding-box tree over the live faces (insert / remove, the insertion descent of
+/// Box2D's b2DynamicTree choosing the child whose box grows least), so that a collapse can
+/// be checked against every face near its new faces before it is done.
+class FaceTree {
+public:
+    static constexpr uint32_t kNone = UINT32_MAX;
+    struct Box {
+        double lo[3], hi[3];
+    };
+
+    uint32_t insert(uint32_t face, const Box& box) {
+        const uint32_t leaf = allocate();
+        nodes_[leaf].box = box;
+        nodes_[leaf].face = face;
+        if (root_ == kNone) {
+            root_ = leaf;
+            return leaf;
+        }
+        uint32_t at = root_;
+        while (nodes_[at].face == kNone) {
+            const Node& n = nodes_[at];
+            const double grow0 = perimeter(merge(nodes_[n.child[0]].box, box)) - perimeter(nodes_[n.child[0]].box);
+            const double grow1 = perimeter(merge(nodes_[n.child[1]].box, box)) - perimeter(nodes_[n.child[1]].box);
+            at = grow0 <= grow1 ? n.child[0] : n.child[1];
+        }
+        const uint32_t oldParent = nodes_[at].parent;
+        const uint32_t parent = allocate();
+        nodes_[parent].parent = oldParent;
+        nodes_[parent].child[0] = at;
+        nodes_[parent].child[1] = leaf;
+        nodes_[at].parent = nodes_[leaf].parent = parent;
+        if (oldParent == kNone) root_ = parent;
+        else nodes_[oldParent].child[nodes_[oldParent].child[0] == at ? 0 : 1] = parent;
+        refit(parent);
+        return leaf;
+    }
+
+    void remove(uint32_t leaf) {
+        const uint32_t parent = nodes_[leaf].parent;
+        release(leaf);
+        if (parent == kNone) {
+            root_ = kNone;
+            return;
+        }
+        const uint32_t sibling = nodes_[parent].child[nodes_[parent].child[0] == leaf ? 1 : 0];
+        const uint32_t grand = nodes_[parent].parent;
+        nodes_[sibling].parent = grand;
+        release(parent);
+        if (grand == kNone) {
+            root_ = sibling;
+        } else {
+            nodes_[grand].child[nodes_[grand].child[0] == parent ? 0 : 1] = sibling;
+            refit(grand);
+        }
+    }
+
+    /// Calls visit(face) for every face whose box overlaps `box`; stops when it returns true.
+    template <class Visit>
+    bool query(const Box& box, Visit&& visit) {
+        if (root_ == kNone) return false;
+        stack_.clear();
+        stack_.push_back(root_);
+        while (!stack_.empty()) {
+            const Node& n = nodes_[stack_.back()];
+            stack_.pop_back();
+            if (!overlap(n.box, box)) continue;
+            if (n.face != kNone) {
+                if (visit(n.face)) return true;
+            } else {
+                stack_.push_back(n.child[0]);
+                stack_.push_back(n.child[1]);
+            }
+        }
+        return false;
+    }
+
+    static Box merge(const Box& a, const Box& b) {
+        Box m;
+        for (int k = 0; k < 3; ++k) {
+            m.lo[k] = std::min(a.lo[k], b.lo[k]);
+            m.hi[k] = std::max(a.hi[k], b.hi[k]);
+        }
+        return m;
+    }
+
+private:
+    struct Node {
+        Box box;
+        uint32_t parent = kNone, child[2] = {kNone, kNone}, face = kNone;
+    };
+    static double perimeter(const Box& b) { return (b.hi[0] - b.lo[0]) + (b.hi[1] - b.lo[1]) + (b.hi[2] - b.lo[2]); }
+    static bool overlap(const Box& a, const Box& b) {
+        for (int k = 0; k < 3; ++k)
+            if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+        return true;
+    }
+    uint32_t allocate() {
+        uint32_t i;
+        if (!free_.empty()) {
+            i = free_.back();
+            free_.pop_back();
+            nodes_[i] = Node{};
+        } else {
+            i = static_cast<uint32_t>(nodes_.size());
+            nodes_.emplace_back();
+        }
+        return i;
+    }
+    void release(uint32_t i) { free_.push_back(i); }
+    void refit(uint32_t i) {
+        for (; i != kNone; i = nodes_[i].parent)
+            nodes_[i].box = merge(nodes_[nodes_[i].child[0]].box, nodes_[nodes_[i].child[1]].box);
+    }
+
+    std::vector<Node> nodes_;
+    std::vector<uint32_t> free_, stack_;
+    uint32_t root_ = kNone;
+};
+
+bool separatedByPlaneOf(const double* a, const double* b);
+bool sharePosition(const double* a, const double* b);
+
 class Simplifier {
 public:
     Simplifier(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
@@ -117,6 +239,8 @@ public:
         if (pinned)
             for (size_t v = 0; v < std::min(n, pinned->size()); ++v) locked_[v] |= (*pinned)[v];
         liveFaces_ = faces_.size();
+        faceLeaf_.assign(faces_.size(), FaceTree::kNone);
+        for (uint32_t f = 0; f < faces_.size(); ++f) faceLeaf_[f] = tree_.insert(f, faceBox(f));
     }
 
     /// Collapses while the cheapest collapse costs <= maxError and more than minTriangles
@@ -137,6 +261,7 @@ public:
                 heap_.push(Entry{c.cost, e.a, e.b, e.stampA, e.stampB});
                 continue;
             }
+            if (crossesOtherFaces(e.a, e.b, c.position)) continue;  // tried again if a neighbour changes
             collapse(e.a, e.b, c);
             ++result.collapses;
             result.errorEstimate = std::max(result.errorEstimate, c.cost);
@@ -325,6 +450,51 @@ private:
         return true;
     }
 
+    FaceTree::Box faceBox(uint32_t f) const {
+        FaceTree::Box box;
+        for (int k = 0; k < 3; ++k) box.lo[k] = INFINITY, box.hi[k] = -INFINITY;
+        for (uint32_t v : faces_[f]) {
+            const double q[3] = {p_[v].x, p_[v].y, p_[v].z};
+            for (int k = 0; k < 3; ++k) box.lo[k] = std::min(box.lo[k], q[k]), box.hi[k] = std::max(box.hi[k], q[k]);
+        }
+        return box;
+    }
+
+    /// Would a face made by collapsing (a, b) into `position` cross a face that shares no
+    /// vertex with it? Neighbours sharing a vertex are left to the fold test; the check keeps
+    /// two parts of the surface pushed towards each other across a narrow gap from meeting.
+    bool crossesOtherFaces(uint32_t a, uint32_t b, V3 position) {
+        for (uint32_t f : scratchFaces_) {  // the faces around the edge, from evaluate()
+            const auto& t = faces_[f];
+            if ((t[0] == a || t[1] == a || t[2] == a) && (t[0] == b || t[1] == b || t[2] == b)) continue;
+            double corners[9];
+            uint32_t ids[3];
+            FaceTree::Box box;
+            for (int k = 0; k < 3; ++k) box.lo[k] = INFINITY, box.hi[k] = -INFINITY;
+            for (int k = 0; k < 3; ++k) {
+                ids[k] = (t[k] == a || t[k] == b) ? a : t[k];
+                const V3 q = (t[k] == a || t[k] == b) ? position : p_[t[k]];
+                corners[3 * k] = q.x, corners[3 * k + 1] = q.y, corners[3 * k + 2] = q.z;
+                const double qq[3] = {q.x, q.y, q.z};
+                for (int d = 0; d < 3; ++d) box.lo[d] = std::min(box.lo[d], qq[d]), box.hi[d] = std::max(box.hi[d], qq[d]);
+            }
+            const bool crossing = tree_.query(box, [&](uint32_t g) {
+                const auto& u = faces_[g];
+                for (uint32_t w : u)
+                    if (w == ids[0] || w == ids[1] || w == ids[2] || w == b) return false;
+                double other[9];
+                for (int k = 0; k < 3; ++k) other[3 * k] = p_[u[k]].x, other[3 * k + 1] = p_[u[k]].y, other[3 * k + 2] = p_[u[k]].z;
+                if (sharePosition(corners, other) || separatedByPlaneOf(corners, other) || separatedByPlaneOf(other, corners))
+                    return false;
+                bool hit = false;
+                triangleTriangleDistance(corners, corners + 3, corners + 6, other, other + 3, other + 6, nullptr, nullptr, &hit);
+                return hit;
+            });
+            if (crossing) return true;
+        }
+        return false;
+    }
+
     void collapse(uint32_t a, uint32_t b, const Candidate& c) {
         p_[a] = c.position;
         for (uint32_t f : vertexFaces_[b]) {
@@ -332,6 +502,8 @@ private:
             if (t[0] == a || t[1] == a || t[2] == a) {
                 faceAlive_[f] = 0;
                 --liveFaces_;
+                tree_.remove(faceLeaf_[f]);
+                faceLeaf_[f] = FaceTree::kNone;
                 for (uint32_t w : t)
                     if (w != a && w != b) {
                         auto& list = vertexFaces_[w];
@@ -346,6 +518,10 @@ private:
         auto& listA = vertexFaces_[a];
         listA.erase(std::remove_if(listA.begin(), listA.end(), [&](uint32_t f) { return !faceAlive_[f]; }), listA.end());
         std::sort(listA.begin(), listA.end());
+        for (uint32_t f : listA) {  // every face around the moved vertex changed its box
+            tree_.remove(faceLeaf_[f]);
+            faceLeaf_[f] = tree_.insert(f, faceBox(f));
+        }
         vertexFaces_[b].clear();
         alive_[b] = 0;
         quadric_[a] += quadric_[b];
@@ -374,6 +550,8 @@ private:
     bool started_ = false;
     std::vector<uint32_t> scratchFaces_, scratchA_, scratchB_, scratchNeighbours_;
     std::vector<Plane> planes_;
+    FaceTree tree_;
+    std::vector<uint32_t> faceLeaf_;
 };
 
 bool boxesOverlap(const TriangleBvh::Node& x, const TriangleBvh::Node& y) {
