@@ -85,13 +85,14 @@ bool closedMesh(const std::vector<uint32_t>& indices) {
 }
 
 /// The per-object LOD chain of `object`: meshopt_simplify at absolute target errors
-/// radius * 2^(-j/2), j = 0..26, coarsest first, identical results kept once. Vertices are
+/// radius * 2^(-j/2), j = 0, 1, ... down to `finest`, coarsest first, identical results kept
+/// once. Vertices are
 /// welded by position first (glTF art repeats them at seams, which would otherwise lock the
 /// seams). A closed result is measured as our proxies are (inside-ness by ray parity); an open
 /// one gets no inside credit: its originals -> proxy distance is that of the original surface
 /// to the proxy surface (measureProxyError with the roles swapped: its proxy -> originals
 /// direction is a surface-to-surface bound that needs no closed mesh).
-Chain buildChain(const InputObject& object, double radius) {
+Chain buildChain(const InputObject& object, double radius, double finest) {
     Chain chain;
     const size_t vertexCount = object.positions.size() / 3;
     chain.levels.push_back({object.indices.size() / 3, 0.0, true});
@@ -111,8 +112,9 @@ Chain buildChain(const InputObject& object, double radius) {
     weldedObject.indices = indices;
     std::vector<ChainLevel> coarseToFine;
     size_t previousCount = 0;
-    for (int j = 0; j <= 26; ++j) {
+    for (int j = 0;; ++j) {
         const double target = radius * std::pow(2.0, -0.5 * j);
+        if (target < finest) break;
         std::vector<uint32_t> out(indices.size());
         const size_t count = meshopt_simplify(out.data(), indices.data(), indices.size(), weldedPositions.data(), welded,
                                               3 * sizeof(float), 0, float(target / scale), 0, nullptr);
@@ -242,9 +244,15 @@ bool runScene(const Options& o, const std::string& name) {
             std::copy(n.sphereCenter, n.sphereCenter + 3, &leafCenter[3 * object]);
             leafRadius[object] = n.sphereRadius;
         }
+    // No camera comes closer to an object than the scene radius (the nearest is 1 diameter
+    // from the centre), where 1 px is radius / k: finer levels than a quarter of that would
+    // never be drawn, and measuring them dominates the run.
+    const double k = kViewportHeight / (2.0 * std::tan(kFovY / 2));  // sse = error * k / d
+    const double finest = 0.25 * sphere.radius / k;
     const auto chainStart = std::chrono::steady_clock::now();
     std::vector<Chain> chains(objects.size());
-    detail::parallelFor(objects.size(), o.threads, [&](size_t i) { chains[i] = buildChain(objects[i], leafRadius[i]); });
+    detail::parallelFor(objects.size(), o.threads,
+                        [&](size_t i) { chains[i] = buildChain(objects[i], leafRadius[i], finest); });
     const double chainSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - chainStart).count();
     size_t chainLevels = 0, openLevels = 0;
     for (const Chain& c : chains)
@@ -253,14 +261,13 @@ bool runScene(const Options& o, const std::string& name) {
             openLevels += c.levels[l].closed ? 0 : 1;
         }
     std::printf("per-object LOD: %zu simplified levels (%.1f per object), %zu of them not closed (no inside credit); "
-                "chains built and measured in %.2f s\n",
-                chainLevels, double(chainLevels) / double(objects.size()), openLevels, chainSeconds);
+                "targets down to %.3g; chains built and measured in %.2f s\n",
+                chainLevels, double(chainLevels) / double(objects.size()), openLevels, finest, chainSeconds);
 
     // Cameras.
     int a1 = 0, a2 = 1;  // horizontal axes
     if (input.upAxis == 1) a1 = 2, a2 = 0;
     const double elevation = o.elevationDegrees * kPi / 180.0;
-    const double k = kViewportHeight / (2.0 * std::tan(kFovY / 2));  // sse = error * k / d
     runtime::Selector selector(file);
     runtime::SelectionSettings settings;
     settings.pixelTolerance = kTau;
