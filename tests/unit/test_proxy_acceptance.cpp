@@ -2,7 +2,8 @@
 // non-leaf node (aggregates and per-object LOD nodes) of in-process bakes of spheres15, chess,
 // forest, village, truck_town without its ground and a 400-object generated scene:
 //  - closed (after welding equal positions), edge-manifold (every index edge used by exactly
-//    two triangles, once each way), positive volume;
+//    two triangles, once each way: a proxy whose vertices are ever split for attributes must
+//    be welded before this check), positive volume;
 //  - one shell per connected part: as many edge-connected shells as the exact aggregate's
 //    componentCount (per-object LOD node: as its object);
 //  - every original vertex of the node's sources inside or on the proxy;
@@ -319,7 +320,9 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
         const double volume = signedVolumeOf(mesh);
         if (!(volume > 0)) {
             ++f.nonPositiveVolume;
-            f.example("volume", name + ": volume " + std::to_string(volume));
+            std::ostringstream text;
+            text << name << ": volume " << volume;
+            f.example("volume", text.str());
         }
         const int shells = shellCount(mesh.indices);
         if (shells != p.expectedShells) {
