@@ -1,0 +1,616 @@
+// Acceptance of the proxies an engine draws and collides against (DESIGN 2.6), for every
+// non-leaf node (aggregates and per-object LOD nodes) of in-process bakes of spheres15, chess,
+// forest, village, truck_town without its ground and a 400-object generated scene:
+//  - closed (after welding equal positions), edge-manifold (every index edge used by exactly
+//    two triangles, once each way: a proxy whose vertices are ever split for attributes must
+//    be welded before this check), positive volume;
+//  - one shell per connected part: as many edge-connected shells as the exact aggregate's
+//    componentCount (per-object LOD node: as its object);
+//  - every original vertex of the node's sources inside or on the proxy;
+//  - rays from outside reach the proxy no later than the originals (Embree);
+//  - certified error within the node's budget, and an independent brute-force measurement on
+//    a subset of nodes never above the certified bound.
+// The checker itself is tested on the exact aggregates (which must pass the geometric checks)
+// and on damaged copies of them (which must fail them), so a passing scene is not a checker
+// that cannot fail. Scene tests that fail on the proxies of the time are registered DISABLED_
+// until the proxies meet them; run them with --gtest_also_run_disabled_tests.
+#include "acceptance_scenes.h"
+#include "grid_measure.h"
+#include "mesh_distance.h"
+#include "test_support.h"
+
+#include <aggrelod/hierarchy_nodes.h>
+
+#include <embree3/rtcore.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace aggrelod;
+using namespace aggrelod::testing;
+
+namespace {
+
+// ------------------------------------------------------------------------------------------
+// Baked scenes, once per test process.
+
+struct AcceptanceScene {
+    SceneInput input;
+    Baked baked;
+    SceneSphere sphere;
+};
+
+/// Bakes are kept small (4 automatic levels; the generated scene at ~150 triangles per
+/// object) so that the whole file runs in about a minute in Release.
+const AcceptanceScene& acceptanceScene(const std::string& name) {
+    static std::map<std::string, std::unique_ptr<AcceptanceScene>> cache;
+    auto& slot = cache[name];
+    if (slot) return *slot;
+    slot = std::make_unique<AcceptanceScene>();
+    SceneRequest request;
+    request.name = name;
+    request.randomObjects = 400;
+    request.randomTriangles = 60000;
+    request.sharedDataDir = sharedDataDir().string();
+    slot->input = loadScene(request);
+    if (slot->input.problem.empty()) {
+        slot->baked = bakeScene(slot->input, 4, 2);
+        slot->sphere = sceneSphere(slot->input.objects);
+    }
+    return *slot;
+}
+
+#define REQUIRE_ACCEPTANCE_SCENE(s)                                                                  \
+    do {                                                                                           \
+        if ((s).input.problem.rfind("absent: ", 0) == 0) GTEST_SKIP() << (s).input.problem;        \
+        ASSERT_TRUE((s).input.problem.empty()) << (s).input.problem;                               \
+        ASSERT_TRUE((s).baked.ok) << (s).input.label << ": " << (s).baked.problem;                 \
+    } while (0)
+
+// ------------------------------------------------------------------------------------------
+// Topology.
+
+/// Edge-connected shells of an indexed mesh (triangles sharing an undirected index edge).
+int shellCount(const std::vector<uint32_t>& indices) {
+    const size_t triangles = indices.size() / 3;
+    std::vector<uint32_t> parent(triangles);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> firstUse;
+    for (size_t t = 0; t < triangles; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = indices[3 * t + k], b = indices[3 * t + (k + 1) % 3];
+            const auto [it, fresh] = firstUse.emplace(std::make_pair(std::min(a, b), std::max(a, b)), uint32_t(t));
+            if (!fresh) parent[find(uint32_t(t))] = find(it->second);
+        }
+    int shells = 0;
+    for (size_t t = 0; t < triangles; ++t) shells += find(uint32_t(t)) == t ? 1 : 0;
+    return shells;
+}
+
+/// Empty when every undirected index edge is used by exactly two triangles, once in each
+/// direction; else what the first offending edge does.
+std::string edgeManifoldProblem(const std::vector<uint32_t>& indices) {
+    if (indices.empty()) return "no triangles";
+    std::map<std::pair<uint32_t, uint32_t>, int> directed;
+    for (size_t t = 0; t + 2 < indices.size(); t += 3)
+        for (int k = 0; k < 3; ++k) ++directed[{indices[t + k], indices[t + (k + 1) % 3]}];
+    for (const auto& [edge, uses] : directed) {
+        const auto back = directed.find({edge.second, edge.first});
+        const int backUses = back == directed.end() ? 0 : back->second;
+        if (uses != 1 || backUses != 1)
+            return "index edge " + std::to_string(edge.first) + "-" + std::to_string(edge.second) + " used " +
+                   std::to_string(uses) + " + " + std::to_string(backUses) + " times in the two directions";
+    }
+    return {};
+}
+
+/// The object's shells after welding equal positions (glTF art repeats vertices at seams).
+int objectShells(const InputObject& o) {
+    std::map<std::array<double, 3>, uint32_t> ids;
+    std::vector<uint32_t> weld(o.positions.size() / 3);
+    for (size_t i = 0; i < weld.size(); ++i)
+        weld[i] = ids.emplace(std::array<double, 3>{o.positions[3 * i], o.positions[3 * i + 1], o.positions[3 * i + 2]},
+                              uint32_t(ids.size()))
+                      .first->second;
+    std::vector<uint32_t> welded;
+    for (uint32_t i : o.indices) welded.push_back(weld[i]);
+    return shellCount(welded);
+}
+
+// ------------------------------------------------------------------------------------------
+// Embree: per-object scenes, instanced into one scene per node; proxies with an all-hits mode.
+
+struct RayContext {
+    RTCIntersectContext base;      // first member: Embree hands this pointer to the filter
+    std::vector<float>* hits = nullptr;  // non-null: collect every hit distance and go on
+};
+
+void collectEveryHit(const RTCFilterFunctionNArguments* args) {
+    const RayContext* context = reinterpret_cast<const RayContext*>(args->context);
+    if (!context->hits) return;
+    context->hits->push_back(RTCRayN_tfar(args->ray, args->N, 0));
+    args->valid[0] = 0;
+}
+
+class Embree {
+public:
+    Embree() : device_(rtcNewDevice(nullptr)) {}
+    ~Embree() {
+        for (RTCScene s : scenes_) rtcReleaseScene(s);
+        rtcReleaseDevice(device_);
+    }
+    Embree(const Embree&) = delete;
+    Embree& operator=(const Embree&) = delete;
+
+    /// A committed scene of one triangle mesh (float xyz, 3 indices per triangle); null when empty.
+    RTCScene mesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices, bool collectFilter) {
+        if (indices.empty()) return nullptr;
+        RTCScene scene = rtcNewScene(device_);
+        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                              3 * sizeof(float), positions.size() / 3));
+        std::copy(positions.begin(), positions.end(), v);
+        auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                  3 * sizeof(uint32_t), indices.size() / 3));
+        std::copy(indices.begin(), indices.end(), ix);
+        if (collectFilter) rtcSetGeometryIntersectFilterFunction(g, collectEveryHit);
+        attach(scene, g);
+        return committed(scene);
+    }
+
+    /// A committed scene instancing `parts` (null entries skipped) with identity transforms.
+    RTCScene instances(const std::vector<RTCScene>& parts) {
+        RTCScene scene = rtcNewScene(device_);
+        const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+        for (RTCScene part : parts) {
+            if (!part) continue;
+            RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(g, part);
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+            attach(scene, g);
+        }
+        return committed(scene);
+    }
+
+    void release(RTCScene scene) {
+        if (!scene) return;
+        scenes_.erase(std::find(scenes_.begin(), scenes_.end(), scene));
+        rtcReleaseScene(scene);
+    }
+
+private:
+    static void attach(RTCScene scene, RTCGeometry g) {
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(scene, g);
+        rtcReleaseGeometry(g);
+    }
+    RTCScene committed(RTCScene scene) {
+        rtcCommitScene(scene);
+        scenes_.push_back(scene);
+        return scene;
+    }
+
+    RTCDevice device_;
+    std::vector<RTCScene> scenes_;
+};
+
+/// First hit distance along o + t d (t >= 0), INFINITY when none; with `hits`, every hit
+/// distance goes there instead (for scenes built with collectFilter).
+float castRay(RTCScene scene, const double o[3], const double d[3], std::vector<float>* hits = nullptr) {
+    if (!scene) return INFINITY;
+    RayContext context;
+    rtcInitIntersectContext(&context.base);
+    context.hits = hits;
+    RTCRayHit rh{};
+    // org, tnear, dir, time, tfar, mask, id, flags
+    rh.ray = {float(o[0]), float(o[1]), float(o[2]), 0.0f, float(d[0]), float(d[1]), float(d[2]), 0.0f, INFINITY, ~0u, 0, 0};
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &context.base, &rh);
+    return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
+}
+
+/// Inside a closed mesh by ray parity: majority over three fixed, oblique directions; hits at
+/// (nearly) equal distances (a ray through an edge) count once.
+bool insideByParity(RTCScene proxy, const double p[3], double mergeDistance) {
+    static const double kDirections[3][3] = {{0.5383, 0.6221, 0.5686}, {-0.7071, 0.3162, -0.6325}, {0.2673, -0.8018, 0.5345}};
+    int inside = 0;
+    std::vector<float> hits;
+    for (const auto& d : kDirections) {
+        hits.clear();
+        castRay(proxy, p, d, &hits);
+        std::sort(hits.begin(), hits.end());
+        int crossings = 0;
+        for (size_t i = 0; i < hits.size(); ++i)
+            if (i == 0 || hits[i] - hits[i - 1] > mergeDistance) ++crossings;
+        inside += crossings % 2;
+    }
+    return inside >= 2;
+}
+
+/// Uniform double in [0, 1) from the raw engine output (portable across standard libraries).
+double uniform01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
+
+// ------------------------------------------------------------------------------------------
+// The checks, on any set of proxies standing for sets of originals.
+
+struct ProxyUnderTest {
+    uint32_t node = 0;
+    const std::vector<float>* positions = nullptr;
+    const std::vector<uint32_t>* indices = nullptr;
+    std::vector<uint32_t> sources;
+    int expectedShells = 0;
+};
+
+struct Figures {
+    size_t proxies = 0, notClosed = 0, notEdgeManifold = 0, nonPositiveVolume = 0, shellMismatch = 0;
+    size_t verticesChecked = 0, verticesOutside = 0, proxiesWithVerticesOutside = 0;
+    double maxVertexOutside = 0;  ///< world units
+    size_t rays = 0, raysHittingOriginals = 0, rayViolations = 0, proxiesWithRayViolations = 0;
+    size_t rayLateButWithinTolerance = 0;  ///< later along the ray, the hit point within tolerance of the proxy
+    double maxRayDepth = 0;  ///< world units: distance outside the proxy of an original point hit first
+    std::vector<std::string> examples;  ///< a few nodes per kind of problem
+    std::map<std::string, int> examplesOfKind;
+
+    void example(const std::string& kind, const std::string& text) {
+        if (examplesOfKind[kind]++ < 3) examples.push_back(text);
+    }
+    /// Adds a proxy's `count` problems of one kind to `total` (and the proxy to `proxiesWith`).
+    void tally(size_t count, size_t& proxiesWith, size_t& total, const std::string& kind, const std::string& text) {
+        if (!count) return;
+        ++proxiesWith;
+        total += count;
+        example(kind, text);
+    }
+    std::string summary() const {
+        std::ostringstream s;
+        s << proxies << " proxies: " << notClosed << " not closed, " << notEdgeManifold << " not edge-manifold, "
+          << nonPositiveVolume << " volume <= 0, " << shellMismatch << " shell count != exact aggregate's; "
+          << verticesOutside << " of " << verticesChecked << " original vertices outside (in " << proxiesWithVerticesOutside
+          << " proxies, max " << maxVertexOutside << "); " << rayViolations << " of " << rays << " rays ("
+          << raysHittingOriginals << " hitting originals) reach an original first (in " << proxiesWithRayViolations
+          << " proxies, max depth " << maxRayDepth << "; " << rayLateButWithinTolerance
+          << " more later along the ray but within tolerance)";
+        for (const std::string& e : examples) s << "\n  " << e;
+        return s.str();
+    }
+};
+
+/// Runs the geometric checks on `proxies`, `raysPerScene` rays spread evenly over them.
+/// tolerance: world units (1e-5 of the scene's size).
+Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vector<InputObject>& objects,
+                     double tolerance, size_t raysPerScene) {
+    Figures f;
+    Embree embree;
+    std::vector<RTCScene> objectScene(objects.size(), nullptr);
+    for (size_t o = 0; o < objects.size(); ++o)
+        objectScene[o] = embree.mesh(std::vector<float>(objects[o].positions.begin(), objects[o].positions.end()),
+                                     objects[o].indices, false);
+    const size_t raysPerProxy = std::max<size_t>(64, (raysPerScene + proxies.size() - 1) / std::max<size_t>(1, proxies.size()));
+    std::mt19937_64 rng(20240601);
+    for (const ProxyUnderTest& p : proxies) {
+        ++f.proxies;
+        const std::string name = "node " + std::to_string(p.node);
+        InputObject mesh;
+        mesh.positions.assign(p.positions->begin(), p.positions->end());
+        mesh.indices.assign(p.indices->begin(), p.indices->end());
+        const ClosedCheck closed = checkClosedAfterWeld(mesh);
+        if (!closed.problem.empty()) {
+            ++f.notClosed;
+            f.example("closed", name + ": not closed: " + closed.problem);
+        }
+        const std::string manifold = edgeManifoldProblem(mesh.indices);
+        if (!manifold.empty()) {
+            ++f.notEdgeManifold;
+            f.example("manifold", name + ": not edge-manifold: " + manifold);
+        }
+        const double volume = signedVolumeOf(mesh);
+        if (!(volume > 0)) {
+            ++f.nonPositiveVolume;
+            std::ostringstream text;
+            text << name << ": volume " << volume;
+            f.example("volume", text.str());
+        }
+        const int shells = shellCount(mesh.indices);
+        if (shells != p.expectedShells) {
+            ++f.shellMismatch;
+            f.example("shells", name + ": " + std::to_string(shells) + " shells, exact aggregate " + std::to_string(p.expectedShells));
+        }
+
+        // Every original vertex inside or within tolerance of the proxy surface.
+        RTCScene proxyScene = embree.mesh(*p.positions, *p.indices, true);
+        detail::TriangleBvh proxyBvh;
+        proxyBvh.build(mesh.positions.data(), mesh.positions.size() / 3, mesh.indices.data(), mesh.indices.size() / 3);
+        size_t outside = 0;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        auto grow = [&](const double* q) {
+            for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], q[k]), hi[k] = std::max(hi[k], q[k]);
+        };
+        for (size_t v = 0; v < mesh.positions.size(); v += 3) grow(&mesh.positions[v]);
+        for (uint32_t s : p.sources)
+            for (size_t v = 0; v < objects[s].positions.size(); v += 3) {
+                const double* q = &objects[s].positions[v];
+                grow(q);
+                ++f.verticesChecked;
+                if (insideByParity(proxyScene, q, 0.1 * tolerance)) continue;
+                const double d = mesh.indices.empty() ? INFINITY : detail::closestPoint(proxyBvh, q).distance;
+                if (d <= tolerance) continue;
+                ++outside;
+                f.maxVertexOutside = std::max(f.maxVertexOutside, d);
+            }
+        f.tally(outside, f.proxiesWithVerticesOutside, f.verticesOutside, "vertices",
+                name + ": " + std::to_string(outside) + " original vertices outside the proxy");
+
+        // Rays from a sphere around the proxy and its originals, aimed at points of their box.
+        std::vector<RTCScene> parts;
+        for (uint32_t s : p.sources) parts.push_back(objectScene[s]);
+        RTCScene originalsScene = embree.instances(parts);
+        double center[3], radius = 0;
+        for (int k = 0; k < 3; ++k) {
+            center[k] = 0.5 * (lo[k] + hi[k]);
+            radius += 0.25 * (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        }
+        radius = 1.5 * std::sqrt(radius) + tolerance;
+        size_t violations = 0;
+        for (size_t r = 0; r < raysPerProxy; ++r) {
+            double origin[3], target[3], dir[3], len = 0;
+            const double z = 2 * uniform01(rng) - 1, phi = 2 * 3.14159265358979323846 * uniform01(rng);
+            const double s = std::sqrt(std::max(0.0, 1 - z * z));
+            const double u[3] = {s * std::cos(phi), s * std::sin(phi), z};
+            for (int k = 0; k < 3; ++k) {
+                origin[k] = center[k] + radius * u[k];
+                target[k] = lo[k] + (hi[k] - lo[k]) * uniform01(rng);
+                dir[k] = target[k] - origin[k];
+                len += dir[k] * dir[k];
+            }
+            len = std::sqrt(len);
+            for (double& c : dir) c /= len;
+            ++f.rays;
+            const float tOriginal = castRay(originalsScene, origin, dir);
+            if (!std::isfinite(tOriginal)) continue;
+            ++f.raysHittingOriginals;
+            const float tProxy = castRay(proxyScene, origin, dir);
+            if (double(tProxy) <= double(tOriginal) + tolerance) continue;
+            // Later along the ray: a violation when the original point hit lies farther than
+            // the tolerance outside the proxy (along a grazing ray a tiny offset gets long).
+            double hit[3];
+            for (int k = 0; k < 3; ++k) hit[k] = origin[k] + double(tOriginal) * dir[k];
+            const double depth = mesh.indices.empty() ? INFINITY : detail::closestPoint(proxyBvh, hit).distance;
+            if (depth <= tolerance) {
+                ++f.rayLateButWithinTolerance;
+                continue;
+            }
+            ++violations;
+            f.maxRayDepth = std::max(f.maxRayDepth, depth);
+        }
+        f.tally(violations, f.proxiesWithRayViolations, f.rayViolations, "rays",
+                name + ": " + std::to_string(violations) + " rays reach an original first");
+        embree.release(originalsScene);
+        embree.release(proxyScene);
+    }
+    return f;
+}
+
+/// The non-leaf nodes of a bake as proxies under test.
+std::vector<ProxyUnderTest> nodeProxies(const AcceptanceScene& s) {
+    std::vector<ProxyUnderTest> out;
+    const HierarchyNodes& nodes = s.baked.nodes;
+    for (uint32_t i = 0; i < nodes.nodes.size(); ++i) {
+        const HierarchyNode& n = nodes.nodes[i];
+        if (n.leaf) continue;
+        ProxyUnderTest p;
+        p.node = i;
+        p.positions = &n.positions;
+        p.indices = &n.indices;
+        p.sources.assign(n.sources.begin(), n.sources.end());
+        p.expectedShells = n.objectLod >= 1
+                               ? objectShells(s.input.objects[n.sources.front()])
+                               : s.baked.hierarchy.levels[size_t(n.firstLevel)].aggregates[n.aggregateIndex].componentCount;
+        out.push_back(std::move(p));
+    }
+    return out;
+}
+
+constexpr size_t kRaysPerScene = 20000;  // six scenes: >= 100k rays
+
+void expectClosedAndContaining(const std::string& name) {
+    const AcceptanceScene& s = acceptanceScene(name);
+    REQUIRE_ACCEPTANCE_SCENE(s);
+    const std::vector<ProxyUnderTest> proxies = nodeProxies(s);
+    ASSERT_FALSE(proxies.empty());
+    const Figures f = checkProxies(proxies, s.input.objects, 1e-5 * s.sphere.diagonal, kRaysPerScene);
+    std::printf("%s: %s\n", s.input.label.c_str(), f.summary().c_str());
+    ::testing::Test::RecordProperty("proxies", int(f.proxies));
+    ::testing::Test::RecordProperty("rays", int(f.rays));
+    ::testing::Test::RecordProperty("ray_violations", int(f.rayViolations));
+    ::testing::Test::RecordProperty("vertices_outside", int(f.verticesOutside));
+    EXPECT_GE(f.rays, kRaysPerScene);
+    EXPECT_GT(f.raysHittingOriginals, f.rays / 10) << "rays must mostly test something";
+    EXPECT_EQ(f.notClosed, 0u) << f.summary();
+    EXPECT_EQ(f.notEdgeManifold, 0u);
+    EXPECT_EQ(f.nonPositiveVolume, 0u);
+    EXPECT_EQ(f.shellMismatch, 0u);
+    EXPECT_EQ(f.verticesOutside, 0u);
+    EXPECT_EQ(f.rayViolations, 0u);
+}
+
+/// Certified error <= budget for every non-leaf node; on a subset of nodes (small enough for
+/// a dense grid: every k-th such node, at most 8; else the smallest node) the brute-force grid measurement of
+/// grid_measure.h never exceeds the certified one-sided bounds.
+void expectErrorsWithinBudget(const std::string& name) {
+    const AcceptanceScene& s = acceptanceScene(name);
+    REQUIRE_ACCEPTANCE_SCENE(s);
+    const std::vector<HierarchyNode>& nodes = s.baked.nodes.nodes;
+    size_t checked = 0, overBudget = 0, noBudget = 0;
+    double maxRatio = 0;
+    uint32_t worst = 0, fewest = 0;
+    size_t fewestTriangles = SIZE_MAX;
+    std::vector<uint32_t> small;  // nodes with <= 6000 triangles on both sides together
+    for (uint32_t i = 0; i < nodes.size(); ++i) {
+        const HierarchyNode& n = nodes[i];
+        if (n.leaf) continue;
+        ++checked;
+        if (!(n.budget > 0)) ++noBudget;
+        const double ratio = n.error.bound() / n.budget;
+        if (!(n.error.bound() <= n.budget)) ++overBudget;
+        if (ratio > maxRatio) maxRatio = ratio, worst = i;
+        size_t triangles = n.indices.size() / 3;
+        for (uint32_t o : n.sources) triangles += s.input.objects[o].indices.size() / 3;
+        if (triangles <= 6000) small.push_back(i);
+        if (triangles < fewestTriangles) fewestTriangles = triangles, fewest = i;
+    }
+    if (small.empty() && checked > 0) small.push_back(fewest);
+    const size_t step = std::max<size_t>(1, small.size() / 8);
+    const double slack = 1e-6 * s.sphere.diagonal;
+    size_t bruteChecked = 0, bruteAbove = 0;
+    double bruteWorstExcess = 0;
+    for (size_t j = 0; j < small.size() && bruteChecked < 8; j += step) {
+        const HierarchyNode& n = nodes[small[j]];
+        std::vector<const InputObject*> originals;
+        size_t triangles = n.indices.size() / 3;
+        for (uint32_t o : n.sources) {
+            originals.push_back(&s.input.objects[o]);
+            triangles += s.input.objects[o].indices.size() / 3;
+        }
+        // About 40k grid points over both sides.
+        const int grid = std::clamp(int(std::sqrt(80000.0 / double(std::max<size_t>(1, triangles)))), 2, 12);
+        const GridMeasured m = gridMeasure(n.positions, n.indices, originals, grid);
+        ++bruteChecked;
+        const double excess = std::max(m.proxyToOriginals - n.error.proxyToOriginals, m.originalsToProxy - n.error.originalsToProxy);
+        if (excess > slack) {
+            ++bruteAbove;
+            bruteWorstExcess = std::max(bruteWorstExcess, excess);
+            std::printf("  node %u: grid (n=%d) %.6g / %.6g above certified %.6g / %.6g\n", small[j], grid, m.proxyToOriginals,
+                        m.originalsToProxy, n.error.proxyToOriginals, n.error.originalsToProxy);
+        }
+    }
+    std::printf("%s: %zu non-leaf nodes, %zu over budget (max error/budget %.3g at node %u), %zu without budget; "
+                "brute force on %zu nodes: %zu above the certified bound (max excess %.3g)\n",
+                s.input.label.c_str(), checked, overBudget, maxRatio, worst, noBudget, bruteChecked, bruteAbove,
+                bruteWorstExcess);
+    ::testing::Test::RecordProperty("nodes", int(checked));
+    ::testing::Test::RecordProperty("over_budget", int(overBudget));
+    ::testing::Test::RecordProperty("brute_force_nodes", int(bruteChecked));
+    EXPECT_GT(checked, 0u);
+    EXPECT_EQ(noBudget, 0u);
+    EXPECT_EQ(overBudget, 0u) << "max error / budget " << maxRatio << " at node " << worst;
+    EXPECT_GT(bruteChecked, 0u);
+    EXPECT_EQ(bruteAbove, 0u) << "max excess " << bruteWorstExcess;
+}
+
+/// The exact aggregates of a bake as proxies under test (they hold pointers into `positions`
+/// and `indices`, one entry per aggregate of every level).
+std::vector<ProxyUnderTest> exactAggregates(const Hierarchy3D& h, std::vector<std::vector<float>>& positions,
+                                            std::vector<std::vector<uint32_t>>& indices) {
+    std::vector<ProxyUnderTest> out;
+    positions.clear();
+    indices.clear();
+    for (const Level& level : h.levels)
+        for (const Aggregate& a : level.aggregates) {
+            positions.emplace_back(a.positions.begin(), a.positions.end());
+            indices.push_back(a.indices);
+        }
+    size_t i = 0;
+    for (const Level& level : h.levels)
+        for (const Aggregate& a : level.aggregates) {
+            ProxyUnderTest p;
+            p.node = uint32_t(i);
+            p.positions = &positions[i];
+            p.indices = &indices[i];
+            p.sources.assign(a.sourceObjects.begin(), a.sourceObjects.end());
+            p.expectedShells = a.componentCount;
+            out.push_back(std::move(p));
+            ++i;
+        }
+    return out;
+}
+
+/// The exact aggregates (closed, containing their originals by construction) pass every
+/// geometric check of the checker.
+void expectExactAggregatesPass(const std::string& name, size_t rays) {
+    const AcceptanceScene& s = acceptanceScene(name);
+    REQUIRE_ACCEPTANCE_SCENE(s);
+    std::vector<std::vector<float>> positions;
+    std::vector<std::vector<uint32_t>> indices;
+    const std::vector<ProxyUnderTest> proxies = exactAggregates(s.baked.hierarchy, positions, indices);
+    const Figures exact = checkProxies(proxies, s.input.objects, 1e-5 * s.sphere.diagonal, rays);
+    std::printf("%s exact aggregates: %s\n", s.input.label.c_str(), exact.summary().c_str());
+    EXPECT_GE(exact.rays, rays);
+    EXPECT_GT(exact.raysHittingOriginals, exact.rays / 10);
+    EXPECT_EQ(exact.notClosed + exact.notEdgeManifold + exact.nonPositiveVolume + exact.shellMismatch, 0u) << exact.summary();
+    EXPECT_EQ(exact.verticesOutside, 0u);
+    EXPECT_EQ(exact.rayViolations, 0u);
+}
+
+}  // namespace
+
+// The checker on spheres15 and on the art of truck_town: the exact aggregates pass it.
+TEST(ProxyAcceptance, CheckerPassesExactAggregates) { expectExactAggregatesPass("spheres15", 10000); }
+TEST(ProxyAcceptance, CheckerPassesExactAggregatesOfRealArt) { expectExactAggregatesPass("truck_town", 10000); }
+// Shrunken, holed and inside-out copies of spheres15's exact aggregates fail the checker.
+TEST(ProxyAcceptance, CheckerCatchesDamagedProxies) {
+    const AcceptanceScene& s = acceptanceScene("spheres15");
+    REQUIRE_ACCEPTANCE_SCENE(s);
+    std::vector<std::vector<float>> positions;
+    std::vector<std::vector<uint32_t>> indices;
+    const std::vector<ProxyUnderTest> proxies = exactAggregates(s.baked.hierarchy, positions, indices);
+    const size_t count = proxies.size();
+    const double tolerance = 1e-5 * s.sphere.diagonal;
+
+    // Shrunk by 2 % about its centroid: original vertices and ray hits outside it.
+    for (std::vector<float>& p : positions) {
+        double c[3] = {0, 0, 0};
+        for (size_t v = 0; v < p.size(); v += 3)
+            for (int k = 0; k < 3; ++k) c[k] += p[v + k] / double(p.size() / 3);
+        for (size_t v = 0; v < p.size(); v += 3)
+            for (int k = 0; k < 3; ++k) p[v + k] = float(c[k] + 0.98 * (p[v + k] - c[k]));
+    }
+    const Figures shrunk = checkProxies(proxies, s.input.objects, tolerance, 4000);
+    std::printf("shrunk: %s\n", shrunk.summary().c_str());
+    EXPECT_EQ(shrunk.proxiesWithVerticesOutside, count);
+    EXPECT_GT(shrunk.proxiesWithRayViolations, 0u);
+    EXPECT_EQ(shrunk.notClosed, 0u);
+
+    // A triangle removed: open. Orientation flipped: negative volume (and still closed).
+    size_t i = 0;
+    for (const Level& level : s.baked.hierarchy.levels)
+        for (const Aggregate& a : level.aggregates) positions[i++].assign(a.positions.begin(), a.positions.end());
+    for (i = 0; i < count; ++i) {
+        if (i % 2 == 0) indices[i].resize(indices[i].size() - 3);
+        else
+            for (size_t t = 0; t < indices[i].size(); t += 3) std::swap(indices[i][t + 1], indices[i][t + 2]);
+    }
+    const Figures damaged = checkProxies(proxies, s.input.objects, tolerance, 1000);
+    std::printf("damaged: %s\n", damaged.summary().c_str());
+    EXPECT_EQ(damaged.notClosed, (count + 1) / 2);
+    EXPECT_EQ(damaged.notEdgeManifold, (count + 1) / 2);
+    EXPECT_EQ(damaged.nonPositiveVolume, count / 2);
+}
+
+// The scenes. A test is DISABLED_ while the proxies of the time fail it (see the figures each
+// prints); run with --gtest_also_run_disabled_tests.
+TEST(ProxyAcceptance, DISABLED_Spheres15ClosedAndContaining) { expectClosedAndContaining("spheres15"); }
+TEST(ProxyAcceptance, DISABLED_Spheres15ErrorsWithinBudget) { expectErrorsWithinBudget("spheres15"); }
+TEST(ProxyAcceptance, DISABLED_ChessClosedAndContaining) { expectClosedAndContaining("chess"); }
+TEST(ProxyAcceptance, DISABLED_ChessErrorsWithinBudget) { expectErrorsWithinBudget("chess"); }
+TEST(ProxyAcceptance, DISABLED_ForestClosedAndContaining) { expectClosedAndContaining("forest"); }
+TEST(ProxyAcceptance, DISABLED_ForestErrorsWithinBudget) { expectErrorsWithinBudget("forest"); }
+TEST(ProxyAcceptance, DISABLED_VillageClosedAndContaining) { expectClosedAndContaining("village"); }
+TEST(ProxyAcceptance, DISABLED_VillageErrorsWithinBudget) { expectErrorsWithinBudget("village"); }
+TEST(ProxyAcceptance, DISABLED_TruckTownClosedAndContaining) { expectClosedAndContaining("truck_town"); }
+TEST(ProxyAcceptance, DISABLED_TruckTownErrorsWithinBudget) { expectErrorsWithinBudget("truck_town"); }
+TEST(ProxyAcceptance, DISABLED_Random400ClosedAndContaining) { expectClosedAndContaining("random"); }
+TEST(ProxyAcceptance, DISABLED_Random400ErrorsWithinBudget) { expectErrorsWithinBudget("random"); }
