@@ -15,9 +15,10 @@ namespace aggrelod::io {
 uint64_t settingsHash(const std::string& text);
 
 /// Faces meeting at a dihedral angle (between their normals) of more than this are a crease:
-/// their shared vertices are split, each side gets its own normal. 45 degrees keeps box and
-/// roof edges crisp and smooths the coarse tessellation of rounded proxies.
-constexpr double kCreaseAngleDegrees = 45.0;
+/// their shared vertices are split, each side gets its own normal. 60 degrees keeps box edges
+/// and steep roof ridges crisp and smooths the coarse facets of rounded proxies (a distant
+/// clump of trees should not look like a cut gem).
+constexpr double kCreaseAngleDegrees = 60.0;
 
 /// A mesh ready to draw: one normal and one colour per vertex.
 struct RenderMesh {

@@ -76,6 +76,7 @@ struct HierarchyBuilder {
     const std::vector<SyntheticBox>& boxes;
     uint32_t branching;
     float errorScale;
+    uint32_t objectLodChain;
 
     // Builds the subtree over objects ids[first, last); returns its node index and height.
     std::pair<uint32_t, uint32_t> build(std::vector<uint32_t>& ids, size_t first, size_t last) {
@@ -96,7 +97,26 @@ struct HierarchyBuilder {
                                        static_cast<uint8_t>(13 * o + 200), 255};
             appendBoxMesh(p, node, b.lo, b.hi, colour);
             p.nodes.push_back(node);
-            return {static_cast<uint32_t>(p.nodes.size() - 1), 0};
+            uint32_t below = static_cast<uint32_t>(p.nodes.size() - 1);
+            // Per-object LOD chain: simplified versions of this one object (the same box here),
+            // each a little coarser and with a slightly larger sphere than the node below.
+            for (uint32_t j = 1; j <= objectLodChain; ++j) {
+                runtime::BuildNode lod = p.nodes[below];
+                lod.level = runtime::kObjectLodLevel;
+                lod.firstChild = static_cast<uint32_t>(p.childIndices.size());
+                lod.childCount = 1;
+                p.childIndices.push_back(below);
+                lod.firstSource = static_cast<uint32_t>(p.sourceObjects.size());
+                p.sourceObjects.push_back(o);
+                lod.sphereRadius = float(double(lod.sphereRadius) * (1.0 + 1e-6) + 1e-4);
+                lod.geometricError = errorScale * 0.02f * float(j) * (b.hi[1] - b.lo[1]);
+                appendBoxMesh(p, lod, b.lo, b.hi, colour);
+                const uint32_t self = static_cast<uint32_t>(p.nodes.size());
+                p.nodes[below].parent = self;
+                p.nodes.push_back(lod);
+                below = self;
+            }
+            return {below, 0};
         }
         // Split along the longest axis of the centres, median first, full tie-break on id.
         float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
@@ -178,16 +198,18 @@ struct HierarchyBuilder {
 /// A hierarchy over `objectCount` city boxes: about objectCount*b/(b-1) nodes. `roots` > 1
 /// splits the objects into that many separate trees. An inner node's error is errorScale
 /// times half its box diagonal (1 = the box proxy's true one-sided distance bound; smaller
-/// values mimic proxies that hug their originals, as the bake's).
+/// values mimic proxies that hug their originals, as the bake's). `objectLodChain` > 0 puts
+/// that many per-object LOD nodes (level kObjectLodLevel, one source, errors rising) between
+/// every leaf and its aggregate.
 inline runtime::BuildParams makeSyntheticHierarchy(uint32_t objectCount, uint32_t seed,
                                                    uint32_t branching = 4, uint32_t roots = 1,
-                                                   float errorScale = 1.0f) {
+                                                   float errorScale = 1.0f, uint32_t objectLodChain = 0) {
     runtime::BuildParams p;
     const std::vector<SyntheticBox> boxes = makeCityBoxes(objectCount, seed);
     for (uint32_t i = 0; i < objectCount; ++i) p.objectNames.push_back("box" + std::to_string(i));
     std::vector<uint32_t> ids(objectCount);
     std::iota(ids.begin(), ids.end(), 0u);
-    detail::HierarchyBuilder builder{p, boxes, branching, errorScale};
+    detail::HierarchyBuilder builder{p, boxes, branching, errorScale, objectLodChain};
     roots = std::max(1u, std::min(roots, objectCount));
     for (uint32_t r = 0; r < roots; ++r)
         builder.build(ids, size_t(objectCount) * r / roots, size_t(objectCount) * (r + 1) / roots);
