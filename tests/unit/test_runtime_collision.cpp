@@ -211,7 +211,9 @@ TEST(RuntimeCollision, CutAtLevelRanksPerObjectLodsBetweenLeavesAndLevelZero) {
         for (uint32_t n : b) {
             EXPECT_FALSE(chain.isObjectLod(n)) << "level " << k << " node " << n;
             leavesB += chain.isLeaf(n);
-            if (!chain.isLeaf(n)) EXPECT_LE(chain.node(n).level, k);
+            if (!chain.isLeaf(n)) {
+                EXPECT_LE(chain.node(n).level, k);
+            }
         }
         EXPECT_EQ(leavesA, leavesB) << "level " << k;
     }
