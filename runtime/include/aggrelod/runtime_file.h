@@ -105,8 +105,8 @@ public:
     Span<float> vertices(uint32_t node) const;  ///< 3 floats per vertex, world units
     Span<uint32_t> triangles(uint32_t node) const;  ///< 3 per triangle, relative to node's vertices
     /// Unit outward normal per vertex of a node: 3 floats per vertex, as many vertices as
-    /// vertices(). Smooth across edges whose faces meet at less than kCreaseAngleDegrees
-    /// (the bake's choice), split otherwise.
+    /// vertices(). The bake smooths across edges whose faces' normals differ by at most 60
+    /// degrees and splits the vertices of sharper edges and colour boundaries (docs/runtime.md).
     Span<float> normals(uint32_t node) const;
     /// Base colour per vertex of a node: 4 bytes per vertex (RGB sRGB-encoded, alpha linear;
     /// decodeColorSrgb8 gives linear RGBA), as many vertices as vertices().

@@ -100,8 +100,9 @@ public:
     /// Changes of cut() made by the last call that selects (select, selectFull,
     /// selectByDistance, reset; construction counts as one from an empty cut): the nodes now
     /// in cut() that were not before, and those no longer in it. An engine streams in the
-    /// meshes of entered() and may release those of left(). Each node at most once; order
-    /// unspecified; no allocation. Both are empty when the cut did not change.
+    /// meshes of entered() and may release those of left(). Node indices, each at most once
+    /// (sizes <= nodeCount); order unspecified; no allocation. Both are empty when the cut did
+    /// not change.
     Span<uint32_t> entered() const { return {entered_.data(), enteredCount_}; }
     Span<uint32_t> left() const { return {left_.data(), leftCount_}; }
     /// Inner nodes of the cut: draw their proxy meshes.
