@@ -32,6 +32,21 @@ aglod_status failWith(aglod_status status, const std::string& message) {
 
 using aggrelod::runtime::capi::failWith;
 
+namespace {
+// A per-vertex attribute of a node (`components` values per vertex) as a view into the file.
+template <class T>
+int nodeAttribute(const aglod_file* file, uint32_t node, aggrelod::runtime::Span<T> (RuntimeFile::*get)(uint32_t) const,
+                         size_t components, const T** data, uint32_t* vertex_count) {
+    if (data) *data = nullptr;
+    if (vertex_count) *vertex_count = 0;
+    if (!file || node >= file->file.nodeCount()) return 0;
+    const aggrelod::runtime::Span<T> values = (file->file.*get)(node);
+    if (data) *data = values.data;
+    if (vertex_count) *vertex_count = static_cast<uint32_t>(values.size / components);
+    return 1;
+}
+}  // namespace
+
 extern "C" {
 
 const char* aglod_status_string(aglod_status status) {
@@ -123,23 +138,11 @@ int aglod_node_mesh(const aglod_file* file, uint32_t node, const float** positio
 }
 
 int aglod_node_normals(const aglod_file* file, uint32_t node, const float** normals, uint32_t* vertex_count) {
-    if (normals) *normals = nullptr;
-    if (vertex_count) *vertex_count = 0;
-    if (!file || node >= file->file.nodeCount()) return 0;
-    const aggrelod::runtime::Span<float> n = file->file.normals(node);
-    if (normals) *normals = n.data;
-    if (vertex_count) *vertex_count = static_cast<uint32_t>(n.size / 3);
-    return 1;
+    return nodeAttribute(file, node, &RuntimeFile::normals, 3, normals, vertex_count);
 }
 
 int aglod_node_colors(const aglod_file* file, uint32_t node, const uint8_t** colors, uint32_t* vertex_count) {
-    if (colors) *colors = nullptr;
-    if (vertex_count) *vertex_count = 0;
-    if (!file || node >= file->file.nodeCount()) return 0;
-    const aggrelod::runtime::Span<uint8_t> c = file->file.colors(node);
-    if (colors) *colors = c.data;
-    if (vertex_count) *vertex_count = static_cast<uint32_t>(c.size / 4);
-    return 1;
+    return nodeAttribute(file, node, &RuntimeFile::colors, 4, colors, vertex_count);
 }
 
 void aglod_color_to_linear(const uint8_t rgba[4], float linear[4]) {

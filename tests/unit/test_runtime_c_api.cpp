@@ -23,6 +23,13 @@ std::vector<uint8_t> syntheticBytes(uint32_t objects) {
     EXPECT_TRUE(aggrelod::runtime::writeRuntimeFile(makeSyntheticHierarchy(objects, 9), bytes, error)) << error;
     return bytes;
 }
+// The same bytes through the C API and the C++ reader.
+void openBoth(const std::vector<uint8_t>& bytes, aglod_file*& file, aggrelod::runtime::RuntimeFile& cpp) {
+    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
+    std::string message;
+    ASSERT_EQ(aggrelod::runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), cpp, message),
+              aggrelod::runtime::FileStatus::Ok) << message;
+}
 }  // namespace
 
 TEST(RuntimeCApi, OpenSelectAndNames) {
@@ -137,11 +144,8 @@ TEST(RuntimeCApi, RaycastReportsNodeAndObjects) {
 TEST(RuntimeCApi, NodeMeshIsAViewOfTheFile) {
     const std::vector<uint8_t> bytes = syntheticBytes(50);
     aglod_file* file = nullptr;
-    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
     aggrelod::runtime::RuntimeFile cpp;
-    std::string message;
-    ASSERT_EQ(aggrelod::runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), cpp, message),
-              aggrelod::runtime::FileStatus::Ok);
+    ASSERT_NO_FATAL_FAILURE(openBoth(bytes, file, cpp));
     size_t withTriangles = 0;
     for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
         const float* positions = nullptr;
@@ -221,11 +225,8 @@ TEST(RuntimeCApi, NodeNormalsAndColorsAreViewsOfTheFile) {
 TEST(RuntimeCApi, ViewSelectionCullsAndReportsCutChanges) {
     const std::vector<uint8_t> bytes = syntheticBytes(400);
     aglod_file* file = nullptr;
-    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
     aggrelod::runtime::RuntimeFile cpp;
-    std::string message;
-    ASSERT_EQ(aggrelod::runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), cpp, message),
-              aggrelod::runtime::FileStatus::Ok);
+    ASSERT_NO_FATAL_FAILURE(openBoth(bytes, file, cpp));
     aglod_selector* selector = aglod_selector_create(file);
     ASSERT_NE(selector, nullptr);
     aglod_cut_changes changes;
