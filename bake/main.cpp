@@ -366,9 +366,13 @@ void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int dept
                     sources.empty() ? "" : file.objectName(sources[0]).data(), n.indexCount / 3,
                     cli::formatNumber(n.sphereRadius).c_str());
     } else {
-        std::printf("%snode %u  level %u  delta %s  error %s  triangles %u  box [%s %s %s]..[%s %s %s]  sphere r %s  "
+        // A per-object LOD (a simplified version of one object) has no level of its own.
+        const std::string level = n.level == runtime::kObjectLodLevel
+                                      ? std::string("object LOD")
+                                      : "level " + std::to_string(n.level) + "  delta " + cli::formatNumber(n.delta);
+        std::printf("%snode %u  %s  error %s  triangles %u  box [%s %s %s]..[%s %s %s]  sphere r %s  "
                     "%u objects:",
-                    indent.c_str(), index, n.level, cli::formatNumber(n.delta).c_str(),
+                    indent.c_str(), index, level.c_str(),
                     cli::formatNumber(n.geometricError).c_str(), n.indexCount / 3,
                     cli::formatNumber(n.boundsMin[0]).c_str(), cli::formatNumber(n.boundsMin[1]).c_str(),
                     cli::formatNumber(n.boundsMin[2]).c_str(), cli::formatNumber(n.boundsMax[0]).c_str(),
@@ -397,12 +401,15 @@ int runInspect(const InspectOptions& o) {
         printError(o.file + ": " + runtime::toString(status) + (message.empty() ? "" : ": " + message));
         return kFileError;
     }
-    uint32_t aggregates = 0, leaves = 0;
-    uint64_t proxyTriangles = 0, leafTriangles = 0;
+    uint32_t aggregates = 0, leaves = 0, objectLods = 0;
+    uint64_t proxyTriangles = 0, leafTriangles = 0, objectLodTriangles = 0;
     for (const runtime::NodeRecord& n : file.nodes()) {
         if (n.level == runtime::kLeafLevel) {
             ++leaves;
             leafTriangles += n.indexCount / 3;
+        } else if (n.level == runtime::kObjectLodLevel) {
+            ++objectLods;
+            objectLodTriangles += n.indexCount / 3;
         } else {
             ++aggregates;
             proxyTriangles += n.indexCount / 3;
@@ -411,9 +418,10 @@ int runInspect(const InspectOptions& o) {
     std::printf("%s: format %u.%u, tool %.*s, settings hash %016llx, %zu bytes\n", o.file.c_str(),
                 unsigned(file.versionMajor()), unsigned(file.versionMinor()), int(file.toolVersion().size()),
                 file.toolVersion().data(), static_cast<unsigned long long>(file.settingsHash()), file.byteSize());
-    std::printf("%u nodes: %u aggregates (%llu proxy triangles), %u original objects (%llu triangles); "
-                "%zu roots, depth %u\n",
-                file.nodeCount(), aggregates, static_cast<unsigned long long>(proxyTriangles), leaves,
+    std::printf("%u nodes: %u aggregates (%llu proxy triangles), %u per-object LODs (%llu triangles), "
+                "%u original objects (%llu triangles); %zu roots, depth %u\n",
+                file.nodeCount(), aggregates, static_cast<unsigned long long>(proxyTriangles), objectLods,
+                static_cast<unsigned long long>(objectLodTriangles), leaves,
                 static_cast<unsigned long long>(leafTriangles), file.roots().size, file.depth());
     for (uint32_t r : file.roots()) printInspectNode(file, r, 0, o);
     std::fflush(stdout);

@@ -4,6 +4,7 @@
 #include "render.h"
 
 #include "raster.h"
+#include "runtime_export.h"
 #include "scene_io.h"
 
 #include <aggrelod/collision.h>
@@ -55,22 +56,31 @@ bool buildParamsFromLevels(const std::vector<io::LevelsGlbNode>& nodes, runtime:
         b.firstSource = uint32_t(params.sourceObjects.size());
         b.sourceCount = 1;
         params.sourceObjects.push_back(uint32_t(i));
-        b.firstVertex = uint32_t(params.positions.size() / 3);
-        b.vertexCount = uint32_t(n.positions.size() / 3);
-        b.firstIndex = uint32_t(params.indices.size());
-        b.indexCount = uint32_t(n.indices.size());
         b.level = runtime::kLeafLevel;
         float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        std::vector<float> positions(n.positions.size());
         for (size_t k = 0; k < n.positions.size(); ++k) {
             const float v = float(n.positions[k]);
             if (!std::isfinite(v)) {
                 error = "node '" + n.name + "' has a non-finite coordinate";
                 return false;
             }
-            params.positions.push_back(v);
+            positions[k] = v;
             lo[k % 3] = std::min(lo[k % 3], v);
             hi[k % 3] = std::max(hi[k % 3], v);
         }
+        io::RenderMesh mesh;  // the writer wants normals; the panels colour by group
+        if (!io::buildRenderMesh(positions, n.indices, {}, mesh)) {
+            error = "node '" + n.name + "' has a triangle index out of range";
+            return false;
+        }
+        b.firstVertex = uint32_t(params.positions.size() / 3);
+        b.vertexCount = uint32_t(mesh.positions.size() / 3);
+        b.firstIndex = uint32_t(params.indices.size());
+        b.indexCount = uint32_t(mesh.indices.size());
+        params.positions.insert(params.positions.end(), mesh.positions.begin(), mesh.positions.end());
+        params.normals.insert(params.normals.end(), mesh.normals.begin(), mesh.normals.end());
+        params.colors.insert(params.colors.end(), mesh.colors.begin(), mesh.colors.end());
         if (n.positions.empty()) std::fill(lo, lo + 3, 0.0f), std::fill(hi, hi + 3, 0.0f);
         float r2 = 0;
         for (int k = 0; k < 3; ++k) {
@@ -80,7 +90,7 @@ bool buildParamsFromLevels(const std::vector<io::LevelsGlbNode>& nodes, runtime:
             r2 += 0.25f * (hi[k] - lo[k]) * (hi[k] - lo[k]);
         }
         b.sphereRadius = std::sqrt(r2) * 1.0001f;
-        params.indices.insert(params.indices.end(), n.indices.begin(), n.indices.end());
+        params.indices.insert(params.indices.end(), mesh.indices.begin(), mesh.indices.end());
         params.nodes.push_back(b);
         params.objectNames.push_back(n.name);
     }
@@ -170,6 +180,16 @@ bool RenderScene::open(const std::string& path, std::string& error) {
     originals.label = "ORIGINALS";
     runtime::cutAtLevel(file_, kLeafLevel, originals.nodes);
     panels_.push_back(std::move(originals));
+    bool anyObjectLod = false;
+    for (uint32_t i = 0; i < file_.nodeCount(); ++i) anyObjectLod = anyObjectLod || file_.isObjectLod(i);
+    if (anyObjectLod) {
+        // The coarsest simplified version of every object, before any aggregation.
+        Panel objectLods;
+        objectLods.level = runtime::kObjectLodLevel;
+        objectLods.label = "OBJECT LODS";
+        runtime::cutAtLevel(file_, runtime::kObjectLodLevel, objectLods.nodes);
+        panels_.push_back(std::move(objectLods));
+    }
     for (uint32_t level : runtime::levelsOf(file_)) {
         Panel panel;
         panel.level = level;
@@ -198,7 +218,9 @@ std::string RenderScene::levelList() const {
     std::string s;
     for (const Panel& p : panels_) {
         if (!s.empty()) s += ", ";
-        s += p.level == kLeafLevel ? std::string("originals") : std::to_string(p.level);
+        s += p.level == kLeafLevel                ? std::string("originals")
+             : p.level == runtime::kObjectLodLevel ? std::string("object-lods")
+                                                   : std::to_string(p.level);
     }
     return s;
 }

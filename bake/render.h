@@ -34,7 +34,7 @@ struct RgbImage {
 /// One picture the scene offers: the originals or one level.
 struct Panel {
     std::string label;            ///< e.g. "LEVEL 2  DELTA 0.5" or "ORIGINALS"
-    uint32_t level = 0;           ///< runtime::kLeafLevel for the originals
+    uint32_t level = 0;           ///< runtime::kLeafLevel for the originals, kObjectLodLevel for the per-object LODs
     std::vector<uint32_t> nodes;  ///< the cut: runtime-file nodes drawn
 };
 
@@ -47,7 +47,8 @@ public:
     RenderScene(const RenderScene&) = delete;
     RenderScene& operator=(const RenderScene&) = delete;
 
-    /// Opens a .aglod (panels: the originals, then every level) or a levels.glb (panels:
+    /// Opens a .aglod (panels: the originals, the coarsest per-object LODs when the file has
+    /// any, then every aggregate level) or a levels.glb (panels:
     /// every level). False with a message naming the file and the problem.
     bool open(const std::string& path, std::string& error);
 

@@ -61,11 +61,13 @@ int runRender(const RenderOptions& o) {
         panels.push_back(0);
     } else {
         uint32_t level = runtime::kLeafLevel;
-        if (o.level != "originals") {
+        if (o.level == "object-lods") {
+            level = runtime::kObjectLodLevel;
+        } else if (o.level != "originals") {
             char* end = nullptr;
             const long k = std::strtol(o.level.c_str(), &end, 10);
-            if (o.level.empty() || *end != '\0' || k < 0 || k >= long(runtime::kLeafLevel)) {
-                printError("--level '" + o.level + "': expected 'originals' or a level number");
+            if (o.level.empty() || *end != '\0' || k < 0 || k >= long(runtime::kMaxAggregateLevel)) {
+                printError("--level '" + o.level + "': expected 'originals', 'object-lods' or a level number");
                 return kUsage;
             }
             level = uint32_t(k);

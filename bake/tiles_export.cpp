@@ -176,6 +176,9 @@ private:
         out_ += in + "\"extras\": {\"node\": " + std::to_string(n);
         if (node.leaf) {
             out_ += ", \"object\": " + jsonString(objects_[n].name) + ", \"id\": " + std::to_string(objects_[n].id);
+        } else if (node.objectLod >= 1) {
+            // A simplified version of one object: no aggregate level of its own.
+            out_ += ", \"objectLod\": " + std::to_string(node.objectLod) + ", \"objects\": 1";
         } else {
             out_ += ", \"level\": " + std::to_string(node.firstLevel) + ", \"lastLevel\": " +
                     std::to_string(node.lastLevel) + ", \"delta\": " + number(node.delta) +
@@ -227,12 +230,16 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
     for (uint32_t n : writer.contentNodes()) {
         const HierarchyNode& node = nodes.nodes[n];
         TileMesh tile;
-        tile.name = node.leaf ? "object_" + objects[n].name : "node" + std::to_string(n) + "_level" +
-                                                                  std::to_string(node.firstLevel);
+        const bool objectLod = node.objectLod >= 1;
+        tile.name = node.leaf    ? "object_" + objects[n].name
+                    : objectLod ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
+                                : "node" + std::to_string(n) + "_level" + std::to_string(node.firstLevel);
         tile.positions = node.positions;
         tile.indices = node.indices;
         if (!node.leaf) {
-            const std::vector<double> colour = levelBaseColour(size_t(node.firstLevel), size_t(levelCount));
+            // Per-object LODs are finer than level 0: they take its tint.
+            const std::vector<double> colour =
+                levelBaseColour(objectLod ? 0 : size_t(node.firstLevel), size_t(std::max(levelCount, 1)));
             std::copy(colour.begin(), colour.begin() + 4, tile.baseColor);
         }
         tile.node = n;

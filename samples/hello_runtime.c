@@ -4,23 +4,28 @@
  *
  * It opens the baked hierarchy, flies a camera from far away towards the scene, prints which
  * nodes a renderer would draw each frame (aggregate proxies far away, the original objects
- * close up), then casts a ray against the originals and against the coarsest level. */
+ * close up) and what entered and left the cut (what an engine would stream), culls a view
+ * that looks at half of the scene, reads a drawn mesh's normals and colours, then casts a ray
+ * against the originals and against the coarsest level. */
 #include <aggrelod_runtime.h>
 
 #include <math.h>
 #include <stdio.h>
 
-static void print_cut(int frame, float distance, const aglod_file* file, const aglod_cut* cut) {
+static void print_cut(int frame, float distance, const aglod_file* file, const aglod_cut* cut,
+                      const aglod_cut_changes* changes) {
     /* A renderer would draw the proxy mesh of each proxy node and its own meshes of the
-     * original objects listed in cut->originals. Here we only count them per level. */
-    unsigned coarsest = 0;
+     * original objects listed in cut->originals. Here we only count them per level
+     * (per-object LODs, simplified single objects, have no aggregate level). */
+    int coarsest = -1;
     for (uint32_t i = 0; i < cut->proxy_count; ++i) {
         const uint32_t level = aglod_node_level(file, cut->proxies[i]);
-        if (level > coarsest) coarsest = level;
+        if (level != AGLOD_OBJECT_LOD_LEVEL && (int)level > coarsest) coarsest = (int)level;
     }
-    printf("frame %2d  distance %9.1f  cut %5u nodes: %5u proxies (coarsest level %2d), %5u originals\n",
-           frame, distance, cut->node_count, cut->proxy_count, cut->proxy_count ? (int)coarsest : -1,
-           cut->original_count);
+    printf("frame %2d  distance %9.1f  cut %5u nodes: %5u proxies (coarsest level %2d), %5u originals;"
+           "  %u entered, %u left\n",
+           frame, distance, cut->node_count, cut->proxy_count, coarsest, cut->original_count,
+           changes->entered_count, changes->left_count);
 }
 
 static void print_hit(const char* what, const aglod_file* file, int hit, const aglod_hit* h) {
@@ -66,6 +71,7 @@ int main(int argc, char** argv) {
     aglod_selector* selector = aglod_selector_create(file);
     aglod_camera camera = {{0, 0, 0}, 1.0f /* ~57 degrees */, 1080.0f};
     aglod_cut cut;
+    aglod_cut_changes changes;
     for (int frame = 0; frame < 12; ++frame) {
         const float distance = 1000.0f * size * powf(0.5f, (float)frame); /* fly in */
         camera.position[0] = center[0] - distance * 0.6f;
@@ -76,7 +82,40 @@ int main(int argc, char** argv) {
             fprintf(stderr, "hello_runtime: %s\n", aglod_last_error());
             break;
         }
-        print_cut(frame, distance, file, &cut);
+        aglod_selector_changes(selector, &changes); /* stream in changes.entered, release changes.left */
+        print_cut(frame, distance, file, &cut, &changes);
+    }
+
+    /* 2b. Frustum culling: looking from the last position at the scene's centre, 16:9. Nodes
+     *     outside the view are neither refined nor drawn. The first drawn mesh's normals and
+     *     colours come with its positions (one of each per vertex). */
+    aglod_view_camera view = {{camera.position[0], camera.position[1], camera.position[2]}, 1.0f, 1080.0f,
+                              {center[0] - camera.position[0], center[1] - camera.position[1],
+                               center[2] - camera.position[2]},
+                              {0, 1, 0}, 16.0f / 9.0f, 0.0f, 0.0f};
+    aglod_cut view_cut;
+    if (aglod_select_view(selector, &view, 1.0f, 0.75f, &view_cut) == AGLOD_OK) {
+        uint32_t culled = 0;
+        aglod_culled_nodes(selector, &culled);
+        aglod_selector_changes(selector, &changes);
+        printf("view towards the centre: %u nodes drawn, %u culled; %u entered, %u left\n", view_cut.node_count,
+               culled, changes.entered_count, changes.left_count);
+        if (view_cut.node_count > 0) {
+            const float* normals = NULL;
+            const uint8_t* colors = NULL;
+            uint32_t vertices = 0;
+            aglod_node_normals(file, view_cut.nodes[0], &normals, &vertices);
+            aglod_node_colors(file, view_cut.nodes[0], &colors, &vertices);
+            if (vertices > 0) {
+                float linear[4];
+                aglod_color_to_linear(colors, linear);
+                printf("node %u: %u vertices, first normal (%.2f %.2f %.2f), colour (%.2f %.2f %.2f %.2f) linear\n",
+                       view_cut.nodes[0], vertices, normals[0], normals[1], normals[2], linear[0], linear[1],
+                       linear[2], linear[3]);
+            }
+        }
+    } else {
+        fprintf(stderr, "hello_runtime: %s\n", aglod_last_error());
     }
 
     /* 3. Collide: a ray from the last camera position towards the first node drawn, first against
@@ -95,7 +134,7 @@ int main(int argc, char** argv) {
         uint32_t coarsest = 0;
         for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
             const uint32_t level = aglod_node_level(file, n);
-            if (level != AGLOD_LEAF_LEVEL && level > coarsest) coarsest = level;
+            if (level != AGLOD_LEAF_LEVEL && level != AGLOD_OBJECT_LOD_LEVEL && level > coarsest) coarsest = level;
         }
         if (aglod_collision_use_level(collision, coarsest) == AGLOD_OK) {
             got = aglod_raycast(collision, camera.position, dir, 1e30f, &hit);

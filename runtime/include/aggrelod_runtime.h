@@ -43,6 +43,10 @@ typedef struct aglod_collision aglod_collision;
 
 /* Marks leaves (original objects) in aglod_node_level, and "originals" in aglod_collision_use_level. */
 #define AGLOD_LEAF_LEVEL 0xFFFFu
+/* Marks per-object LOD nodes (a simplified version of one object, between its leaf and its
+ * first aggregate) in aglod_node_level; in aglod_collision_use_level: the coarsest per-object
+ * LOD of every object. */
+#define AGLOD_OBJECT_LOD_LEVEL 0xFFFEu
 #define AGLOD_NO_INDEX 0xFFFFFFFFu
 
 /* Short name of a status, e.g. "checksum mismatch". Never NULL. */
@@ -60,7 +64,8 @@ void aglod_close(aglod_file* file);
 
 uint32_t aglod_node_count(const aglod_file* file);
 uint32_t aglod_object_count(const aglod_file* file);
-/* Level of a node (AGLOD_LEAF_LEVEL for originals), AGLOD_NO_INDEX when out of range. */
+/* Level of a node: 0, 1, ... for aggregates, AGLOD_LEAF_LEVEL for originals,
+ * AGLOD_OBJECT_LOD_LEVEL for per-object LODs; AGLOD_NO_INDEX when out of range. */
 uint32_t aglod_node_level(const aglod_file* file, uint32_t node);
 /* Geometric error of a node, world units (-1 when out of range). */
 float aglod_node_error(const aglod_file* file, uint32_t node);
@@ -72,6 +77,18 @@ int aglod_node_bounds(const aglod_file* file, uint32_t node, float min[3], float
  * meshes for leaves. 0 when out of range (outputs then empty), 1 otherwise. */
 int aglod_node_mesh(const aglod_file* file, uint32_t node, const float** positions, uint32_t* vertex_count,
                     const uint32_t** indices, uint32_t* index_count);
+/* Per-vertex normals of a node's mesh, a view into the file: 3 floats per vertex (unit,
+ * outward), *vertex_count vertices, in the order of aglod_node_mesh's positions. Vertices on
+ * creases and colour boundaries are split in the file, so positions + normals + colours can
+ * be uploaded as they are. 0 when out of range (outputs then empty), 1 otherwise. */
+int aglod_node_normals(const aglod_file* file, uint32_t node, const float** normals, uint32_t* vertex_count);
+/* Per-vertex base colours of a node's mesh, a view into the file: 4 bytes per vertex, RGB
+ * sRGB-encoded and alpha linear (upload as an sRGB8_ALPHA8-like normalised attribute and
+ * linearise in the shader, or use aglod_color_to_linear), *vertex_count vertices. White
+ * (255, 255, 255, 255) where the scene had no colour. 0 when out of range, 1 otherwise. */
+int aglod_node_colors(const aglod_file* file, uint32_t node, const uint8_t** colors, uint32_t* vertex_count);
+/* The linear RGBA in [0, 1] (glTF COLOR_0 / baseColorFactor meaning) of 4 colour bytes. */
+void aglod_color_to_linear(const uint8_t rgba[4], float linear[4]);
 /* Box of the whole scene (union of the roots' boxes), world units. 0 when file is NULL. */
 int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]);
 /* Name of an original object, NUL-terminated copy into buffer (capacity bytes); returns the
@@ -86,10 +103,30 @@ typedef struct aglod_camera {
 
 /* The nodes to draw. Views owned by the selector, valid until its next aglod_select. */
 typedef struct aglod_cut {
-    const uint32_t* nodes;     uint32_t node_count;     /* all nodes of the cut */
+    const uint32_t* nodes;     uint32_t node_count;     /* all nodes drawn (the cut, minus culled nodes) */
     const uint32_t* proxies;   uint32_t proxy_count;    /* inner nodes: draw their proxy mesh */
     const uint32_t* originals; uint32_t original_count; /* objects the engine draws itself */
 } aglod_cut;
+
+/* A camera with orientation, for selection with frustum culling (aglod_select_view). */
+typedef struct aglod_view_camera {
+    float position[3];     /* world units */
+    float fov_y;           /* vertical field of view, radians, in (0, pi) */
+    float viewport_height; /* pixels */
+    float forward[3];      /* view direction, world space, any non-zero length */
+    float up[3];           /* world space, not parallel to forward */
+    float aspect;          /* viewport width / height, > 0 */
+    float near_distance;   /* near plane, world units along forward, >= 0 */
+    float far_distance;    /* far plane, world units along forward; 0 or infinity = none */
+} aglod_view_camera;
+
+/* The cut's changes made by the last selection call: nodes now drawn that were not before
+ * (stream their meshes in) and nodes no longer drawn. Views owned by the selector, valid
+ * until its next call. Creating the selector counts as a first call (entered = the roots). */
+typedef struct aglod_cut_changes {
+    const uint32_t* entered; uint32_t entered_count;
+    const uint32_t* left;    uint32_t left_count;
+} aglod_cut_changes;
 
 /* One selector per view; allocates at creation only. NULL on failure. */
 aglod_selector* aglod_selector_create(const aglod_file* file);
@@ -98,6 +135,18 @@ void aglod_selector_destroy(aglod_selector* selector);
  * pixel_tolerance: tau in pixels (> 0); coarsen_ratio in (0, 1]: hysteresis (1 = none). */
 aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera,
                           float pixel_tolerance, float coarsen_ratio, aglod_cut* out);
+/* Same selection with frustum culling: a node whose bounding sphere lies outside the view
+ * frustum is neither refined nor drawn; it is not in `out` (nodes, proxies, originals), so
+ * the objects it stands for are simply not drawn; aglod_culled_nodes lists such nodes.
+ * May be mixed with aglod_select on the same selector. AGLOD_INVALID_ARGUMENT for a zero or
+ * non-finite forward, up parallel to forward, aspect <= 0, near < 0 or far <= near. */
+aglod_status aglod_select_view(aglod_selector* selector, const aglod_view_camera* camera,
+                               float pixel_tolerance, float coarsen_ratio, aglod_cut* out);
+/* Nodes culled by the last aglod_select_view (none after aglod_select): *count of them,
+ * a view owned by the selector, valid until its next call. NULL with *count 0 for NULL. */
+const uint32_t* aglod_culled_nodes(const aglod_selector* selector, uint32_t* count);
+/* Fills *out with the changes of the cut made by the last call; 0 for NULL arguments. */
+int aglod_selector_changes(const aglod_selector* selector, aglod_cut_changes* out);
 
 /* ---- collision (aggrelod_runtime_collision, Embree 3) ---- */
 

@@ -3,7 +3,7 @@
 //
 //   offset  size  field
 //   0       8     magic "AGGRELOD"
-//   8       2     major version        10  2  minor version
+//   8       2     major version (2)    10  2  minor version (0)
 //   12      4     section count
 //   16      8     total size in bytes (a multiple of 32)
 //   24      8     checksum: fileChecksum() of the whole file with this field read as 0
@@ -37,12 +37,16 @@ enum SectionKind : uint32_t {
     kIndices = 6,      // u32, relative to the node's first vertex
     kNameRanges = 7,   // {u32 offset, u32 length} into kNameBlob, stride 8
     kNameBlob = 8,     // UTF-8 bytes
+    kNormals = 9,      // 3 x f32 unit normal per vertex, stride 12 (same count as kPositions)
+    kColors = 10,      // RGBA8 per vertex, RGB sRGB-encoded, alpha linear (same count as kPositions)
 };
-constexpr uint32_t kSectionCount = 8;
-constexpr uint32_t kSectionStride[kSectionCount + 1] = {0, 88, 4, 4, 4, 12, 4, 8, 1};
+constexpr uint32_t kSectionCount = 10;
+constexpr uint32_t kSectionStride[kSectionCount + 1] = {0, 88, 4, 4, 4, 12, 4, 8, 1, 12, 4};
 constexpr const char* kSectionName[kSectionCount + 1] = {
     "", "nodes", "roots", "child indices", "source objects", "positions", "indices",
-    "name ranges", "name blob"};
+    "name ranges", "name blob", "normals", "colors"};
+/// A stored normal's length may differ from 1 by this much (float rounding of the bake).
+constexpr float kNormalLengthTolerance = 1e-3f;
 
 inline bool hostIsLittleEndian() {
     const uint32_t one = 1;

@@ -8,6 +8,7 @@
 #include "c_api_internal.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <new>
 
@@ -30,6 +31,21 @@ aglod_status failWith(aglod_status status, const std::string& message) {
 }  // namespace aggrelod::runtime::capi
 
 using aggrelod::runtime::capi::failWith;
+
+namespace {
+// A per-vertex attribute of a node (`components` values per vertex) as a view into the file.
+template <class T>
+int nodeAttribute(const aglod_file* file, uint32_t node, aggrelod::runtime::Span<T> (RuntimeFile::*get)(uint32_t) const,
+                         size_t components, const T** data, uint32_t* vertex_count) {
+    if (data) *data = nullptr;
+    if (vertex_count) *vertex_count = 0;
+    if (!file || node >= file->file.nodeCount()) return 0;
+    const aggrelod::runtime::Span<T> values = (file->file.*get)(node);
+    if (data) *data = values.data;
+    if (vertex_count) *vertex_count = static_cast<uint32_t>(values.size / components);
+    return 1;
+}
+}  // namespace
 
 extern "C" {
 
@@ -121,6 +137,19 @@ int aglod_node_mesh(const aglod_file* file, uint32_t node, const float** positio
     return 1;
 }
 
+int aglod_node_normals(const aglod_file* file, uint32_t node, const float** normals, uint32_t* vertex_count) {
+    return nodeAttribute(file, node, &RuntimeFile::normals, 3, normals, vertex_count);
+}
+
+int aglod_node_colors(const aglod_file* file, uint32_t node, const uint8_t** colors, uint32_t* vertex_count) {
+    return nodeAttribute(file, node, &RuntimeFile::colors, 4, colors, vertex_count);
+}
+
+void aglod_color_to_linear(const uint8_t rgba[4], float linear[4]) {
+    if (!rgba || !linear) return;
+    decodeColorSrgb8(rgba, linear);
+}
+
 int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]) {
     if (!file || !min || !max) return 0;
     for (int k = 0; k < 3; ++k) {
@@ -163,22 +192,82 @@ aglod_selector* aglod_selector_create(const aglod_file* file) {
 
 void aglod_selector_destroy(aglod_selector* selector) { delete selector; }
 
+static bool validSelection(const char* function, float pixel_tolerance, float coarsen_ratio, float fov_y,
+                           float viewport_height) {
+    if (pixel_tolerance > 0 && coarsen_ratio > 0 && coarsen_ratio <= 1 && fov_y > 0 && fov_y < 3.14159f &&
+        viewport_height > 0)
+        return true;
+    failWith(AGLOD_INVALID_ARGUMENT, std::string(function) +
+                                         ": need pixel_tolerance > 0, coarsen_ratio in (0,1], fov_y in (0,pi), "
+                                         "viewport_height > 0");
+    return false;
+}
+
+static void fillCut(const Selector& s, aglod_cut* out) {
+    *out = {s.cut().data, uint32_t(s.cut().size), s.proxyNodes().data, uint32_t(s.proxyNodes().size),
+            s.originalObjects().data, uint32_t(s.originalObjects().size)};
+}
+
 aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera, float pixel_tolerance,
                           float coarsen_ratio, aglod_cut* out) {
     if (!selector || !camera || !out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_select: NULL argument");
-    if (!(pixel_tolerance > 0) || !(coarsen_ratio > 0 && coarsen_ratio <= 1) || !(camera->fov_y > 0 && camera->fov_y < 3.14159f) ||
-        !(camera->viewport_height > 0))
-        return failWith(AGLOD_INVALID_ARGUMENT,
-                        "aglod_select: need pixel_tolerance > 0, coarsen_ratio in (0,1], fov_y in (0,pi), viewport_height > 0");
+    if (!validSelection("aglod_select", pixel_tolerance, coarsen_ratio, camera->fov_y, camera->viewport_height))
+        return AGLOD_INVALID_ARGUMENT;
     Camera c;
     std::memcpy(c.position, camera->position, sizeof(c.position));
     c.fovY = camera->fov_y;
     c.viewportHeight = camera->viewport_height;
     selector->selector.select(c, SelectionSettings{pixel_tolerance, coarsen_ratio});
-    const Selector& s = selector->selector;
-    *out = {s.cut().data, uint32_t(s.cut().size), s.proxyNodes().data, uint32_t(s.proxyNodes().size),
-            s.originalObjects().data, uint32_t(s.originalObjects().size)};
+    fillCut(selector->selector, out);
     return AGLOD_OK;
+}
+
+aglod_status aglod_select_view(aglod_selector* selector, const aglod_view_camera* camera, float pixel_tolerance,
+                               float coarsen_ratio, aglod_cut* out) {
+    if (!selector || !camera || !out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_select_view: NULL argument");
+    if (!validSelection("aglod_select_view", pixel_tolerance, coarsen_ratio, camera->fov_y, camera->viewport_height))
+        return AGLOD_INVALID_ARGUMENT;
+    const float* f = camera->forward;
+    const float* u = camera->up;
+    const double fl = std::sqrt(double(f[0]) * f[0] + double(f[1]) * f[1] + double(f[2]) * f[2]);
+    const double ul = std::sqrt(double(u[0]) * u[0] + double(u[1]) * u[1] + double(u[2]) * u[2]);
+    const double cx = double(f[1]) * u[2] - double(f[2]) * u[1], cy = double(f[2]) * u[0] - double(f[0]) * u[2],
+                 cz = double(f[0]) * u[1] - double(f[1]) * u[0];
+    const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (fl * ul);
+    const float far = camera->far_distance == 0.0f ? INFINITY : camera->far_distance;
+    if (!(fl > 0) || !std::isfinite(fl) || !(ul > 0) || !std::isfinite(ul) || !(sine > 1e-6) ||
+        !(camera->aspect > 0) || !std::isfinite(camera->aspect) || !(camera->near_distance >= 0) ||
+        !(far > camera->near_distance))
+        return failWith(AGLOD_INVALID_ARGUMENT,
+                        "aglod_select_view: need a finite non-zero forward, up not parallel to it, aspect > 0, "
+                        "near_distance >= 0 and far_distance > near_distance (0 = none)");
+    ViewCamera c;
+    std::memcpy(c.position, camera->position, sizeof(c.position));
+    c.fovY = camera->fov_y;
+    c.viewportHeight = camera->viewport_height;
+    std::memcpy(c.forward, camera->forward, sizeof(c.forward));
+    std::memcpy(c.up, camera->up, sizeof(c.up));
+    c.aspect = camera->aspect;
+    c.nearDistance = camera->near_distance;
+    c.farDistance = far;
+    selector->selector.select(c, SelectionSettings{pixel_tolerance, coarsen_ratio});
+    fillCut(selector->selector, out);
+    return AGLOD_OK;
+}
+
+const uint32_t* aglod_culled_nodes(const aglod_selector* selector, uint32_t* count) {
+    if (count) *count = 0;
+    if (!selector || !count) return nullptr;
+    const Span<uint32_t> culled = selector->selector.culledNodes();
+    *count = uint32_t(culled.size);
+    return culled.data;
+}
+
+int aglod_selector_changes(const aglod_selector* selector, aglod_cut_changes* out) {
+    if (!selector || !out) return 0;
+    const Selector& s = selector->selector;
+    *out = {s.entered().data, uint32_t(s.entered().size), s.left().data, uint32_t(s.left().size)};
+    return 1;
 }
 
 }  // extern "C"

@@ -18,11 +18,19 @@ namespace aggrelod::runtime {
 
 void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out) {
     out.clear();
-    // Leaves are finer than level 0: rank(leaf) = -1, rank(inner) = its level.
-    auto rank = [&](uint32_t node) -> int64_t {
-        return file.isLeaf(node) ? -1 : int64_t(file.node(node).level);
+    // Leaves are finest, then the per-object LODs, then level 0: rank(leaf) = -2,
+    // rank(object LOD) = -1, rank(aggregate) = its level. A bake puts every object in a
+    // level-0 aggregate, above its per-object LOD chain; should a chain hang directly below
+    // a coarser aggregate, a cut at k >= 0 still passes through it to the leaf.
+    auto rankOf = [](uint32_t l) -> int64_t {
+        return l == kLeafLevel ? -2 : l == kObjectLodLevel ? -1 : int64_t(l);
     };
-    const int64_t wanted = level == kLeafLevel ? -1 : int64_t(level);
+    const int64_t wanted = rankOf(level);
+    auto rank = [&](uint32_t node) -> int64_t {
+        if (file.isLeaf(node)) return -2;
+        if (file.isObjectLod(node)) return wanted == -1 ? -1 : std::numeric_limits<int64_t>::max();
+        return rankOf(file.node(node).level);
+    };
     std::vector<uint32_t> stack(file.roots().begin(), file.roots().end());
     while (!stack.empty()) {
         const uint32_t x = stack.back();
@@ -39,7 +47,7 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
 std::vector<uint32_t> levelsOf(const RuntimeFile& file) {
     std::vector<uint32_t> levels;
     for (uint32_t i = 0; i < file.nodeCount(); ++i)
-        if (!file.isLeaf(i)) levels.push_back(file.node(i).level);
+        if (!file.isLeaf(i) && !file.isObjectLod(i)) levels.push_back(file.node(i).level);
     std::sort(levels.begin(), levels.end());
     levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
     return levels;

@@ -47,6 +47,14 @@ Span<float> RuntimeFile::vertices(uint32_t node) const {
     const NodeRecord& n = nodes_.data[node];
     return {positions_.data + 3ull * n.firstVertex, 3ull * n.vertexCount};
 }
+Span<float> RuntimeFile::normals(uint32_t node) const {
+    const NodeRecord& n = nodes_.data[node];
+    return {normals_.data + 3ull * n.firstVertex, 3ull * n.vertexCount};
+}
+Span<uint8_t> RuntimeFile::colors(uint32_t node) const {
+    const NodeRecord& n = nodes_.data[node];
+    return {colors_.data + 4ull * n.firstVertex, 4ull * n.vertexCount};
+}
 Span<uint32_t> RuntimeFile::triangles(uint32_t node) const {
     const NodeRecord& n = nodes_.data[node];
     return {indices_.data + n.firstIndex, n.indexCount};
@@ -137,12 +145,20 @@ struct FileValidator {
             }
         }
         if (counts[kNodes] >= kNoIndex) return fail(FileStatus::BadSection, "too many nodes");
+        // Normals and colours are per vertex: the same count as the positions.
+        for (uint32_t s : {kNormals, kColors})
+            if (counts[s] != counts[kPositions])
+                return fail(FileStatus::BadSection, std::string(kSectionName[s]) + ": " + std::to_string(counts[s]) +
+                                                        " entries for " + std::to_string(counts[kPositions]) +
+                                                        " vertices");
 
         out.nodes_ = {static_cast<const NodeRecord*>(data[kNodes]), counts[kNodes]};
         out.roots_ = {static_cast<const uint32_t*>(data[kRoots]), counts[kRoots]};
         out.childIndices_ = {static_cast<const uint32_t*>(data[kChildIndices]), counts[kChildIndices]};
         out.sourceObjects_ = {static_cast<const uint32_t*>(data[kSourceObjects]), counts[kSourceObjects]};
         out.positions_ = {static_cast<const float*>(data[kPositions]), 3 * counts[kPositions]};
+        out.normals_ = {static_cast<const float*>(data[kNormals]), 3 * counts[kNormals]};
+        out.colors_ = {static_cast<const uint8_t*>(data[kColors]), 4 * counts[kColors]};
         out.indices_ = {static_cast<const uint32_t*>(data[kIndices]), counts[kIndices]};
         out.nameRanges_ = {static_cast<const uint32_t*>(data[kNameRanges]), 2 * counts[kNameRanges]};
         out.nameBlob_ = {static_cast<const char*>(data[kNameBlob]), counts[kNameBlob]};
@@ -199,10 +215,28 @@ struct FileValidator {
             for (int k = 0; k < 3; ++k)
                 if (r.boundsMin[k] > r.boundsMax[k])
                     return fail(FileStatus::BadValue, where() + ": box min > max");
+            const bool leaf = r.childCount == 0;
+            if (leaf != (r.level == kLeafLevel))
+                return fail(FileStatus::BadValue, where() + (leaf ? ": a leaf with level " + std::to_string(r.level)
+                                                                  : ": an inner node with the leaf level"));
+            if (r.level == kObjectLodLevel && r.sourceCount != 1)
+                return fail(FileStatus::BadValue, where() + ": per-object LOD node standing for " +
+                                                      std::to_string(r.sourceCount) + " objects");
+            if (!leaf && r.level != kObjectLodLevel && r.level >= kMaxAggregateLevel)
+                return fail(FileStatus::BadValue, where() + ": level " + std::to_string(r.level));
         }
         for (size_t i = 0; i < out.positions_.size; ++i)
             if (!std::isfinite(out.positions_[i]))
                 return fail(FileStatus::BadValue, "vertex " + std::to_string(i / 3) + ": NaN or infinite coordinate");
+        for (size_t v = 0; v < out.normals_.size / 3; ++v) {
+            const float* nv = out.normals_.data + 3 * v;
+            const float length2 = nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2];
+            // NaN fails the comparison too.
+            if (!(std::fabs(length2 - 1.0f) <= 2.0f * layout::kNormalLengthTolerance))
+                return fail(FileStatus::BadValue, "vertex " + std::to_string(v) + ": normal (" + std::to_string(nv[0]) +
+                                                      ", " + std::to_string(nv[1]) + ", " + std::to_string(nv[2]) +
+                                                      ") is not of unit length");
+        }
         for (size_t i = 0; i < out.childIndices_.size; ++i)
             if (out.childIndices_[i] >= n)
                 return fail(FileStatus::IndexOutOfRange, "child entry " + std::to_string(i) + ": node " +

@@ -7,6 +7,8 @@
 
 #include "aglod_layout.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -38,6 +40,16 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
     if (params.positions.size() % 3 != 0) {
         error = "positions: " + std::to_string(params.positions.size()) +
                 " floats is not a multiple of 3";
+        return false;
+    }
+    if (params.normals.size() != params.positions.size()) {
+        error = "normals: " + std::to_string(params.normals.size()) + " floats for " +
+                std::to_string(params.positions.size()) + " position floats (one normal per vertex)";
+        return false;
+    }
+    if (params.colors.size() / 4 != params.positions.size() / 3 || params.colors.size() % 4 != 0) {
+        error = "colors: " + std::to_string(params.colors.size()) + " bytes for " +
+                std::to_string(params.positions.size() / 3) + " vertices (4 bytes per vertex)";
         return false;
     }
     if (params.toolVersion.size() >= kToolVersionSize) {
@@ -103,6 +115,8 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
         {params.indices.data(), params.indices.size()},
         {nameRanges.data(), nameRanges.size() / 2},
         {blob.data(), blob.size()},
+        {params.normals.data(), params.normals.size() / 3},
+        {params.colors.data(), params.colors.size() / 4},
     };
 
     size_t offsets[kSectionCount + 1] = {};
@@ -145,6 +159,23 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
         return false;
     }
     return true;
+}
+
+namespace {
+float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+float linearToSrgb(float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f; }
+uint8_t toByte(float unit) { return static_cast<uint8_t>(std::lround(unit * 255.0f)); }
+float clampUnit(float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; }  // NaN -> 0
+}  // namespace
+
+void encodeColorSrgb8(const float linear[4], uint8_t out[4]) {
+    for (int k = 0; k < 3; ++k) out[k] = toByte(linearToSrgb(clampUnit(linear[k])));
+    out[3] = toByte(clampUnit(linear[3]));
+}
+
+void decodeColorSrgb8(const uint8_t encoded[4], float linear[4]) {
+    for (int k = 0; k < 3; ++k) linear[k] = srgbToLinear(encoded[k] / 255.0f);
+    linear[3] = encoded[3] / 255.0f;
 }
 
 }  // namespace aggrelod::runtime

@@ -81,6 +81,11 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
     posInOriginals_.assign(file.objectCount(), kNoIndex);
     leaseSerial_.assign(n, 0);
     heap_.reserve(2 * size_t(n) + 16);
+    inView_.assign(n, 0);
+    entered_.resize(n);
+    left_.resize(n);
+    touched_.resize(n);
+    touchStamp_.assign(n, 0);
     reset();
 }
 
@@ -89,8 +94,7 @@ void Selector::reset() {
     for (State& st : state_) st.refined = 0;
     nextSize_ = proxyCount_ = originalCount_ = 0;
     for (uint32_t root : file_->roots()) emit(root);
-    std::swap(cut_, nextCut_);
-    cutSize_ = nextSize_;
+    endFrame(0);
 }
 
 Selector::Frame Selector::makeFrame(const float p[3], float k, float tau, float coarsenRatio) {
@@ -163,15 +167,54 @@ void Selector::beginFrame(const Frame& f) {
     if (++frame_ == 0) {  // stamp wrap-around after 2^32 frames
         for (State& st : state_) st.decidedStamp = st.emittedStamp = 0;
         std::fill(targetStamp_.begin(), targetStamp_.end(), 0);
+        std::fill(touchStamp_.begin(), touchStamp_.end(), 0);
         frame_ = 1;
     }
     for (int k = 0; k < 3; ++k) frameP_[k] = f.p[k];
     stats_ = {};
 }
 
-void Selector::endFrame() {
+// nextCut_[0, nextSize_) is the new cover, its last `culled` entries culled.
+void Selector::endFrame(uint32_t culled) {
+    diffRebuilt(cut_.data(), cutSize_ - culledCount_, nextCut_.data(), nextSize_ - culled);
     std::swap(cut_, nextCut_);
     cutSize_ = nextSize_;
+    culledCount_ = culled;
+}
+
+void Selector::diffRebuilt(const uint32_t* oldDrawn, uint32_t oldCount, const uint32_t* newDrawn, uint32_t newCount) {
+    enteredCount_ = leftCount_ = 0;
+    for (uint32_t i = 0; i < newCount; ++i) {
+        const uint32_t x = newDrawn[i];
+        if (!inView_[x]) entered_[enteredCount_++] = x;
+        inView_[x] = 2;  // in both cuts or entered
+    }
+    for (uint32_t i = 0; i < oldCount; ++i) {
+        const uint32_t x = oldDrawn[i];
+        if (inView_[x] == 1) {
+            left_[leftCount_++] = x;
+            inView_[x] = 0;
+        }
+    }
+    for (uint32_t i = 0; i < newCount; ++i) inView_[newDrawn[i]] = 1;
+}
+
+inline void Selector::touch(uint32_t node) {
+    if (touchStamp_[node] == frame_) return;
+    touchStamp_[node] = frame_;
+    touched_[touchedCount_++] = node;
+}
+
+void Selector::diffTouched() {
+    enteredCount_ = leftCount_ = 0;
+    for (uint32_t i = 0; i < touchedCount_; ++i) {
+        const uint32_t x = touched_[i];
+        const uint8_t now = posInCut_[x] != kNoIndex;
+        if (now && !inView_[x]) entered_[enteredCount_++] = x;
+        if (!now && inView_[x]) left_[leftCount_++] = x;
+        inView_[x] = now;
+    }
+    touchedCount_ = 0;
 }
 
 void Selector::runIncremental(const Frame& f) {
@@ -206,19 +249,23 @@ void Selector::runIncremental(const Frame& f) {
             emit(n);
         }
     }
-    endFrame();
+    endFrame(0);
 }
 
-void Selector::runFull(const Frame& f) {
+void Selector::runFull(const Frame& f, bool cull) {
     dropIndex();
     beginFrame(f);
     nextSize_ = proxyCount_ = originalCount_ = 0;
-    uint32_t top = 0, refinedCount = 0;
+    // Culled nodes are put at the end of nextCut_ (the cover never exceeds its size).
+    const uint32_t capacity = static_cast<uint32_t>(nextCut_.size());
+    uint32_t top = 0, refinedCount = 0, culled = 0;
     const Span<uint32_t> roots = file_->roots();
     for (size_t i = roots.size; i-- > 0;) stack_[top++] = roots[i];
     while (top > 0) {
         const uint32_t x = stack_[--top];
-        if (refine(x, f)) {
+        if (cull && outsideFrustum(x)) {
+            nextCut_[capacity - 1 - culled++] = x;
+        } else if (refine(x, f)) {
             newlyRefined_[refinedCount++] = x;
             const Span<uint32_t> kids = file_->children(x);
             for (size_t i = kids.size; i-- > 0;) stack_[top++] = kids[i];
@@ -232,7 +279,73 @@ void Selector::runFull(const Frame& f) {
             state_[x].refined = 0;
     for (uint32_t i = 0; i < refinedCount; ++i) state_[newlyRefined_[i]].refined = 1;
     stats_.refined = refinedCount;
-    endFrame();
+    stats_.culled = culled;
+    // The culled nodes follow the drawn ones (in walk order); the copy runs forwards to a
+    // start that is not after the source's, so the ranges may overlap.
+    std::reverse(nextCut_.begin() + (capacity - culled), nextCut_.end());
+    std::copy(nextCut_.begin() + (capacity - culled), nextCut_.end(), nextCut_.begin() + nextSize_);
+    nextSize_ += culled;
+    endFrame(culled);
+}
+
+bool Selector::setFrustum(const ViewCamera& c) {
+    planeCount_ = 0;
+    const double f0[3] = {c.forward[0], c.forward[1], c.forward[2]}, u0[3] = {c.up[0], c.up[1], c.up[2]};
+    const double fl = std::sqrt(f0[0] * f0[0] + f0[1] * f0[1] + f0[2] * f0[2]);
+    if (!(fl > 0) || !std::isfinite(fl) || !(c.aspect > 0) || !std::isfinite(c.aspect) || !(c.fovY > 0) ||
+        !(c.fovY < 3.14159265f))
+        return false;
+    const double f[3] = {f0[0] / fl, f0[1] / fl, f0[2] / fl};
+    double r[3] = {f[1] * u0[2] - f[2] * u0[1], f[2] * u0[0] - f[0] * u0[2], f[0] * u0[1] - f[1] * u0[0]};
+    const double rl = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    if (!(rl > 1e-12 * std::sqrt(u0[0] * u0[0] + u0[1] * u0[1] + u0[2] * u0[2])) || !std::isfinite(rl)) return false;
+    for (double& x : r) x /= rl;
+    const double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    const double tanY = std::tan(0.5 * double(c.fovY)), tanX = tanY * double(c.aspect);
+    // Side planes through the eye: inside when |q.r| <= (q.f) tanX and |q.u| <= (q.f) tanY
+    // (q = p - eye), i.e. q.(f tan -/+ axis) >= 0, normalised.
+    double normals[6][3];
+    double offsets[6];
+    int count = 0;
+    const double sx = 1.0 / std::sqrt(tanX * tanX + 1.0), sy = 1.0 / std::sqrt(tanY * tanY + 1.0);
+    for (int sign : {-1, 1}) {
+        for (int k = 0; k < 3; ++k) normals[count][k] = (f[k] * tanX + sign * r[k]) * sx;
+        ++count;
+        for (int k = 0; k < 3; ++k) normals[count][k] = (f[k] * tanY + sign * u[k]) * sy;
+        ++count;
+    }
+    for (int p = 0; p < count; ++p) offsets[p] = 0;
+    // Near: q.f >= near; far: q.f <= far.
+    const double nearD = std::max(0.0, double(c.nearDistance));
+    for (int k = 0; k < 3; ++k) normals[count][k] = f[k];
+    offsets[count++] = -nearD;
+    if (std::isfinite(c.farDistance)) {
+        for (int k = 0; k < 3; ++k) normals[count][k] = -f[k];
+        offsets[count++] = double(c.farDistance);
+    }
+    for (int p = 0; p < count; ++p) {
+        const double d = offsets[p] - (normals[p][0] * c.position[0] + normals[p][1] * c.position[1] +
+                                       normals[p][2] * c.position[2]);
+        if (!std::isfinite(d)) return false;
+        for (int k = 0; k < 3; ++k) planes_[p][k] = float(normals[p][k]);
+        planes_[p][3] = float(d);
+    }
+    planeCount_ = count;
+    return true;
+}
+
+// Outside when the whole sphere is on the outer side of one plane; the float evaluation gets
+// a relative margin so that rounding never culls a sphere that touches the frustum.
+inline bool Selector::outsideFrustum(uint32_t node) const {
+    const Hot& h = hot_[node];
+    for (int p = 0; p < planeCount_; ++p) {
+        const float* q = planes_[p];
+        const float s = q[0] * h.center[0] + q[1] * h.center[1] + q[2] * h.center[2] + q[3];
+        const float scale = std::fabs(q[0] * h.center[0]) + std::fabs(q[1] * h.center[1]) +
+                            std::fabs(q[2] * h.center[2]) + std::fabs(q[3]) + h.radius;
+        if (s < -h.radius - 1e-5f * scale) return true;
+    }
+    return false;
 }
 
 static float projectionScale(const Camera& camera) {
@@ -247,7 +360,14 @@ void Selector::select(const Camera& camera, const SelectionSettings& settings) {
 
 void Selector::selectFull(const Camera& camera, const SelectionSettings& settings) {
     runFull(makeFrame(camera.position, projectionScale(camera), settings.pixelTolerance,
-                      settings.coarsenRatio));
+                      settings.coarsenRatio),
+            false);
+}
+
+void Selector::select(const ViewCamera& camera, const SelectionSettings& settings) {
+    const bool cull = setFrustum(camera);
+    runFull(makeFrame(camera.position, projectionScale(camera), settings.pixelTolerance, settings.coarsenRatio),
+            cull);
 }
 
 void Selector::selectByDistance(const float point[3], float maxErrorPerDistance, float coarsenRatio) {
@@ -323,6 +443,7 @@ void Selector::grantLease(uint32_t node, const Frame& f) {
 }
 
 void Selector::insertNode(uint32_t node, const Frame& f) {
+    touch(node);
     posInCut_[node] = cutSize_;
     cut_[cutSize_++] = node;
     const Hot& h = hot_[node];
@@ -340,6 +461,7 @@ void Selector::insertNode(uint32_t node, const Frame& f) {
 }
 
 void Selector::removeNode(uint32_t node) {
+    touch(node);
     const uint32_t i = posInCut_[node];
     const uint32_t last = cut_[--cutSize_];
     cut_[i] = last;
@@ -421,6 +543,7 @@ void Selector::runLeased(const Frame& f) {
         ++stats_.leasesExpired;
         handleExpired(l.node, f);
     }
+    diffTouched();
 }
 
 }  // namespace aggrelod::runtime

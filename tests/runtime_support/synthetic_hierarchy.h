@@ -22,21 +22,36 @@ struct SyntheticBox {
     float lo[3], hi[3];
 };
 
-/// Appends a closed, outward 12-triangle box mesh to `p`, sets node's vertex/index ranges.
+/// Appends a closed, outward 12-triangle box mesh to `p` (4 vertices per face, so each face
+/// has its own normal, as the bake splits at creases), sets node's vertex/index ranges. The
+/// faces get colour `rgba` (the file's encoded bytes), the top face a lighter one.
 inline void appendBoxMesh(runtime::BuildParams& p, runtime::BuildNode& node, const float lo[3],
-                          const float hi[3]) {
+                          const float hi[3], const uint8_t rgba[4] = nullptr) {
+    static const uint8_t kWhite[4] = {255, 255, 255, 255};
+    if (!rgba) rgba = kWhite;
     node.firstVertex = static_cast<uint32_t>(p.positions.size() / 3);
-    node.vertexCount = 8;
+    node.vertexCount = 24;
     node.firstIndex = static_cast<uint32_t>(p.indices.size());
     node.indexCount = 36;
-    for (int v = 0; v < 8; ++v) {
-        p.positions.push_back((v & 1) ? hi[0] : lo[0]);
-        p.positions.push_back((v & 2) ? hi[1] : lo[1]);
-        p.positions.push_back((v & 4) ? hi[2] : lo[2]);
+    // Corner v of the box: bit 0 = x high, bit 1 = y high, bit 2 = z high. Each face lists its
+    // corners counter-clockwise seen from outside.
+    static const int kFaceCorners[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    static const float kFaceNormal[6][3] = {{0, 0, -1}, {0, 0, 1}, {0, -1, 0}, {0, 1, 0}, {-1, 0, 0}, {1, 0, 0}};
+    for (int f = 0; f < 6; ++f) {
+        const uint32_t base = static_cast<uint32_t>(p.positions.size() / 3) - node.firstVertex;
+        for (int i = 0; i < 4; ++i) {
+            const int v = kFaceCorners[f][i];
+            p.positions.push_back((v & 1) ? hi[0] : lo[0]);
+            p.positions.push_back((v & 2) ? hi[1] : lo[1]);
+            p.positions.push_back((v & 4) ? hi[2] : lo[2]);
+            p.normals.insert(p.normals.end(), kFaceNormal[f], kFaceNormal[f] + 3);
+            for (int k = 0; k < 4; ++k)
+                p.colors.push_back(f == 3 && k < 3 ? static_cast<uint8_t>(rgba[k] / 2 + 128) : rgba[k]);
+        }
+        const uint32_t quad[6] = {base, base + 1, base + 2, base, base + 2, base + 3};
+        p.indices.insert(p.indices.end(), quad, quad + 6);
     }
-    static const uint32_t kFaces[36] = {0, 2, 1, 1, 2, 3,  4, 5, 6, 5, 7, 6,  0, 1, 4, 1, 5, 4,
-                                        2, 6, 3, 3, 6, 7,  0, 4, 2, 2, 4, 6,  1, 3, 5, 3, 7, 5};
-    p.indices.insert(p.indices.end(), kFaces, kFaces + 36);
 }
 
 inline std::vector<SyntheticBox> makeCityBoxes(uint32_t count, uint32_t seed, float cell = 10.0f) {
@@ -61,6 +76,7 @@ struct HierarchyBuilder {
     const std::vector<SyntheticBox>& boxes;
     uint32_t branching;
     float errorScale;
+    uint32_t objectLodChain;
 
     // Builds the subtree over objects ids[first, last); returns its node index and height.
     std::pair<uint32_t, uint32_t> build(std::vector<uint32_t>& ids, size_t first, size_t last) {
@@ -77,9 +93,30 @@ struct HierarchyBuilder {
                 node.boundsMax[k] = b.hi[k];
             }
             finishSphereOfBox(node);
-            appendBoxMesh(p, node, b.lo, b.hi);
+            const uint8_t colour[4] = {static_cast<uint8_t>(37 * o), static_cast<uint8_t>(91 * o + 40),
+                                       static_cast<uint8_t>(13 * o + 200), 255};
+            appendBoxMesh(p, node, b.lo, b.hi, colour);
             p.nodes.push_back(node);
-            return {static_cast<uint32_t>(p.nodes.size() - 1), 0};
+            uint32_t below = static_cast<uint32_t>(p.nodes.size() - 1);
+            // Per-object LOD chain: simplified versions of this one object (the same box here),
+            // each a little coarser and with a slightly larger sphere than the node below.
+            for (uint32_t j = 1; j <= objectLodChain; ++j) {
+                runtime::BuildNode lod = p.nodes[below];
+                lod.level = runtime::kObjectLodLevel;
+                lod.firstChild = static_cast<uint32_t>(p.childIndices.size());
+                lod.childCount = 1;
+                p.childIndices.push_back(below);
+                lod.firstSource = static_cast<uint32_t>(p.sourceObjects.size());
+                p.sourceObjects.push_back(o);
+                lod.sphereRadius = float(double(lod.sphereRadius) * (1.0 + 1e-6) + 1e-4);
+                lod.geometricError = errorScale * 0.02f * float(j) * (b.hi[1] - b.lo[1]);
+                appendBoxMesh(p, lod, b.lo, b.hi, colour);
+                const uint32_t self = static_cast<uint32_t>(p.nodes.size());
+                p.nodes[below].parent = self;
+                p.nodes.push_back(lod);
+                below = self;
+            }
+            return {below, 0};
         }
         // Split along the longest axis of the centres, median first, full tie-break on id.
         float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
@@ -161,16 +198,18 @@ struct HierarchyBuilder {
 /// A hierarchy over `objectCount` city boxes: about objectCount*b/(b-1) nodes. `roots` > 1
 /// splits the objects into that many separate trees. An inner node's error is errorScale
 /// times half its box diagonal (1 = the box proxy's true one-sided distance bound; smaller
-/// values mimic proxies that hug their originals, as the bake's).
+/// values mimic proxies that hug their originals, as the bake's). `objectLodChain` > 0 puts
+/// that many per-object LOD nodes (level kObjectLodLevel, one source, errors rising) between
+/// every leaf and its aggregate.
 inline runtime::BuildParams makeSyntheticHierarchy(uint32_t objectCount, uint32_t seed,
                                                    uint32_t branching = 4, uint32_t roots = 1,
-                                                   float errorScale = 1.0f) {
+                                                   float errorScale = 1.0f, uint32_t objectLodChain = 0) {
     runtime::BuildParams p;
     const std::vector<SyntheticBox> boxes = makeCityBoxes(objectCount, seed);
     for (uint32_t i = 0; i < objectCount; ++i) p.objectNames.push_back("box" + std::to_string(i));
     std::vector<uint32_t> ids(objectCount);
     std::iota(ids.begin(), ids.end(), 0u);
-    detail::HierarchyBuilder builder{p, boxes, branching, errorScale};
+    detail::HierarchyBuilder builder{p, boxes, branching, errorScale, objectLodChain};
     roots = std::max(1u, std::min(roots, objectCount));
     for (uint32_t r = 0; r < roots; ++r)
         builder.build(ids, size_t(objectCount) * r / roots, size_t(objectCount) * (r + 1) / roots);

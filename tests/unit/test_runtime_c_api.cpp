@@ -23,6 +23,13 @@ std::vector<uint8_t> syntheticBytes(uint32_t objects) {
     EXPECT_TRUE(aggrelod::runtime::writeRuntimeFile(makeSyntheticHierarchy(objects, 9), bytes, error)) << error;
     return bytes;
 }
+// The same bytes through the C API and the C++ reader.
+void openBoth(const std::vector<uint8_t>& bytes, aglod_file*& file, aggrelod::runtime::RuntimeFile& cpp) {
+    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
+    std::string message;
+    ASSERT_EQ(aggrelod::runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), cpp, message),
+              aggrelod::runtime::FileStatus::Ok) << message;
+}
 }  // namespace
 
 TEST(RuntimeCApi, OpenSelectAndNames) {
@@ -137,11 +144,8 @@ TEST(RuntimeCApi, RaycastReportsNodeAndObjects) {
 TEST(RuntimeCApi, NodeMeshIsAViewOfTheFile) {
     const std::vector<uint8_t> bytes = syntheticBytes(50);
     aglod_file* file = nullptr;
-    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
     aggrelod::runtime::RuntimeFile cpp;
-    std::string message;
-    ASSERT_EQ(aggrelod::runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), cpp, message),
-              aggrelod::runtime::FileStatus::Ok);
+    ASSERT_NO_FATAL_FAILURE(openBoth(bytes, file, cpp));
     size_t withTriangles = 0;
     for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
         const float* positions = nullptr;
@@ -166,5 +170,146 @@ TEST(RuntimeCApi, NodeMeshIsAViewOfTheFile) {
     EXPECT_EQ(positions, nullptr);
     EXPECT_EQ(vertexCount, 0u);
     EXPECT_EQ(aglod_node_mesh(nullptr, 0, nullptr, nullptr, nullptr, nullptr), 0);
+    aglod_close(file);
+}
+
+TEST(RuntimeCApi, NodeNormalsAndColorsAreViewsOfTheFile) {
+    const aggrelod::runtime::BuildParams p = makeSyntheticHierarchy(40, 9, 4, 1, 1.0f, 1);
+    std::vector<uint8_t> bytes;
+    std::string error;
+    ASSERT_TRUE(aggrelod::runtime::writeRuntimeFile(p, bytes, error)) << error;
+    aglod_file* file = nullptr;
+    ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
+    size_t objectLods = 0;
+    for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
+        const aggrelod::runtime::BuildNode& b = p.nodes[n];
+        const float* normals = nullptr;
+        const uint8_t* colors = nullptr;
+        uint32_t normalCount = 0, colorCount = 0, vertexCount = 0;
+        ASSERT_EQ(aglod_node_mesh(file, n, nullptr, &vertexCount, nullptr, nullptr), 1);
+        ASSERT_EQ(aglod_node_normals(file, n, &normals, &normalCount), 1);
+        ASSERT_EQ(aglod_node_colors(file, n, &colors, &colorCount), 1);
+        ASSERT_EQ(normalCount, vertexCount);
+        ASSERT_EQ(colorCount, vertexCount);
+        ASSERT_EQ(vertexCount, b.vertexCount);
+        EXPECT_EQ(std::memcmp(normals, &p.normals[3 * size_t(b.firstVertex)], 12 * size_t(vertexCount)), 0) << n;
+        EXPECT_EQ(std::memcmp(colors, &p.colors[4 * size_t(b.firstVertex)], 4 * size_t(vertexCount)), 0) << n;
+        objectLods += aglod_node_level(file, n) == AGLOD_OBJECT_LOD_LEVEL;
+    }
+    EXPECT_EQ(objectLods, 40u);
+    // The colour bytes decode to linear RGBA as the C++ runtime does.
+    const uint8_t rgba[4] = {188, 0, 255, 128};
+    float linear[4];
+    aglod_color_to_linear(rgba, linear);
+    EXPECT_NEAR(linear[0], 0.5f, 0.003f);
+    EXPECT_EQ(linear[1], 0.0f);
+    EXPECT_EQ(linear[2], 1.0f);
+    EXPECT_NEAR(linear[3], 128 / 255.0f, 1e-6f);
+    aglod_color_to_linear(nullptr, linear);  // NULL-safe
+    // Out of range and NULL: 0 and empty outputs.
+    const float* normals = reinterpret_cast<const float*>(&bytes);
+    const uint8_t* colors = bytes.data();
+    uint32_t count = 7;
+    EXPECT_EQ(aglod_node_normals(file, aglod_node_count(file), &normals, &count), 0);
+    EXPECT_EQ(normals, nullptr);
+    EXPECT_EQ(count, 0u);
+    count = 7;
+    EXPECT_EQ(aglod_node_colors(file, aglod_node_count(file), &colors, &count), 0);
+    EXPECT_EQ(colors, nullptr);
+    EXPECT_EQ(count, 0u);
+    EXPECT_EQ(aglod_node_normals(nullptr, 0, nullptr, nullptr), 0);
+    EXPECT_EQ(aglod_node_colors(nullptr, 0, nullptr, nullptr), 0);
+    aglod_close(file);
+}
+
+TEST(RuntimeCApi, ViewSelectionCullsAndReportsCutChanges) {
+    const std::vector<uint8_t> bytes = syntheticBytes(400);
+    aglod_file* file = nullptr;
+    aggrelod::runtime::RuntimeFile cpp;
+    ASSERT_NO_FATAL_FAILURE(openBoth(bytes, file, cpp));
+    aglod_selector* selector = aglod_selector_create(file);
+    ASSERT_NE(selector, nullptr);
+    aglod_cut_changes changes;
+    ASSERT_EQ(aglod_selector_changes(selector, &changes), 1);
+    ASSERT_EQ(changes.entered_count, uint32_t(cpp.roots().size));  // construction: the roots entered
+    EXPECT_EQ(changes.left_count, 0u);
+
+    // In the middle of the city, looking along +x: the same cut and culled nodes as the C++
+    // selector with the same camera; far = 0 means no far plane.
+    float lo[3], hi[3];
+    ASSERT_EQ(aglod_scene_bounds(file, lo, hi), 1);
+    aglod_view_camera view = {{0.5f * (lo[0] + hi[0]), 10.0f, 0.5f * (lo[2] + hi[2])}, 1.0f, 1080.0f,
+                              {1, 0, 0}, {0, 1, 0}, 1.5f, 0.0f, 0.0f};
+    aglod_cut cut;
+    ASSERT_EQ(aglod_select_view(selector, &view, 2.0f, 0.75f, &cut), AGLOD_OK) << aglod_last_error();
+    aggrelod::runtime::Selector reference(cpp);
+    aggrelod::runtime::ViewCamera c;
+    std::memcpy(c.position, view.position, sizeof c.position);
+    c.fovY = 1.0f;
+    c.viewportHeight = 1080.0f;
+    c.aspect = 1.5f;
+    c.forward[0] = 1; c.forward[1] = 0; c.forward[2] = 0;
+    reference.select(c, {2.0f, 0.75f});
+    std::vector<uint32_t> a(cut.nodes, cut.nodes + cut.node_count), b(reference.cut().begin(), reference.cut().end());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    uint32_t culledCount = 0;
+    const uint32_t* culled = aglod_culled_nodes(selector, &culledCount);
+    ASSERT_GT(culledCount, 0u);
+    EXPECT_EQ(culledCount, uint32_t(reference.culledNodes().size));
+    std::vector<uint32_t> ca(culled, culled + culledCount), cb(reference.culledNodes().begin(), reference.culledNodes().end());
+    std::sort(ca.begin(), ca.end());
+    std::sort(cb.begin(), cb.end());
+    EXPECT_EQ(ca, cb);
+    // The changes since construction: everything drawn entered, the roots (refined) left.
+    ASSERT_EQ(aglod_selector_changes(selector, &changes), 1);
+    EXPECT_EQ(changes.entered_count, cut.node_count);
+    std::vector<uint32_t> entered(changes.entered, changes.entered + changes.entered_count);
+    std::sort(entered.begin(), entered.end());
+    EXPECT_EQ(entered, a);
+
+    // Turning around: what was drawn leaves, the cut of the other half enters.
+    const std::vector<uint32_t> before = a;
+    view.forward[0] = -1;
+    ASSERT_EQ(aglod_select_view(selector, &view, 2.0f, 0.75f, &cut), AGLOD_OK);
+    ASSERT_EQ(aglod_selector_changes(selector, &changes), 1);
+    std::vector<uint32_t> after(cut.nodes, cut.nodes + cut.node_count), left(changes.left, changes.left + changes.left_count);
+    std::sort(after.begin(), after.end());
+    std::sort(left.begin(), left.end());
+    std::vector<uint32_t> expectedLeft;
+    std::set_difference(before.begin(), before.end(), after.begin(), after.end(), std::back_inserter(expectedLeft));
+    EXPECT_EQ(left, expectedLeft);
+    EXPECT_GT(changes.left_count, 0u);
+    EXPECT_GT(changes.entered_count, 0u);
+
+    // aglod_select afterwards culls nothing.
+    aglod_camera plain = {{view.position[0], view.position[1], view.position[2]}, 1.0f, 1080.0f};
+    ASSERT_EQ(aglod_select(selector, &plain, 2.0f, 0.75f, &cut), AGLOD_OK);
+    aglod_culled_nodes(selector, &culledCount);
+    EXPECT_EQ(culledCount, 0u);
+
+    // Bad cameras are refused with a message; NULLs are safe.
+    aglod_view_camera bad = view;
+    bad.forward[0] = 0;
+    EXPECT_EQ(aglod_select_view(selector, &bad, 2.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(aglod_last_error()).find("forward"), std::string::npos);
+    bad = view;
+    bad.up[0] = -1; bad.up[1] = 0;  // parallel to forward
+    EXPECT_EQ(aglod_select_view(selector, &bad, 2.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
+    bad = view;
+    bad.aspect = 0;
+    EXPECT_EQ(aglod_select_view(selector, &bad, 2.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
+    bad = view;
+    bad.near_distance = 5;
+    bad.far_distance = 2;
+    EXPECT_EQ(aglod_select_view(selector, &bad, 2.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
+    EXPECT_EQ(aglod_select_view(selector, nullptr, 2.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
+    EXPECT_EQ(aglod_select_view(nullptr, &view, 2.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
+    EXPECT_EQ(aglod_culled_nodes(nullptr, &culledCount), nullptr);
+    EXPECT_EQ(culledCount, 0u);
+    EXPECT_EQ(aglod_selector_changes(nullptr, &changes), 0);
+    EXPECT_EQ(aglod_selector_changes(selector, nullptr), 0);
+    aglod_selector_destroy(selector);
     aglod_close(file);
 }

@@ -185,6 +185,55 @@ TEST(RuntimeCollision, SegmentAndOcclusionAgreeWithTheRay) {
     EXPECT_FALSE(world.raycast(o, zero, 10.0f, hit));
     EXPECT_FALSE(world.occluded(o, zero, 10.0f));
 }
+TEST(RuntimeCollision, CutAtLevelRanksPerObjectLodsBetweenLeavesAndLevelZero) {
+    // The same hierarchy with and without a chain of two per-object LODs above every leaf.
+    std::vector<uint8_t> plainBytes, chainBytes;
+    std::string error;
+    ASSERT_TRUE(writeRuntimeFile(makeSyntheticHierarchy(120, 23, 3), plainBytes, error)) << error;
+    ASSERT_TRUE(writeRuntimeFile(makeSyntheticHierarchy(120, 23, 3, 1, 1.0f, 2), chainBytes, error)) << error;
+    RuntimeFile plain, chain;
+    ASSERT_EQ(RuntimeFile::openMemory(plainBytes.data(), plainBytes.size(), plain, error), FileStatus::Ok) << error;
+    ASSERT_EQ(RuntimeFile::openMemory(chainBytes.data(), chainBytes.size(), chain, error), FileStatus::Ok) << error;
+    ASSERT_EQ(chain.nodeCount(), plain.nodeCount() + 2 * 120);
+
+    // The per-object LODs are not a level.
+    EXPECT_EQ(levelsOf(chain), levelsOf(plain));
+    ASSERT_GE(levelsOf(chain).size(), 3u);
+    // A level k >= 0 gives the same cut as without the chains: no per-object LOD, the leaves
+    // where no aggregate of level <= k exists.
+    for (uint32_t k : levelsOf(chain)) {
+        std::vector<uint32_t> a, b;
+        cutAtLevel(plain, k, a);
+        cutAtLevel(chain, k, b);
+        ASSERT_EQ(a.size(), b.size()) << "level " << k;
+        size_t leavesA = 0, leavesB = 0;
+        for (uint32_t n : a) leavesA += plain.isLeaf(n);
+        for (uint32_t n : b) {
+            EXPECT_FALSE(chain.isObjectLod(n)) << "level " << k << " node " << n;
+            leavesB += chain.isLeaf(n);
+            if (!chain.isLeaf(n)) {
+                EXPECT_LE(chain.node(n).level, k);
+            }
+        }
+        EXPECT_EQ(leavesA, leavesB) << "level " << k;
+    }
+    // kLeafLevel still gives the originals; kObjectLodLevel the top of every chain.
+    std::vector<uint32_t> originals, lods;
+    cutAtLevel(chain, kLeafLevel, originals);
+    cutAtLevel(chain, kObjectLodLevel, lods);
+    ASSERT_EQ(originals.size(), 120u);
+    ASSERT_EQ(lods.size(), 120u);
+    for (uint32_t n : originals) EXPECT_TRUE(chain.isLeaf(n));
+    for (uint32_t n : lods) {
+        EXPECT_TRUE(chain.isObjectLod(n));
+        EXPECT_FALSE(chain.isObjectLod(chain.node(n).parent));
+    }
+    // Collision against the per-object LODs works like any other cut.
+    CollisionWorld world(chain, 1);
+    ASSERT_TRUE(world.ok()) << world.error();
+    world.useLevel(kObjectLodLevel);
+    EXPECT_EQ(world.currentCut(), lods);
+}
 #else
 TEST(RuntimeCollision, NotBuilt) { GTEST_SKIP() << "Embree 3 not found: aggrelod_runtime_collision not built"; }
 #endif

@@ -84,6 +84,10 @@ TEST(RuntimeFormat, RoundTripKeepsEveryField) {
         for (uint32_t s = 0; s < b.sourceCount; ++s) EXPECT_EQ(file.sources(i)[s], p.sourceObjects[b.firstSource + s]);
         ASSERT_EQ(file.vertices(i).size, 3u * b.vertexCount);
         for (uint32_t v = 0; v < 3 * b.vertexCount; ++v) EXPECT_EQ(file.vertices(i)[v], p.positions[3 * b.firstVertex + v]);
+        ASSERT_EQ(file.normals(i).size, 3u * b.vertexCount);
+        for (uint32_t v = 0; v < 3 * b.vertexCount; ++v) EXPECT_EQ(file.normals(i)[v], p.normals[3 * b.firstVertex + v]);
+        ASSERT_EQ(file.colors(i).size, 4u * b.vertexCount);
+        for (uint32_t v = 0; v < 4 * b.vertexCount; ++v) EXPECT_EQ(file.colors(i)[v], p.colors[4 * b.firstVertex + v]);
         ASSERT_EQ(file.triangles(i).size, b.indexCount);
         for (uint32_t t = 0; t < b.indexCount; ++t) EXPECT_EQ(file.triangles(i)[t], p.indices[b.firstIndex + t]);
         if (b.parent == kNoIndex) roots.push_back(i);
@@ -152,6 +156,16 @@ TEST(RuntimeFormat, WriterRefusesInconsistentHierarchies) {
              p.nodes[root].parent = p.childIndices[p.nodes[root].firstChild];
          }, "bad tree"},
         {"child range past the array", [](BuildParams& p) { p.nodes.back().firstChild = 1u << 30; }, "index out of range"},
+        {"NaN normal", [](BuildParams& p) { p.normals[7] = std::nanf(""); }, "bad value"},
+        {"infinite normal", [](BuildParams& p) { p.normals[3] = INFINITY; }, "bad value"},
+        {"normal not of unit length", [](BuildParams& p) { p.normals[0] *= 1.01f, p.normals[1] *= 1.01f, p.normals[2] *= 1.01f; }, "bad value"},
+        {"zero normal", [](BuildParams& p) { std::fill(p.normals.end() - 3, p.normals.end(), 0.0f); }, "bad value"},
+        {"one normal missing", [](BuildParams& p) { p.normals.resize(p.normals.size() - 3); }, "normals"},
+        {"one colour missing", [](BuildParams& p) { p.colors.resize(p.colors.size() - 4); }, "colors"},
+        {"leaf with an aggregate level", [](BuildParams& p) { p.nodes[0].level = 0; }, "bad value"},
+        {"inner node with the leaf level", [](BuildParams& p) { p.nodes.back().level = kLeafLevel; }, "bad value"},
+        {"per-object LOD of several objects", [](BuildParams& p) { p.nodes.back().level = kObjectLodLevel; }, "bad value"},
+        {"level out of range", [](BuildParams& p) { p.nodes.back().level = kMaxAggregateLevel; }, "bad value"},
     };
     for (const Case& c : cases) {
         BuildParams p = good;
@@ -228,6 +242,158 @@ TEST(RuntimeFormat, ForgedContentWithValidChecksumIsRefused) {
                 << "node " << node << " field " << field << ": " << toString(status) << " " << message;
         }
     }
+}
+
+// Offset, count and stride of section `kind` as the table states them.
+struct SectionEntry {
+    uint64_t offset, count;
+    uint32_t stride;
+};
+SectionEntry sectionEntry(const std::vector<uint8_t>& bytes, uint32_t kind) {
+    SectionEntry e{};
+    const uint8_t* at = bytes.data() + 64 + 32 * (kind - 1);
+    std::memcpy(&e.stride, at + 4, 4);
+    std::memcpy(&e.offset, at + 8, 8);
+    std::memcpy(&e.count, at + 16, 8);
+    return e;
+}
+
+TEST(RuntimeFormat, NormalsAndColorsSectionsAreOnePerVertex) {
+    using namespace aggrelod::runtime::layout;
+    const BuildParams p = makeSyntheticHierarchy(30, 9);
+    const std::vector<uint8_t> bytes = writeOrDie(p);
+    const SectionEntry positions = sectionEntry(bytes, kPositions), normals = sectionEntry(bytes, kNormals),
+                       colors = sectionEntry(bytes, kColors);
+    EXPECT_EQ(normals.stride, 12u);
+    EXPECT_EQ(colors.stride, 4u);
+    EXPECT_EQ(normals.count, positions.count);
+    EXPECT_EQ(colors.count, positions.count);
+    EXPECT_EQ(positions.count, p.positions.size() / 3);
+    // The bytes in place: little-endian floats, then RGBA bytes.
+    EXPECT_EQ(std::memcmp(bytes.data() + normals.offset, p.normals.data(), 4 * p.normals.size()), 0);
+    EXPECT_EQ(std::memcmp(bytes.data() + colors.offset, p.colors.data(), p.colors.size()), 0);
+    uint16_t major = 0;
+    std::memcpy(&major, bytes.data() + 8, 2);
+    EXPECT_EQ(major, 2u);
+}
+
+TEST(RuntimeFormat, ForgedNormalsAndColorSectionsAreRefused) {
+    // With a recomputed checksum: bad values in the normals, and counts or strides of the new
+    // sections that disagree with the positions.
+    using namespace aggrelod::runtime::layout;
+    const std::vector<uint8_t> good = writeOrDie(makeSyntheticHierarchy(40, 10));
+    const SectionEntry normals = sectionEntry(good, kNormals);
+    const float bad[] = {std::nanf(""), INFINITY, -INFINITY, 1.5f, -2.0f, 1e30f};
+    const uint64_t vertices = normals.count;
+    for (uint64_t v : {uint64_t(0), vertices / 2, vertices - 1}) {
+        for (int k = 0; k < 3; ++k) {
+            for (float value : bad) {
+                std::vector<uint8_t> forged = good;
+                std::memcpy(forged.data() + normals.offset + 12 * v + 4 * k, &value, 4);
+                resign(forged);
+                std::string message;
+                EXPECT_EQ(openCopy(forged, forged.size(), message), FileStatus::BadValue)
+                    << "vertex " << v << " component " << k << " = " << value << ": " << message;
+                EXPECT_NE(message.find("normal"), std::string::npos) << message;
+            }
+        }
+    }
+    {
+        std::vector<uint8_t> forged = good;
+        std::memset(forged.data() + normals.offset + 12 * (vertices / 3), 0, 12);
+        resign(forged);
+        std::string message;
+        EXPECT_EQ(openCopy(forged, forged.size(), message), FileStatus::BadValue) << "zero normal: " << message;
+    }
+    // Count fields: one fewer / one more vertex (the byte size follows, so only the
+    // per-vertex rule can refuse it).
+    for (uint32_t kind : {kNormals, kColors}) {
+        for (int64_t change : {-1, 1}) {
+            std::vector<uint8_t> forged = good;
+            const SectionEntry e = sectionEntry(forged, kind);
+            const uint64_t count = e.count + change, byteSize = count * e.stride;
+            std::memcpy(forged.data() + 64 + 32 * (kind - 1) + 16, &count, 8);
+            std::memcpy(forged.data() + 64 + 32 * (kind - 1) + 24, &byteSize, 8);
+            resign(forged);
+            std::string message;
+            EXPECT_EQ(openCopy(forged, forged.size(), message), FileStatus::BadSection) << kind << " " << change << ": " << message;
+        }
+        // Another stride.
+        std::vector<uint8_t> forged = good;
+        const uint32_t stride = kind == kNormals ? 6 : 8;
+        std::memcpy(forged.data() + 64 + 32 * (kind - 1) + 4, &stride, 4);
+        resign(forged);
+        std::string message;
+        EXPECT_EQ(openCopy(forged, forged.size(), message), FileStatus::BadSection) << message;
+    }
+    // A file of the previous major version (no normals or colours) is refused by version.
+    std::vector<uint8_t> old = good;
+    const uint16_t one = 1;
+    std::memcpy(old.data() + 8, &one, 2);
+    resign(old);
+    std::string message;
+    EXPECT_EQ(openCopy(old, old.size(), message), FileStatus::WrongVersion) << message;
+}
+
+TEST(RuntimeFormat, TruncationInsideTheNewSectionsIsRefused) {
+    using namespace aggrelod::runtime::layout;
+    const std::vector<uint8_t> good = writeOrDie(makeSyntheticHierarchy(40, 11));
+    for (uint32_t kind : {kNormals, kColors}) {
+        const SectionEntry e = sectionEntry(good, kind);
+        for (uint64_t cut : {e.offset, e.offset + 1, e.offset + e.count * e.stride / 2, e.offset + e.count * e.stride - 1}) {
+            std::string message;
+            EXPECT_EQ(openCopy(good, size_t(cut), message), FileStatus::Truncated) << kind << " at " << cut << ": " << message;
+        }
+    }
+}
+
+TEST(RuntimeFormat, ColorEncodingIsSrgbWithLinearAlpha) {
+    // The 256 codes survive decode + encode; linear black, white and mid-grey land where the
+    // sRGB curve puts them; alpha stays linear; out-of-range and NaN are clamped.
+    for (int code = 0; code < 256; ++code) {
+        const uint8_t in[4] = {uint8_t(code), uint8_t(255 - code), uint8_t(code / 2), uint8_t(code)};
+        float linear[4];
+        decodeColorSrgb8(in, linear);
+        uint8_t back[4];
+        encodeColorSrgb8(linear, back);
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(back[k], in[k]) << "code " << code << " channel " << k;
+        EXPECT_FLOAT_EQ(linear[3], code / 255.0f);
+    }
+    const float samples[4] = {0.0f, 1.0f, 0.5f, 0.5f};
+    uint8_t out[4];
+    encodeColorSrgb8(samples, out);
+    EXPECT_EQ(out[0], 0);
+    EXPECT_EQ(out[1], 255);
+    EXPECT_EQ(out[2], 188);  // sRGB(0.5 linear) = 0.7354
+    EXPECT_EQ(out[3], 128);  // alpha is not curved
+    const float odd[4] = {-1.0f, 7.0f, std::nanf(""), 2.0f};
+    encodeColorSrgb8(odd, out);
+    EXPECT_EQ(out[0], 0);
+    EXPECT_EQ(out[1], 255);
+    EXPECT_EQ(out[2], 0);
+    EXPECT_EQ(out[3], 255);
+}
+
+TEST(RuntimeFormat, PerObjectLodNodesAreAcceptedAndRoundTrip) {
+    const BuildParams p = makeSyntheticHierarchy(50, 12, 3, 1, 1.0f, 2);
+    const std::vector<uint8_t> bytes = writeOrDie(p);
+    RuntimeFile file;
+    std::string message;
+    ASSERT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), file, message), FileStatus::Ok) << message;
+    uint32_t lods = 0;
+    for (uint32_t i = 0; i < file.nodeCount(); ++i) {
+        if (!file.isObjectLod(i)) continue;
+        ++lods;
+        EXPECT_EQ(file.node(i).level, kObjectLodLevel);
+        EXPECT_FALSE(file.isLeaf(i));
+        ASSERT_EQ(file.sources(i).size, 1u);
+        ASSERT_EQ(file.children(i).size, 1u);
+        const uint32_t child = file.children(i)[0];
+        EXPECT_TRUE(file.isLeaf(child) || file.isObjectLod(child));
+        EXPECT_EQ(file.sources(child)[0], file.sources(i)[0]);
+        EXPECT_FALSE(file.isObjectLod(file.node(i).parent) && file.isLeaf(file.node(i).parent));
+    }
+    EXPECT_EQ(lods, 2u * 50u);
 }
 
 TEST(RuntimeFormat, MisalignedBufferIsRefused) {

@@ -708,7 +708,12 @@ TEST(RuntimeScenes, ProxiesGlbMirrorsTheRuntimeTreeAndIsValid) {
     io::SceneReadResult back;
     std::string error;
     ASSERT_TRUE(io::readGltfScene(proxies.string(), {}, back, error)) << error;
-    // One mesh object per aggregate node ("node<i>_level<k>"), the same triangles as the file.
+    // One mesh object per aggregate node ("node<i>_level<k>"), the same triangles as the file
+    // (corner by corner: the file splits vertices at creases as well as at colour changes)
+    // and the same colours (the file's are sRGB-encoded bytes of the glb's linear ones; a
+    // scene without colours has white in the file and per-level tints in the glb).
+    bool sceneHasColours = false;
+    for (const InputObject& o : s.originals) sceneHasColours = sceneHasColours || !o.triangleColors.empty();
     size_t aggregates = 0;
     for (uint32_t i = 0; i < s.file.nodeCount(); ++i) aggregates += s.file.node(i).level != runtime::kLeafLevel;
     EXPECT_EQ(back.objects.size(), aggregates);
@@ -716,10 +721,19 @@ TEST(RuntimeScenes, ProxiesGlbMirrorsTheRuntimeTreeAndIsValid) {
         ASSERT_EQ(o.name.rfind("node", 0), 0u) << o.name;
         const uint32_t node = uint32_t(std::stoul(o.name.substr(4)));
         ASSERT_LT(node, s.file.nodeCount());
-        EXPECT_EQ(o.indices.size(), size_t(s.file.node(node).indexCount)) << o.name;
         const auto v = s.file.vertices(node);
-        ASSERT_EQ(o.positions.size(), v.size) << o.name;
-        for (size_t k = 0; k < v.size; ++k) EXPECT_EQ(float(o.positions[k]), v[k]) << o.name;
+        const auto t = s.file.triangles(node);
+        const auto c = s.file.colors(node);
+        ASSERT_EQ(o.indices.size(), t.size) << o.name;
+        const bool coloured = sceneHasColours && o.triangleColors.size() == 4 * (t.size / 3);
+        for (size_t i = 0; i < t.size; ++i) {
+            for (int k = 0; k < 3; ++k)
+                ASSERT_EQ(float(o.positions[3 * size_t(o.indices[i]) + k]), v[3 * size_t(t[i]) + k]) << o.name << " corner " << i;
+            uint8_t expected[4] = {255, 255, 255, 255};
+            if (coloured) runtime::encodeColorSrgb8(&o.triangleColors[4 * (i / 3)], expected);
+            for (int k = 0; k < 4; ++k)
+                EXPECT_NEAR(int(c[4 * size_t(t[i]) + k]), int(expected[k]), 1) << o.name << " corner " << i;
+        }
     }
     validateGltf({proxies}, s.dir);
 }

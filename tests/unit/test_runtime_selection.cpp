@@ -321,3 +321,218 @@ TEST(RuntimeSelection, ExactWithSpheresThatNestOnlyWithinTheFileSlack) {
     expectExactCover(h.file, incremental);
     EXPECT_GT(changes, 100u);
 }
+
+namespace {
+
+// Signed distances of a point to the planes of the view frustum of `c`, in double: inside
+// when every value is >= 0. Independent of the selector's float planes.
+std::vector<double> frustumDistances(const ViewCamera& c, const float p[3]) {
+    double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
+    const double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    for (double& x : f) x /= fl;
+    double r[3] = {f[1] * c.up[2] - f[2] * c.up[1], f[2] * c.up[0] - f[0] * c.up[2], f[0] * c.up[1] - f[1] * c.up[0]};
+    const double rl = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    for (double& x : r) x /= rl;
+    const double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    double q[3];
+    for (int k = 0; k < 3; ++k) q[k] = double(p[k]) - c.position[k];
+    const double x = q[0] * r[0] + q[1] * r[1] + q[2] * r[2], y = q[0] * u[0] + q[1] * u[1] + q[2] * u[2],
+                 z = q[0] * f[0] + q[1] * f[1] + q[2] * f[2];
+    const double ty = std::tan(0.5 * c.fovY), tx = ty * c.aspect;
+    // Distance to the plane x = z tx is (z tx - x) / sqrt(tx^2 + 1), and so on.
+    std::vector<double> d = {(z * tx - x) / std::sqrt(tx * tx + 1), (z * tx + x) / std::sqrt(tx * tx + 1),
+                             (z * ty - y) / std::sqrt(ty * ty + 1), (z * ty + y) / std::sqrt(ty * ty + 1),
+                             z - c.nearDistance};
+    if (std::isfinite(c.farDistance)) d.push_back(c.farDistance - z);
+    return d;
+}
+
+// -1: the node's sphere lies outside one plane by more than a float-rounding slack; +1: it
+// is that much inside every plane's outer side; 0: in between (too close to call).
+int sphereVersusFrustum(const ViewCamera& c, const NodeRecord& r) {
+    double scale = r.sphereRadius + 1.0;
+    for (int k = 0; k < 3; ++k) scale += std::fabs(double(r.sphereCenter[k])) + std::fabs(double(c.position[k]));
+    const double slack = 1e-4 * scale;
+    bool clearlyInside = true;
+    for (double d : frustumDistances(c, r.sphereCenter)) {
+        if (d < -r.sphereRadius - slack) return -1;
+        if (d < -r.sphereRadius + slack) clearlyInside = false;
+    }
+    return clearlyInside ? 1 : 0;
+}
+
+ViewCamera randomViewCamera(std::mt19937& rng) {
+    // Inside or near the city (about 400 x 400 world units), looking mostly sideways.
+    std::uniform_real_distribution<float> u(0, 1);
+    ViewCamera c;
+    c.position[0] = -100 + 600 * u(rng);
+    c.position[1] = 2 + 60 * u(rng);
+    c.position[2] = -100 + 600 * u(rng);
+    const float yaw = 6.2831853f * u(rng), pitch = -0.6f + 0.8f * u(rng);
+    c.forward[0] = std::cos(yaw) * std::cos(pitch);
+    c.forward[1] = std::sin(pitch);
+    c.forward[2] = std::sin(yaw) * std::cos(pitch);
+    const float scale = 0.1f + 10 * u(rng);  // forward need not be unit
+    for (float& x : c.forward) x *= scale;
+    c.up[0] = 0.2f * (u(rng) - 0.5f);
+    c.up[1] = 1;
+    c.up[2] = 0.2f * (u(rng) - 0.5f);
+    c.fovY = 0.4f + 1.2f * u(rng);
+    c.aspect = 0.5f + 2.0f * u(rng);
+    c.viewportHeight = 1080;
+    c.nearDistance = u(rng) < 0.5f ? 0.0f : 5 * u(rng);
+    c.farDistance = u(rng) < 0.5f ? INFINITY : 100 + 400 * u(rng);
+    return c;
+}
+
+std::vector<uint32_t> sorted(Span<uint32_t> s) {
+    std::vector<uint32_t> v(s.begin(), s.end());
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+}  // namespace
+
+TEST(RuntimeSelection, FrustumCullingNeitherRefinesNorDrawsNodesOutsideTheView) {
+    OpenedHierarchy h(makeSyntheticHierarchy(1500, 31, 4, 1, 0.05f));
+    const RuntimeFile& file = h.file;
+    Selector culling(file), plain(file);
+    SelectionSettings noHysteresis;
+    noHysteresis.coarsenRatio = 1.0f;
+    std::mt19937 rng(41);
+    size_t framesWithBoth = 0, culledTotal = 0;
+    for (int frame = 0; frame < 300; ++frame) {
+        const ViewCamera cam = randomViewCamera(rng);
+        noHysteresis.pixelTolerance = std::uniform_real_distribution<float>(0.5f, 4.0f)(rng);
+        culling.select(cam, noHysteresis);
+        EXPECT_EQ(culling.stats().culled, culling.culledNodes().size);
+        // Drawn and culled nodes together cover every object once; the draw lists hold only
+        // the drawn nodes.
+        std::vector<int> cover(file.objectCount(), 0);
+        size_t inner = 0, originals = 0;
+        for (uint32_t n : culling.cut()) {
+            for (uint32_t o : file.sources(n)) ++cover[o];
+            file.isLeaf(n) ? originals += file.sources(n).size : ++inner;
+        }
+        for (uint32_t n : culling.culledNodes())
+            for (uint32_t o : file.sources(n)) ++cover[o];
+        for (uint32_t o = 0; o < file.objectCount(); ++o) ASSERT_EQ(cover[o], 1) << "frame " << frame << " object " << o;
+        EXPECT_EQ(culling.proxyNodes().size, inner);
+        EXPECT_EQ(culling.originalObjects().size, originals);
+        for (uint32_t n : culling.culledNodes()) EXPECT_NE(sphereVersusFrustum(cam, file.node(n)), 1) << n;
+        for (uint32_t n : culling.cut()) EXPECT_NE(sphereVersusFrustum(cam, file.node(n)), -1) << n;
+        // The parent of every drawn or culled node was refined: visible and over tau.
+        const float tau = noHysteresis.pixelTolerance;
+        for (Span<uint32_t> list : {culling.cut(), culling.culledNodes()})
+            for (uint32_t n : list) {
+                const uint32_t parent = file.node(n).parent;
+                if (parent == kNoIndex) continue;
+                EXPECT_NE(sphereVersusFrustum(cam, file.node(parent)), -1) << "parent of " << n;
+                EXPECT_GT(culling.screenSpaceErrorOf(parent, cam), tau * 0.9999f) << "parent of " << n;
+            }
+        for (uint32_t n : culling.cut())
+            if (!file.isLeaf(n)) EXPECT_LE(culling.screenSpaceErrorOf(n, cam), tau * 1.0001f) << n;
+        // No hysteresis: the result does not depend on the history.
+        Selector fresh(file);
+        fresh.select(cam, noHysteresis);
+        EXPECT_EQ(sorted(fresh.cut()), sorted(culling.cut())) << "frame " << frame;
+        EXPECT_EQ(sorted(fresh.culledNodes()), sorted(culling.culledNodes())) << "frame " << frame;
+        // The old call, given the same camera as a Camera, culls nothing and is unchanged.
+        plain.select(static_cast<const Camera&>(cam), noHysteresis);
+        EXPECT_TRUE(plain.culledNodes().empty());
+        expectExactCover(file, plain);
+        framesWithBoth += !culling.cut().empty() && !culling.culledNodes().empty();
+        culledTotal += culling.culledNodes().size;
+        // Drawn nodes are never finer than without culling: culled parts are not refined.
+        if (frame % 10 == 0) {
+            culling.select(static_cast<const Camera&>(cam), noHysteresis);
+            EXPECT_TRUE(culling.culledNodes().empty());
+            EXPECT_EQ(sortedCut(culling), sortedCut(plain));
+        }
+    }
+    EXPECT_GT(framesWithBoth, 100u);
+    EXPECT_GT(culledTotal, 1000u);
+
+    // Looking away from the whole city: nothing drawn, the roots culled. Looking at it from
+    // far away: nothing culled, same cut as without culling.
+    ViewCamera away;
+    away.position[0] = -500; away.position[1] = 50; away.position[2] = 200;
+    away.forward[0] = -1; away.forward[1] = 0; away.forward[2] = 0;
+    culling.select(away, noHysteresis);
+    EXPECT_TRUE(culling.cut().empty());
+    EXPECT_EQ(sorted(culling.culledNodes()), sorted(file.roots()));
+    EXPECT_TRUE(culling.proxyNodes().empty());
+    EXPECT_TRUE(culling.originalObjects().empty());
+    ViewCamera overview = away;
+    overview.forward[0] = 1;
+    overview.position[0] = -3000;
+    culling.select(overview, noHysteresis);
+    plain.select(static_cast<const Camera&>(overview), noHysteresis);
+    EXPECT_TRUE(culling.culledNodes().empty());
+    EXPECT_EQ(sortedCut(culling), sortedCut(plain));
+    // A degenerate orientation culls nothing rather than guessing.
+    ViewCamera degenerate = away;
+    degenerate.forward[0] = 0;
+    culling.select(degenerate, noHysteresis);
+    EXPECT_TRUE(culling.culledNodes().empty());
+    expectExactCover(file, culling);
+    degenerate = away;
+    degenerate.up[0] = -1; degenerate.up[1] = 0;  // parallel to forward
+    culling.select(degenerate, noHysteresis);
+    EXPECT_TRUE(culling.culledNodes().empty());
+}
+
+TEST(RuntimeSelection, CutChangesListExactlyWhatEnteredAndLeft) {
+    OpenedHierarchy h(makeSyntheticHierarchy(1200, 32, 3, 2, 0.05f));
+    const RuntimeFile& file = h.file;
+    Selector s(file);
+    // Construction: everything entered from an empty cut.
+    EXPECT_EQ(sorted(s.entered()), sorted(file.roots()));
+    EXPECT_TRUE(s.left().empty());
+    std::vector<uint32_t> previous = sortedCut(s);
+    SelectionSettings settings;
+    settings.coarsenRatio = 0.7f;
+    std::mt19937 rng(43);
+    size_t leasedChanges = 0, steadyFrames = 0;
+    for (int frame = 0; frame < 900; ++frame) {
+        const float t = 0.01f * frame;
+        ViewCamera cam;
+        cam.position[0] = 200 + 350 * std::cos(t);
+        cam.position[1] = 20 + 15 * std::sin(3 * t);
+        cam.position[2] = 200 + 250 * std::sin(1.3f * t);
+        cam.forward[0] = -std::sin(2 * t); cam.forward[1] = -0.1f; cam.forward[2] = std::cos(2 * t);
+        cam.fovY = 0.9f;
+        cam.viewportHeight = 1000;
+        const int kind = frame % 150 == 149 ? 4 : (frame / 50) % 4;  // runs of each kind, a reset now and then
+        const bool hold = frame % 7 == 3;  // camera did not move since the previous frame
+        if (hold) std::copy(cam.position, cam.position + 3, cam.position);
+        switch (kind) {
+            case 0: s.select(static_cast<const Camera&>(cam), settings); break;
+            case 1: s.select(cam, settings); break;
+            case 2: s.selectFull(static_cast<const Camera&>(cam), settings); break;
+            case 3: s.selectByDistance(cam.position, 0.02f); break;
+            default: s.reset(); break;
+        }
+        const std::vector<uint32_t> now = sortedCut(s);
+        std::vector<uint32_t> entered, left;
+        std::set_difference(now.begin(), now.end(), previous.begin(), previous.end(), std::back_inserter(entered));
+        std::set_difference(previous.begin(), previous.end(), now.begin(), now.end(), std::back_inserter(left));
+        ASSERT_EQ(sorted(s.entered()), entered) << "frame " << frame << " kind " << kind;
+        ASSERT_EQ(sorted(s.left()), left) << "frame " << frame << " kind " << kind;
+        if (kind == 0 && !entered.empty()) ++leasedChanges;
+        previous = now;
+        // The same call again from the same place changes nothing.
+        if (hold && kind != 4) {
+            if (kind == 0) s.select(static_cast<const Camera&>(cam), settings);
+            else if (kind == 1) s.select(cam, settings);
+            else if (kind == 2) s.selectFull(static_cast<const Camera&>(cam), settings);
+            else s.selectByDistance(cam.position, 0.02f);
+            EXPECT_TRUE(s.entered().empty()) << "frame " << frame;
+            EXPECT_TRUE(s.left().empty()) << "frame " << frame;
+            ASSERT_EQ(sortedCut(s), previous);
+            ++steadyFrames;
+        }
+    }
+    EXPECT_GT(leasedChanges, 10u);  // measured 16
+    EXPECT_GT(steadyFrames, 100u);
+}

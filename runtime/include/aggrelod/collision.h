@@ -24,11 +24,15 @@ struct CollisionHit {
 };
 
 /// The nodes of the hierarchy at `level`: for every root-to-leaf path, the highest node whose
-/// level is <= `level` (leaves count as finer than level 0). kLeafLevel gives the originals.
+/// level is <= `level`, where leaves count as finer than per-object LOD nodes and those as
+/// finer than level 0. kLeafLevel gives the originals; kObjectLodLevel the coarsest
+/// per-object LOD of each object (its leaf when it has none); a level k >= 0 never gives a
+/// per-object LOD node (they hang below the level-0 aggregates; the walk would pass through
+/// one to its leaf).
 /// `out` is resized to the cut (node indices, increasing).
 void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out);
 
-/// Levels present in the file, increasing (aggregate levels; the originals are kLeafLevel).
+/// Aggregate levels present in the file, increasing (neither kLeafLevel nor kObjectLodLevel).
 std::vector<uint32_t> levelsOf(const RuntimeFile& file);
 
 /// An Embree scene over a cut: the cut's node meshes merged into one Embree geometry (rebuilt,

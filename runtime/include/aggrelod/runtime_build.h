@@ -14,18 +14,21 @@ namespace aggrelod::runtime {
 constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
 
 /// One node of the hierarchy. Leaves are the original objects (geometricError 0, level
-/// kLeafLevel); inner nodes are aggregates (proxies). Ranges index the arrays of BuildParams.
+/// kLeafLevel); inner nodes are aggregates (proxies, level 0, 1, ...) or simplified versions
+/// of one object (level kObjectLodLevel, between a leaf and its first aggregate). Ranges
+/// index the arrays of BuildParams.
 struct BuildNode {
     uint32_t parent = kNoIndex;      ///< index into BuildParams::nodes; kNoIndex for roots
     uint32_t firstChild = 0;         ///< range [firstChild, firstChild+childCount) in childIndices
     uint32_t childCount = 0;
     uint32_t firstSource = 0;        ///< range in sourceObjects: original objects this node stands for
     uint32_t sourceCount = 0;
-    uint32_t firstVertex = 0;        ///< range in positions (counted in vertices, 3 floats each)
+    uint32_t firstVertex = 0;        ///< range in positions/normals/colors, counted in vertices
     uint32_t vertexCount = 0;
     uint32_t firstIndex = 0;         ///< range in indices (counted in indices, 3 per triangle);
     uint32_t indexCount = 0;         ///<   indices are relative to firstVertex
-    uint32_t level = 0;              ///< 0 = finest aggregate level, rising with delta; kLeafLevel for originals
+    uint32_t level = 0;              ///< 0 = finest aggregate level, rising with delta; kLeafLevel
+                                     ///<   for originals, kObjectLodLevel for per-object LODs
     float delta = 0.0f;              ///< threshold of the level, world units (0 for leaves)
     float geometricError = 0.0f;     ///< world units; >= every child's (0 for leaves)
     float boundsMin[3] = {0, 0, 0};  ///< axis-aligned box, world units, contains the children's
@@ -34,14 +37,27 @@ struct BuildNode {
     float sphereRadius = 0.0f;
 };
 
+/// Level of the leaves (the original objects).
 constexpr uint32_t kLeafLevel = 0xFFFFu;
+/// Level of a per-object LOD node: a simplified version of one object (sourceCount 1, delta 0),
+/// in the chain between that object's leaf and its first aggregate. Ranked finer than
+/// aggregate level 0 and coarser than the leaves (cutAtLevel, levelsOf).
+constexpr uint32_t kObjectLodLevel = 0xFFFEu;
+/// Aggregate levels are < kMaxAggregateLevel; larger values other than the two above are refused.
+constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
 
 /// Everything the runtime file holds. Arrays are owned by the caller.
 struct BuildParams {
     std::vector<BuildNode> nodes;        ///< parents may come before or after children
     std::vector<uint32_t> childIndices;  ///< node indices
     std::vector<uint32_t> sourceObjects; ///< original object indices in [0, objectNames.size())
-    std::vector<float> positions;        ///< xyz per vertex, world units
+    std::vector<float> positions;        ///< xyz per vertex, world units (3 floats per vertex)
+    /// Unit normal per vertex (3 floats per vertex, same count as positions), outward; a mesh
+    /// vertex on a crease or a colour boundary is split into one vertex per side.
+    std::vector<float> normals;
+    /// Base colour per vertex, 4 bytes per vertex: RGB sRGB-encoded (as an SRGB8_ALPHA8
+    /// texel), alpha linear; see encodeColorSrgb8 / decodeColorSrgb8.
+    std::vector<uint8_t> colors;
     std::vector<uint32_t> indices;       ///< 3 per triangle, relative to the node's firstVertex
     std::vector<std::string> objectNames;///< name of each original object (UTF-8)
     uint64_t settingsHash = 0;           ///< hash of the bake settings (for cache invalidation)
@@ -54,14 +70,24 @@ struct BuildParams {
 /// the same params give byte-identical bytes. Implemented in runtime/src/runtime_writer.cpp;
 /// the result is checked by the reader's validator (RuntimeFile::openMemory), which requires:
 /// - every range inside its array, every triangle index < the node's vertexCount,
-///   indexCount a multiple of 3, positions.size() a multiple of 3, finite floats,
+///   indexCount a multiple of 3, positions.size() a multiple of 3, normals.size() ==
+///   positions.size(), colors.size() == 4 * vertex count, finite floats, normals of unit
+///   length (within 1e-3),
 ///   geometricError/sphereRadius/delta >= 0, boundsMin <= boundsMax;
 /// - parent/children consistent (each non-root listed exactly once, by its parent), no cycle,
 ///   at least one node;
+/// - level kLeafLevel exactly for the leaves; kObjectLodLevel only on an inner node standing
+///   for one object; any other level < kMaxAggregateLevel;
 /// - each leaf (childCount 0) stands for >= 1 object, every object in exactly one leaf, an
 ///   inner node lists exactly the objects of its leaves (any order, no duplicates);
 /// - child error <= parent error (exact), child sphere and box inside the parent's (slack
 ///   1e-5 relative to the parent's coordinates).
 bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error);
+
+/// Linear RGBA in [0, 1] (glTF baseColorFactor / COLOR_0 meaning; clamped, NaN -> 0) to the
+/// file's colour bytes: RGB through the sRGB transfer function, alpha linear, rounded to
+/// nearest. decodeColorSrgb8 is its inverse up to that rounding (exact for the 256 codes).
+void encodeColorSrgb8(const float linear[4], uint8_t out[4]);
+void decodeColorSrgb8(const uint8_t encoded[4], float linear[4]);
 
 }  // namespace aggrelod::runtime

@@ -15,7 +15,8 @@
 namespace aggrelod::runtime {
 
 /// Format version written by writeRuntimeFile. A reader accepts only its own major version.
-constexpr uint16_t kFormatMajor = 1;
+/// 2: per-vertex normals and colours (sections 9 and 10).
+constexpr uint16_t kFormatMajor = 2;
 constexpr uint16_t kFormatMinor = 0;
 
 /// Why a file was refused (FileStatus::Ok when it was accepted).
@@ -42,9 +43,9 @@ struct NodeRecord {
     uint32_t parent;
     uint32_t firstChild, childCount;    ///< range in children()
     uint32_t firstSource, sourceCount;  ///< range in sourceObjects()
-    uint32_t firstVertex, vertexCount;  ///< range in positions(), counted in vertices
+    uint32_t firstVertex, vertexCount;  ///< range in positions/normals/colors, counted in vertices
     uint32_t firstIndex, indexCount;    ///< range in indices(); relative to firstVertex
-    uint32_t level;                     ///< kLeafLevel for originals
+    uint32_t level;                     ///< aggregate level; kLeafLevel / kObjectLodLevel
     float delta;                        ///< world units
     float geometricError;               ///< world units, >= every child's
     float boundsMin[3], boundsMax[3];   ///< world units, contains the children's
@@ -103,7 +104,16 @@ public:
     Span<uint32_t> sources(uint32_t node) const;
     Span<float> vertices(uint32_t node) const;  ///< 3 floats per vertex, world units
     Span<uint32_t> triangles(uint32_t node) const;  ///< 3 per triangle, relative to node's vertices
+    /// Unit outward normal per vertex of a node: 3 floats per vertex, as many vertices as
+    /// vertices(). The bake smooths across edges whose faces' normals differ by at most 60
+    /// degrees and splits the vertices of sharper edges and colour boundaries (docs/runtime.md).
+    Span<float> normals(uint32_t node) const;
+    /// Base colour per vertex of a node: 4 bytes per vertex (RGB sRGB-encoded, alpha linear;
+    /// decodeColorSrgb8 gives linear RGBA), as many vertices as vertices().
+    Span<uint8_t> colors(uint32_t node) const;
     bool isLeaf(uint32_t node) const { return nodes_.data[node].childCount == 0; }
+    /// A simplified version of one object (level kObjectLodLevel), not an aggregate.
+    bool isObjectLod(uint32_t node) const { return nodes_.data[node].level == kObjectLodLevel; }
     /// The whole source-object array (NodeRecord::firstSource indexes it).
     Span<uint32_t> allSourceObjects() const { return sourceObjects_; }
     /// Name of original object `object` (< objectCount()), UTF-8.
@@ -122,7 +132,8 @@ private:
     uint32_t depth_ = 0;
     Span<NodeRecord> nodes_;
     Span<uint32_t> roots_, childIndices_, sourceObjects_, indices_, nameRanges_;
-    Span<float> positions_;
+    Span<float> positions_, normals_;
+    Span<uint8_t> colors_;
     Span<char> nameBlob_;
 };
 

@@ -5,6 +5,7 @@
 
 #include <aggrelod/runtime_file.h>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -15,6 +16,17 @@ struct Camera {
     float position[3] = {0, 0, 0};  ///< world units
     float fovY = 1.0f;              ///< vertical field of view, radians, in (0, pi)
     float viewportHeight = 1080.0f; ///< pixels
+};
+
+/// A perspective camera with its orientation, for selection with frustum culling. The base
+/// Camera part means the same as in the calls without culling.
+struct ViewCamera : Camera {
+    float forward[3] = {0, 0, -1};  ///< view direction, world space; any non-zero length
+    float up[3] = {0, 1, 0};        ///< world space, not parallel to forward (only its part
+                                    ///<   orthogonal to forward is used)
+    float aspect = 16.0f / 9.0f;    ///< viewport width / height, > 0
+    float nearDistance = 0.0f;      ///< near plane, world units along forward, >= 0
+    float farDistance = INFINITY;   ///< far plane, world units along forward; infinity = none
 };
 
 /// Pixel tolerance and hysteresis band.
@@ -34,6 +46,7 @@ struct SelectionStats {
     uint32_t refined = 0;     ///< nodes replaced by their children this frame
     uint32_t coarsened = 0;   ///< nodes that replaced their descendants this frame
     uint32_t leasesExpired = 0;  ///< cut nodes re-examined because the camera moved enough
+    uint32_t culled = 0;      ///< nodes left out by the frustum (select with a ViewCamera)
 };
 
 /// Per-file selection state. Allocates once (O(nodes + objects)) at construction; select()
@@ -61,13 +74,37 @@ public:
     /// Reference selection: walks from the roots. Same rule and state as select().
     void selectFull(const Camera& camera, const SelectionSettings& settings);
 
+    /// Selection with frustum culling. The same rule as select(), except that a node whose
+    /// bounding sphere lies entirely outside the view frustum (the four side planes given by
+    /// fovY and aspect, the near plane and, when finite, the far plane) is culled: it is not
+    /// refined and not drawn. It is neither in cut() nor in proxyNodes() / originalObjects(),
+    /// but in culledNodes(), so cut() and culledNodes() together still cover every original
+    /// object exactly once; the objects of a culled node are simply not drawn. Refinement
+    /// state and hysteresis carry over between calls as with select(), and the calls may be
+    /// mixed freely. Cost: a walk from the roots over the visible part of the hierarchy (no
+    /// leases, since a turn of the camera changes what is culled). A camera with a zero or
+    /// non-finite forward, an up parallel to forward, aspect <= 0 or a NaN plane culls nothing.
+    void select(const ViewCamera& camera, const SelectionSettings& settings);
+
     /// Collision cut around a query point (DESIGN section 3): a node is used when its error is
     /// at most maxErrorPerDistance * (distance from `point` to its bounding sphere), i.e.
     /// finer close to the querying agent. Incremental like select(). Units: world / world.
     void selectByDistance(const float point[3], float maxErrorPerDistance, float coarsenRatio = 0.75f);
 
-    /// The cut: node indices (size <= nodeCount). Inner nodes and leaves mixed; order unspecified.
-    Span<uint32_t> cut() const { return {cut_.data(), cutSize_}; }
+    /// The cut: the nodes drawn, node indices (size <= nodeCount). Inner nodes and leaves
+    /// mixed; order unspecified. Without culling it covers every original object exactly once.
+    Span<uint32_t> cut() const { return {cut_.data(), cutSize_ - culledCount_}; }
+    /// Nodes of the last select(ViewCamera) left out by the frustum (not refined, not drawn);
+    /// empty after the calls without culling. Order unspecified.
+    Span<uint32_t> culledNodes() const { return {cut_.data() + (cutSize_ - culledCount_), culledCount_}; }
+    /// Changes of cut() made by the last call that selects (select, selectFull,
+    /// selectByDistance, reset; construction counts as one from an empty cut): the nodes now
+    /// in cut() that were not before, and those no longer in it. An engine streams in the
+    /// meshes of entered() and may release those of left(). Node indices, each at most once
+    /// (sizes <= nodeCount); order unspecified; no allocation. Both are empty when the cut did
+    /// not change.
+    Span<uint32_t> entered() const { return {entered_.data(), enteredCount_}; }
+    Span<uint32_t> left() const { return {left_.data(), leftCount_}; }
     /// Inner nodes of the cut: draw their proxy meshes.
     Span<uint32_t> proxyNodes() const { return {proxies_.data(), proxyCount_}; }
     /// Original objects covered by leaves of the cut: the engine draws these itself.
@@ -102,9 +139,17 @@ private:
     void emit(uint32_t node);
     void descend(uint32_t node, const Frame& f);          // fresh rule below a refined node
     void beginFrame(const Frame& f);
-    void endFrame();
+    void endFrame(uint32_t culled);
     void runIncremental(const Frame& f);
-    void runFull(const Frame& f);
+    void runFull(const Frame& f, bool cull);
+    void runCulled(const Frame& f);
+    bool outsideFrustum(uint32_t node) const;
+    bool setFrustum(const ViewCamera& camera);
+    // Cut changes: from the old and the new drawn lists (passes that rebuild the cut), or from
+    // the nodes inserted or removed in place (leased pass).
+    void diffRebuilt(const uint32_t* oldDrawn, uint32_t oldCount, const uint32_t* newDrawn, uint32_t newCount);
+    void touch(uint32_t node);
+    void diffTouched();
     // Leases (see selection.cpp): per cut node, how far the camera may travel before its
     // decision (or its parent's) can change; only expired nodes are re-examined.
     struct Lease {
@@ -137,6 +182,12 @@ private:
     float leaseReach_[2] = {-1, -1};
     bool leasesValid_ = false;
     uint32_t cutSize_ = 0, proxyCount_ = 0, originalCount_ = 0, nextSize_ = 0;
+    uint32_t culledCount_ = 0;     // the last culledCount_ entries of the cut_ cover are culled
+    float planes_[6][4] = {};      // frustum: inward unit normal n and d, inside when n.p + d >= 0
+    int planeCount_ = 0;
+    std::vector<uint8_t> inView_;  // 1 when the node is in cut() (as of the end of the last call)
+    std::vector<uint32_t> entered_, left_, touched_, touchStamp_;
+    uint32_t enteredCount_ = 0, leftCount_ = 0, touchedCount_ = 0;
     uint32_t frame_ = 0;
     SelectionStats stats_;
 };
