@@ -239,6 +239,7 @@ public:
         if (pinned)
             for (size_t v = 0; v < std::min(n, pinned->size()); ++v) locked_[v] |= (*pinned)[v];
         liveFaces_ = faces_.size();
+        mark_.assign(n, 0);
         faceLeaf_.assign(faces_.size(), FaceTree::kNone);
         for (uint32_t f = 0; f < faces_.size(); ++f) faceLeaf_[f] = tree_.insert(f, faceBox(f));
     }
@@ -333,41 +334,43 @@ private:
         if (locked_[a] || locked_[b]) return false;
         // Faces around the edge: exactly two contain both ends (manifold edge).
         std::vector<uint32_t>& around = scratchFaces_;
-        around.clear();
-        around.insert(around.end(), vertexFaces_[a].begin(), vertexFaces_[a].end());
-        around.insert(around.end(), vertexFaces_[b].begin(), vertexFaces_[b].end());
-        std::sort(around.begin(), around.end());
-        around.erase(std::unique(around.begin(), around.end()), around.end());
+        around.assign(vertexFaces_[a].begin(), vertexFaces_[a].end());
         uint32_t opposite[2];
         int shared = 0;
-        for (uint32_t f : around) {
+        for (uint32_t f : vertexFaces_[b]) {
             const auto& t = faces_[f];
-            const bool hasA = t[0] == a || t[1] == a || t[2] == a;
-            const bool hasB = t[0] == b || t[1] == b || t[2] == b;
-            if (hasA && hasB) {
+            if (t[0] == a || t[1] == a || t[2] == a) {
                 if (shared == 2) return false;
                 for (uint32_t w : t)
                     if (w != a && w != b) opposite[shared] = w;
                 ++shared;
+            } else {
+                around.push_back(f);
             }
         }
         if (shared != 2 || opposite[0] == opposite[1]) return false;
         // Link condition (Dey et al.): the only common neighbours are the two opposite
         // vertices, so the collapse keeps the surface a manifold.
-        neighbours(a, scratchA_);
-        neighbours(b, scratchB_);
-        size_t common = 0;
-        for (size_t i = 0, j = 0; i < scratchA_.size() && j < scratchB_.size();) {
-            if (scratchA_[i] < scratchB_[j]) ++i;
-            else if (scratchB_[j] < scratchA_[i]) ++j;
-            else {
-                if (scratchA_[i] != opposite[0] && scratchA_[i] != opposite[1]) return false;
-                ++common, ++i, ++j;
+        ++markStamp_;
+        size_t neighbourCount = 0, common = 0;
+        for (uint32_t f : vertexFaces_[a])
+            for (uint32_t w : faces_[f])
+                if (w != a && mark_[w] != markStamp_) mark_[w] = markStamp_, ++neighbourCount;
+        const uint32_t seenFromB = ++markStamp_;
+        for (uint32_t f : vertexFaces_[b])
+            for (uint32_t w : faces_[f]) {
+                if (w == b || mark_[w] == seenFromB) continue;
+                if (mark_[w] == seenFromB - 1) {  // a neighbour of both
+                    if (w != a && w != opposite[0] && w != opposite[1]) return false;
+                    if (w != a) ++common;
+                } else {
+                    ++neighbourCount;
+                }
+                mark_[w] = seenFromB;
             }
-        }
         if (common != 2) return false;
         // A tetrahedron (4 vertices) cannot lose an edge and stay closed.
-        if (scratchA_.size() + scratchB_.size() - common <= 4) return false;
+        if (neighbourCount <= 4) return false;
 
         // Constraint planes: unit normal and offset of every face around a or b.
         planes_.clear();
@@ -548,7 +551,9 @@ private:
     size_t liveFaces_ = 0;
     double epsilon_ = 0;
     bool started_ = false;
-    std::vector<uint32_t> scratchFaces_, scratchA_, scratchB_, scratchNeighbours_;
+    std::vector<uint32_t> scratchFaces_, scratchNeighbours_;
+    std::vector<uint32_t> mark_;  ///< per vertex: markStamp_ when seen by the current link test
+    uint32_t markStamp_ = 0;
     std::vector<Plane> planes_;
     FaceTree tree_;
     std::vector<uint32_t> faceLeaf_;

@@ -12,8 +12,7 @@
 //    a subset of nodes never above the certified bound.
 // The checker itself is tested on the exact aggregates (which must pass the geometric checks)
 // and on damaged copies of them (which must fail them), so a passing scene is not a checker
-// that cannot fail. Scene tests that fail on the proxies of the time are registered DISABLED_
-// until the proxies meet them; run them with --gtest_also_run_disabled_tests.
+// that cannot fail.
 #include "acceptance_scenes.h"
 #include "grid_measure.h"
 #include "mesh_distance.h"
@@ -600,17 +599,16 @@ TEST(ProxyAcceptance, CheckerCatchesDamagedProxies) {
     EXPECT_EQ(damaged.nonPositiveVolume, count / 2);
 }
 
-// The scenes. A test is DISABLED_ while the proxies of the time fail it (see the figures each
-// prints); run with --gtest_also_run_disabled_tests.
-TEST(ProxyAcceptance, DISABLED_Spheres15ClosedAndContaining) { expectClosedAndContaining("spheres15"); }
-TEST(ProxyAcceptance, DISABLED_Spheres15ErrorsWithinBudget) { expectErrorsWithinBudget("spheres15"); }
-TEST(ProxyAcceptance, DISABLED_ChessClosedAndContaining) { expectClosedAndContaining("chess"); }
-TEST(ProxyAcceptance, DISABLED_ChessErrorsWithinBudget) { expectErrorsWithinBudget("chess"); }
-TEST(ProxyAcceptance, DISABLED_ForestClosedAndContaining) { expectClosedAndContaining("forest"); }
-TEST(ProxyAcceptance, DISABLED_ForestErrorsWithinBudget) { expectErrorsWithinBudget("forest"); }
-TEST(ProxyAcceptance, DISABLED_VillageClosedAndContaining) { expectClosedAndContaining("village"); }
-TEST(ProxyAcceptance, DISABLED_VillageErrorsWithinBudget) { expectErrorsWithinBudget("village"); }
-TEST(ProxyAcceptance, DISABLED_TruckTownClosedAndContaining) { expectClosedAndContaining("truck_town"); }
-TEST(ProxyAcceptance, DISABLED_TruckTownErrorsWithinBudget) { expectErrorsWithinBudget("truck_town"); }
-TEST(ProxyAcceptance, DISABLED_Random400ClosedAndContaining) { expectClosedAndContaining("random"); }
-TEST(ProxyAcceptance, DISABLED_Random400ErrorsWithinBudget) { expectErrorsWithinBudget("random"); }
+// The scenes.
+TEST(ProxyAcceptance, Spheres15ClosedAndContaining) { expectClosedAndContaining("spheres15"); }
+TEST(ProxyAcceptance, Spheres15ErrorsWithinBudget) { expectErrorsWithinBudget("spheres15"); }
+TEST(ProxyAcceptance, ChessClosedAndContaining) { expectClosedAndContaining("chess"); }
+TEST(ProxyAcceptance, ChessErrorsWithinBudget) { expectErrorsWithinBudget("chess"); }
+TEST(ProxyAcceptance, ForestClosedAndContaining) { expectClosedAndContaining("forest"); }
+TEST(ProxyAcceptance, ForestErrorsWithinBudget) { expectErrorsWithinBudget("forest"); }
+TEST(ProxyAcceptance, VillageClosedAndContaining) { expectClosedAndContaining("village"); }
+TEST(ProxyAcceptance, VillageErrorsWithinBudget) { expectErrorsWithinBudget("village"); }
+TEST(ProxyAcceptance, TruckTownClosedAndContaining) { expectClosedAndContaining("truck_town"); }
+TEST(ProxyAcceptance, TruckTownErrorsWithinBudget) { expectErrorsWithinBudget("truck_town"); }
+TEST(ProxyAcceptance, Random400ClosedAndContaining) { expectClosedAndContaining("random"); }
+TEST(ProxyAcceptance, Random400ErrorsWithinBudget) { expectErrorsWithinBudget("random"); }
