@@ -1495,14 +1495,22 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 node.name = "object_" + objects[i].name;
                 extras["leaf"] = tinygltf::Value(true);
             } else {
-                node.name = "node" + std::to_string(i) + "_level" + std::to_string(n.firstLevel);
-                extras["level"] = tinygltf::Value(n.firstLevel);
-                extras["last_level"] = tinygltf::Value(n.lastLevel);
-                extras["delta"] = tinygltf::Value(n.delta);
+                // A per-object LOD node has no level: it is named and tinted as below level 0.
+                const bool objectLod = n.objectLod >= 1;
+                node.name = "node" + std::to_string(i) +
+                            (objectLod ? "_object_lod" + std::to_string(n.objectLod) : "_level" + std::to_string(n.firstLevel));
+                if (objectLod) {
+                    extras["object_lod"] = intValue(size_t(n.objectLod));
+                } else {
+                    extras["level"] = tinygltf::Value(n.firstLevel);
+                    extras["last_level"] = tinygltf::Value(n.lastLevel);
+                    extras["delta"] = tinygltf::Value(n.delta);
+                }
                 extras["proxy_error_bound"] = tinygltf::Value(n.error.bound());
+                extras["proxy_error_budget"] = tinygltf::Value(n.budget);
                 extras["exact_triangles"] = intValue(n.exactTriangleCount);
                 const std::vector<double> positions(n.positions.begin(), n.positions.end());
-                node.mesh = glb.addMesh(node.name, positions, n.indices, n.firstLevel, &n.faceColors);
+                node.mesh = glb.addMesh(node.name, positions, n.indices, objectLod ? 0 : n.firstLevel, &n.faceColors);
             }
             for (uint32_t c : n.children) node.children.push_back(int(c));
             node.extras = tinygltf::Value(std::move(extras));
