@@ -236,6 +236,7 @@ private:
     enum class NearVertex { Skip, Insert };
     size_t insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex nearVertex);
     void buildLevels();
+    std::vector<double> visibleDeltas() const;
 };
 
 bool Baker::prepare() {
@@ -1243,6 +1244,34 @@ bool Baker::refineCoarseConnections() {
     return inserted > 0;
 }
 
+// Automatic thresholds that change something one can see (DESIGN 2.3). Merges closer than
+// 0.1 % of the diagonal of the aggregated objects (support surfaces left out) look the same
+// as touching at any distance where the scene is seen whole: the geometric series of levels
+// starts at the first merge above that, and runs to the last merge. The finest level sits
+// at half of that first visible merge, so it shows every model apart (except those nearer
+// than that) before anything visible is joined.
+std::vector<double> Baker::visibleDeltas() const {
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (const Model& m : models_)
+        for (uint32_t o : m.objects)
+            for (int k = 0; k < 3; ++k) {
+                box[k] = std::min(box[k], prepared_[o].bounds[k]);
+                box[3 + k] = std::max(box[3 + k], prepared_[o].bounds[3 + k]);
+            }
+    const double diagonal = box[0] <= box[3] ? std::sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
+                                                         (box[5] - box[2]) * (box[5] - box[2]))
+                                             : 0.0;
+    const double visible = 1e-3 * diagonal;
+    std::vector<Merge> seen;
+    for (const Merge& m : out_.merges)
+        if (m.height >= visible) seen.push_back(m);
+    if (seen.empty()) seen = out_.merges;
+    const int count = settings_.automaticLevelCount;
+    std::vector<double> deltas = automaticDeltas(seen, count > 1 ? count - 1 : count);
+    if (count > 1 && !seen.empty() && seen.front().height > 0) deltas.insert(deltas.begin(), 0.5 * seen.front().height);
+    return deltas;
+}
+
 void Baker::buildLevels() {
     timer_.begin("hierarchy");
     detail::precomputeTetEdges(space_, settings_.threadCount);
@@ -1251,7 +1280,7 @@ void Baker::buildLevels() {
     out_.merges = kruskalMerges(models_.size(), graph);
     std::vector<double> deltas = settings_.deltas;
     if (deltas.empty()) {
-        deltas = automaticDeltas(out_.merges, settings_.automaticLevelCount);
+        deltas = visibleDeltas();
         if (deltas.empty()) {
             deltas.push_back(0.0);
             diag(out_, Diagnostic::Severity::Note, "",
