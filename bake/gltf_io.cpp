@@ -397,9 +397,17 @@ const char* modeName(int mode) {
     }
 }
 
-std::string displayName(const tinygltf::Model& model, int node) {
-    const std::string& n = model.nodes[size_t(node)].name;
-    return n.empty() ? "node" + std::to_string(node) : n;
+/// A node's name; an unnamed node is called after its mesh and its index path
+/// ("Wheel@0/3/1": position in the scene's root list, then child positions), which stays the
+/// same however the file is re-exported, as long as the hierarchy does. `path` is empty
+/// before the traversal reached the node (then the node index is used).
+std::string displayName(const tinygltf::Model& model, int node, const std::string& path = std::string()) {
+    const tinygltf::Node& n = model.nodes[size_t(node)];
+    if (!n.name.empty()) return n.name;
+    std::string base = "node";
+    if (n.mesh >= 0 && size_t(n.mesh) < model.meshes.size())
+        base = model.meshes[size_t(n.mesh)].name.empty() ? "mesh" + std::to_string(n.mesh) : model.meshes[size_t(n.mesh)].name;
+    return base + (path.empty() ? std::to_string(node) : path);
 }
 
 /// An object being assembled from one or more mesh nodes.
@@ -425,21 +433,32 @@ private:
     void note(Severity severity, const std::string& object, const std::string& message) {
         diags_.push_back(Diagnostic{severity, object, message});
     }
-    bool excluded(int node) const {
-        if (!hasRegex_) return false;
+    bool matches(std::string text) const {
         // libstdc++'s regex matcher recurses per character: a crafted, very long name could
         // overflow the stack, so only the first 1024 characters of a name are matched.
-        std::string name = displayName(model_, node);
-        if (name.size() > 1024) name.resize(1024);
-        return std::regex_search(name, regex_);
+        if (text.size() > 1024) text.resize(1024);
+        return std::regex_search(text, regex_);
     }
+    /// The node with its subtree is left out: its name or index path matches.
+    bool excluded(int node) const {
+        return hasRegex_ && (matches(name(node)) || matches(paths_[size_t(node)]));
+    }
+    /// Only the node's own mesh is left out (see SceneReadOptions::excludeRegex).
+    bool meshExcluded(int node) const {
+        const tinygltf::Node& n = model_.nodes[size_t(node)];
+        if (!hasRegex_ || n.mesh < 0) return false;
+        const std::string meshName = size_t(n.mesh) < model_.meshes.size() ? model_.meshes[size_t(n.mesh)].name : std::string();
+        return matches(name(node) + "/mesh") || matches(paths_[size_t(node)] + "/mesh") ||
+               (!meshName.empty() && matches("mesh:" + meshName));
+    }
+    std::string name(int node) const { return displayName(model_, node, paths_[size_t(node)]); }
     void addMeshOfNode(int node, const Mat4& world, ObjectBuilder& object);
     bool addPrimitive(int node, int meshIndex, int primIndex, const Mat4& world, bool flip,
                       ObjectBuilder& object);
     void fail(ObjectBuilder& object, int node, const std::string& why) {
         if (!object.failed) {
             note(Severity::Warning, object.name,
-                 why + " (node " + std::to_string(node) + " '" + displayName(model_, node) +
+                 why + " (node " + std::to_string(node) + " '" + name(node) +
                      "'); object skipped");
         }
         object.failed = true;
@@ -450,6 +469,8 @@ private:
     std::vector<Diagnostic>& diags_;
     std::regex regex_;
     bool hasRegex_ = false;
+    std::vector<std::string> paths_;  ///< per node: index path "@0/3/1", set when the traversal reaches it
+    std::vector<std::string> nonTriangle_;  ///< "node 'name' mesh m primitive p: mode", listed in one note
     bool notedTexture_ = false;  ///< the texture note is given once per file
 };
 
@@ -462,16 +483,19 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
         mode != TINYGLTF_MODE_TRIANGLE_FAN) {
         const bool known = mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP;
-        note(known ? Severity::Note : Severity::Warning, object.name,
-             "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
-                 ": mode " + (known ? std::string(modeName(mode)) : std::to_string(mode)) +
-                 " is not triangles; primitive skipped");
+        if (!known) {
+            note(Severity::Warning, object.name,
+                 "node " + std::to_string(node) + " '" + name(node) + "' " + where + ": mode " + std::to_string(mode) +
+                     " is not a glTF primitive mode; primitive skipped");
+        } else {
+            nonTriangle_.push_back("'" + name(node) + "' " + where + " (" + modeName(mode) + ")");
+        }
         return true;
     }
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) {
         note(Severity::Warning, object.name,
-             "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+             "node " + std::to_string(node) + " '" + name(node) + "' " + where +
                  ": no POSITION attribute; primitive skipped");
         return true;
     }
@@ -518,7 +542,7 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
     if (mode == TINYGLTF_MODE_TRIANGLES) {
         if (n % 3 != 0) {
             note(Severity::Warning, object.name,
-                 "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+                 "node " + std::to_string(node) + " '" + name(node) + "' " + where +
                      ": " + std::to_string(n) + " indices is not a multiple of 3; last " +
                      std::to_string(n % 3) + " ignored");
         }
@@ -565,7 +589,7 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
         }
     } else if (prim.material >= 0) {
         note(Severity::Warning, object.name,
-             "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where + ": material " +
+             "node " + std::to_string(node) + " '" + name(node) + "' " + where + ": material " +
                  std::to_string(prim.material) + " does not exist; white is used");
     }
     std::vector<double> vertexColours;
@@ -576,7 +600,7 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
         if (!readAccessor(model_, col->second, false, vertexColours, why, true) ||
             (vertexColours.size() != 3 * vertexCount && vertexColours.size() != 4 * vertexCount)) {
             note(Severity::Warning, object.name,
-                 "node " + std::to_string(node) + " '" + displayName(model_, node) + "' " + where +
+                 "node " + std::to_string(node) + " '" + name(node) + "' " + where +
                      ": COLOR_0 unusable (" + (why.empty() ? "count differs from POSITION" : why) +
                      "); the material colour is used");
             vertexColours.clear();
@@ -634,10 +658,9 @@ void SceneReader::addMeshOfNode(int node, const Mat4& world, ObjectBuilder& obje
                                std::to_string(model_.meshes.size()) + " meshes)");
         return;
     }
-    if (n.skin >= 0) {
+    if (n.skin >= 0 && options_.includeAnimated) {
         note(Severity::Note, object.name,
-             "node " + std::to_string(node) + " '" + displayName(model_, node) +
-                 "' is skinned; its bind pose is used");
+             "node " + std::to_string(node) + " '" + name(node) + "' is skinned; its bind pose is used");
     }
     const bool flip = determinant3(world) < 0;
     const tinygltf::Mesh& mesh = model_.meshes[size_t(n.mesh)];
@@ -725,78 +748,114 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
     // gives it several parents or a cycle.
     std::vector<ObjectBuilder> builders;
     std::vector<char> visited(size_t(nodeCount), 0);
-    std::vector<std::string> excludedNames;
+    std::vector<std::string> excludedNames, excludedMeshes, animatedNames, cameraNames, lightNames;
+    paths_.assign(size_t(nodeCount), std::string());
+    // Nodes an animation moves (their subtrees move with them).
+    std::vector<char> animated(size_t(nodeCount), 0);
+    for (const tinygltf::Animation& a : model_.animations)
+        for (const tinygltf::AnimationChannel& c : a.channels)
+            if (c.target_node >= 0 && c.target_node < nodeCount) animated[size_t(c.target_node)] = 1;
+    // Depth whose nodes open one object gathering their subtree (-1: every mesh node is one).
+    const int groupDepth = options_.objectDepth >= 0 ? options_.objectDepth
+                           : options_.objectUnit == ObjectUnit::Subtree ? 1
+                                                                       : -1;
     struct Item {
         int node;
         Mat4 parent;
         int group;  ///< builder index of the enclosing subtree object, -1 if none
         int depth;  ///< 0 for a scene root
+        std::string path;
     };
     std::vector<Item> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back(Item{*it, Mat4{}, -1, 0});
+    for (size_t r = roots.size(); r-- > 0;) stack.push_back(Item{roots[r], Mat4{}, -1, 0, "@" + std::to_string(r)});
 
     while (!stack.empty()) {
         const Item item = stack.back();
         stack.pop_back();
         const int node = item.node;
         if (visited[size_t(node)]) {
-            note(Severity::Warning, displayName(model_, node),
+            note(Severity::Warning, name(node),
                  "node " + std::to_string(node) +
                      " is reached more than once (invalid glTF: several parents or a cycle); "
                      "read only the first time");
             continue;
         }
         visited[size_t(node)] = 1;
+        paths_[size_t(node)] = item.path;
         if (excluded(node)) {
-            excludedNames.push_back(displayName(model_, node));
+            excludedNames.push_back(name(node));
             continue;
         }
         const tinygltf::Node& n = model_.nodes[size_t(node)];
+        if (n.camera >= 0) cameraNames.push_back(name(node));
+        if (n.extensions.count("KHR_lights_punctual")) lightNames.push_back(name(node));
+        if (animated[size_t(node)] && !options_.includeAnimated) {
+            animatedNames.push_back(name(node) + " (animated, with its subtree)");
+            continue;
+        }
+        // A mesh left out on its own: by --exclude, or skinned (it deforms).
+        bool useMesh = n.mesh >= 0;
+        if (useMesh && meshExcluded(node)) {
+            excludedMeshes.push_back(name(node));
+            useMesh = false;
+        } else if (useMesh && n.skin >= 0 && !options_.includeAnimated) {
+            animatedNames.push_back(name(node) + " (skinned mesh)");
+            useMesh = false;
+        }
         std::string problem;
         const Mat4 world = multiply(item.parent, localTransform(n, problem));
         if (!problem.empty()) {
-            note(Severity::Warning, displayName(model_, node),
+            note(Severity::Warning, name(node),
                  "node " + std::to_string(node) + ": " + problem);
         }
 
         int group = item.group;
-        if (options_.objectUnit == ObjectUnit::Node) {
-            if (n.mesh >= 0) {
+        if (groupDepth < 0 || item.depth < groupDepth) {
+            // A node above the assembly depth: its own mesh is an object by itself.
+            if (useMesh) {
                 builders.push_back(ObjectBuilder{});
-                builders.back().name = displayName(model_, node);
-                builders.back().topNode = node;
-                addMeshOfNode(node, world, builders.back());
-            }
-        } else if (item.depth == 0) {
-            // Subtree unit: a scene root's own mesh is an object by itself; each of its
-            // children opens an object gathering every mesh below it.
-            if (n.mesh >= 0) {
-                builders.push_back(ObjectBuilder{});
-                builders.back().name = displayName(model_, node);
+                builders.back().name = name(node);
                 builders.back().topNode = node;
                 addMeshOfNode(node, world, builders.back());
             }
             group = -1;
         } else {
-            if (item.depth == 1) {
+            // At the assembly depth a node opens an object gathering every mesh below it.
+            if (item.depth == groupDepth) {
                 builders.push_back(ObjectBuilder{});
-                builders.back().name = displayName(model_, node);
+                builders.back().name = name(node);
                 builders.back().topNode = node;
                 group = int(builders.size()) - 1;
             }
-            addMeshOfNode(node, world, builders[size_t(group)]);
+            if (useMesh) addMeshOfNode(node, world, builders[size_t(group)]);
         }
 
         for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) {
             if (*c < 0 || *c >= nodeCount) {
-                note(Severity::Warning, displayName(model_, node),
+                note(Severity::Warning, name(node),
                      "node " + std::to_string(node) + " has child " + std::to_string(*c) +
                          ", which does not exist; ignored");
                 continue;
             }
-            stack.push_back(Item{*c, world, group, item.depth + 1});
+            const size_t position = size_t(n.children.rend() - c) - 1;
+            stack.push_back(Item{*c, world, group, item.depth + 1, item.path + "/" + std::to_string(position)});
         }
     }
+
+    // One note per kind, each listing the nodes.
+    const auto listNote = [&](const std::vector<std::string>& names, const std::string& what) {
+        if (names.empty()) return;
+        std::string list;
+        const size_t shown = std::min<size_t>(names.size(), 20);
+        for (size_t i = 0; i < shown; ++i) list += (i ? ", " : "") + names[i];
+        if (names.size() > shown) list += ", ... (" + std::to_string(names.size()) + ")";
+        note(Severity::Note, "", what + ": " + list);
+    };
+    listNote(animatedNames, "left out as animated or skinned (--include-animated bakes their rest pose)");
+    listNote(excludedMeshes, "--exclude dropped the own mesh of these nodes, keeping their children");
+    listNote(cameraNames, "cameras (not geometry; ignored)");
+    listNote(lightNames, "lights (not geometry; ignored)");
+    listNote(nonTriangle_, "primitives that are not triangles (points or lines; skipped)");
 
     if (hasRegex_) {
         std::string list;
@@ -804,8 +863,10 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
         for (size_t i = 0; i < shown; ++i) list += (i ? ", " : "") + excludedNames[i];
         if (excludedNames.size() > shown) list += ", ...";
         note(Severity::Note, "",
-             excludedNames.empty()
+             excludedNames.empty() && excludedMeshes.empty()
                  ? "--exclude '" + options_.excludeRegex + "' matched no node"
+                 : excludedNames.empty()
+                 ? "--exclude '" + options_.excludeRegex + "' matched no whole node"
                  : "excluded " + std::to_string(excludedNames.size()) + " node(s) matching '" +
                        options_.excludeRegex + "' with their subtrees: " + list);
     }
@@ -1257,6 +1318,7 @@ bool readLevelsGlb(const std::string& path, std::vector<LevelsGlbNode>& out, std
                 return false;
             }
             const tinygltf::Value& extras = model.nodes[size_t(found->second)].extras;
+            if (extras.IsObject() && extras.Has("support")) continue;  // a support surface passed through
             double level = 0, group = 0, delta = 0;
             if (!number(extras, "level", level) || level < 0 || level > 1e6 || level != std::floor(level)) {
                 error = path + ": node '" + object.name +
@@ -1407,6 +1469,11 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 extras["components"] = tinygltf::Value(agg.componentCount);
                 extras["volume"] = tinygltf::Value(agg.measures.volume);
                 extras["volume_original"] = tinygltf::Value(agg.volumeOriginal);
+                // Where the faces on the objects come from: their own faces, or the watertight
+                // solid that stood in for objects that were not closed solids.
+                extras["surface"] = tinygltf::Value(std::string(agg.surface == Aggregate::Surface::Original     ? "original"
+                                                                : agg.surface == Aggregate::Surface::Solidified ? "solidified"
+                                                                                                                : "mixed"));
                 if (nodes) {
                     if (g >= nodes->nodeOfAggregate[k].size()) {
                         error = path + ": " + name + " has no hierarchy node";
@@ -1436,6 +1503,43 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 children.push_back(glb.addNode(std::move(node)));
             }
             model.nodes[size_t(levelIndex)].children = std::move(children);
+        }
+        // Support surfaces pass through unchanged, flagged, under their own root node.
+        if (!hierarchy.supportObjects.empty()) {
+            tinygltf::Material material;
+            material.name = "support";
+            material.pbrMetallicRoughness.baseColorFactor = {0.5, 0.5, 0.5, 1};
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.9;
+            model.materials.push_back(std::move(material));
+            const int materialIndex = int(model.materials.size()) - 1;
+            tinygltf::Node supportNode;
+            supportNode.name = "support";
+            tinygltf::Value::Object supportExtras;
+            supportExtras["support"] = tinygltf::Value(true);
+            supportNode.extras = tinygltf::Value(std::move(supportExtras));
+            const int supportIndex = glb.addNode(std::move(supportNode));
+            roots.push_back(supportIndex);
+            std::vector<int> children;
+            for (uint32_t s : hierarchy.supportObjects) {
+                if (s >= objects.size()) {
+                    error = path + ": support object " + std::to_string(s) + " does not exist";
+                    return false;
+                }
+                const InputObject& o = objects[s];
+                const std::string name = "support_" + o.name;
+                tinygltf::Node node;
+                node.name = name;
+                node.mesh = glb.addMesh(name, o.positions, o.indices, materialIndex, &o.triangleColors);
+                tinygltf::Value::Object extras;
+                extras["support"] = tinygltf::Value(true);
+                extras["sources"] = tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(o.name)});
+                extras["source_ids"] = tinygltf::Value(tinygltf::Value::Array{intValue(o.id)});
+                if (nodes && s < nodes->objectCount) extras["node"] = intValue(s);
+                node.extras = tinygltf::Value(std::move(extras));
+                children.push_back(glb.addNode(std::move(node)));
+            }
+            model.nodes[size_t(supportIndex)].children = std::move(children);
         }
         return glb.write(path, roots, error);
     } catch (const std::exception& e) {

@@ -78,6 +78,11 @@ struct BakeOptions {
     bool tiles = false;
     bool constantBaseline = false;
     bool quiet = false;
+    std::string solidify = "wrap";      ///< wrap | hull | off
+    double wrapOffset = -1;             ///< < 0: automatic
+    std::string support = "auto";       ///< auto | none | a regex on object names
+    int objectDepth = -1;               ///< >= 0: each node at this depth, with its subtree, is one object
+    bool includeAnimated = false;
 };
 
 /// The settings that shape the outputs, as canonical text (hashed into scene.aglod so that an
@@ -91,7 +96,10 @@ std::string settingsText(const BakeOptions& o) {
         text += buffer;
     }
     std::snprintf(buffer, sizeof buffer, ";touch=%.17g;proxy=%.17g", o.touchTolerance, o.proxyError);
-    return text + buffer;
+    text += buffer;
+    std::snprintf(buffer, sizeof buffer, ";wrapoffset=%.17g;depth=%d;animated=%d", o.wrapOffset, o.objectDepth,
+                  o.includeAnimated ? 1 : 0);
+    return text + ";solidify=" + o.solidify + ";support=" + o.support + buffer;
 }
 
 CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
@@ -123,6 +131,23 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "What one object is: node (default: each node with a mesh) or subtree "
                     "(each child of a scene root, with all meshes below it)")
         ->transform(CLI::IsMember({"node", "subtree"}, CLI::ignore_case));
+    cmd->add_option("--object-depth", o.objectDepth,
+                    "Each node at this depth below the scene roots (0 = the roots), with every mesh below it, is "
+                    "one object; shallower meshes stay objects of their own (overrides --object)")
+        ->check(CLI::Range(0, 1000));
+    cmd->add_option("--solidify", o.solidify,
+                    "What stands in for objects that are not closed solids (open, non-manifold, self-intersecting, "
+                    "touching): wrap (default: a tight watertight alpha wrap), hull (convex hull) or off (left out)")
+        ->transform(CLI::IsMember({"wrap", "hull", "off"}, CLI::ignore_case));
+    cmd->add_option("--wrap-offset", o.wrapOffset,
+                    "Distance of the wrap from the original surface, in scene units (default: automatic, see "
+                    "docs/real-art.md)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--support", o.support,
+                    "Support surfaces (ground, terrain, sky, roads, room shell) kept out of aggregation and passed "
+                    "through: auto (default, documented rule), none, or an ECMAScript regex on object names");
+    cmd->add_flag("--include-animated", o.includeAnimated,
+                  "Bake animated and skinned nodes at their rest pose (default: left out and listed)");
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
     cmd->add_flag("--constant-baseline", o.constantBaseline,
                   "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
@@ -205,10 +230,23 @@ int runBake(BakeOptions o) {
         }
     }
 
+    const bool supportRegex = o.support != "auto" && o.support != "none";
+    std::regex support;
+    if (supportRegex) {
+        try {
+            support = std::regex(o.support, std::regex::ECMAScript);
+        } catch (const std::regex_error& e) {
+            printError("--support: invalid regular expression '" + o.support + "': " + e.what());
+            return kUsage;
+        }
+    }
+
     // Read.
     io::SceneReadOptions readOptions;
     readOptions.excludeRegex = o.exclude;
     readOptions.objectUnit = o.objectUnit == "subtree" ? io::ObjectUnit::Subtree : io::ObjectUnit::Node;
+    readOptions.objectDepth = o.objectDepth;
+    readOptions.includeAnimated = o.includeAnimated;
     io::SceneReadResult scene;
     std::string error;
     if (!io::readGltfScene(o.scene, readOptions, scene, error)) {
@@ -232,6 +270,22 @@ int runBake(BakeOptions o) {
     settings.touchTolerance = o.touchTolerance;
     settings.threadCount = o.threads;
     settings.computeConstantBaseline = o.constantBaseline;
+    settings.solidify = o.solidify == "hull" ? SolidifyMethod::Hull
+                        : o.solidify == "off" ? SolidifyMethod::Off
+                                              : SolidifyMethod::Wrap;
+    settings.wrapOffset = o.wrapOffset;
+    settings.support = o.support == "none" ? SupportDetection::None
+                       : supportRegex      ? SupportDetection::Given
+                                           : SupportDetection::Automatic;
+    if (supportRegex) {
+        for (uint32_t i = 0; i < scene.objects.size(); ++i) {
+            std::string name = scene.objects[i].name;
+            if (name.size() > 1024) name.resize(1024);  // as --exclude: bounded regex recursion
+            if (std::regex_search(name, support)) settings.supportObjects.push_back(i);
+        }
+        if (settings.supportObjects.empty() && !o.quiet)
+            std::fprintf(stderr, "note: --support '%s' matched no object\n", o.support.c_str());
+    }
     settings.progress = [&progress](const char* stage, double fraction) {
         progress.update(stage, fraction);
     };

@@ -17,8 +17,19 @@ enum class ObjectUnit {
 };
 
 struct SceneReadOptions {
-    std::string excludeRegex;            ///< ECMAScript regex; nodes whose name matches are left out (with their subtree)
+    /// ECMAScript regex, searched in each node's name and in its index path ("#0/3/1": the
+    /// node's position in the scene's root list, then child positions). A match leaves the
+    /// node out with its subtree. A match on "mesh:" followed by the node's mesh name, or on
+    /// the name or path followed by "/mesh" (e.g. '^Terrain/mesh$'), drops only the node's
+    /// own mesh and keeps its children.
+    std::string excludeRegex;
     ObjectUnit objectUnit = ObjectUnit::Node;
+    /// >= 0: every node at this depth (0 = scene roots), with all meshes below it, is one
+    /// object; meshes of shallower nodes are objects of their own. Overrides objectUnit.
+    int objectDepth = -1;
+    /// Nodes targeted by an animation channel (with their subtrees) and skinned meshes are
+    /// left out with a note listing them, unless this is set (then their rest pose is read).
+    bool includeAnimated = false;
 };
 
 struct SceneReadResult {

@@ -203,6 +203,41 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
     }
     w.endArray();
 
+    // Solidified models (DESIGN 2.0): distances sampled, not certified.
+    w.key("solids");
+    w.beginArray();
+    for (const SolidReport& r : h.solids) {
+        w.beginInlineObject();
+        std::string names;
+        for (size_t i = 0; i < r.objects.size(); ++i) names += (i ? ", " : "") + objects[r.objects[i]].name;
+        w.fieldStr("objects", names);
+        w.fieldStr("method", r.method == SolidifyMethod::Wrap ? "alpha_wrap" : "convex_hull");
+        w.fieldStr("reason", r.reason);
+        w.field("alpha", r.alpha);
+        w.field("offset", r.offset);
+        w.field("bbox_diagonal", r.bboxDiagonal);
+        w.field("volume_original", r.volumeOriginal);
+        w.field("volume_solid", r.volumeSolid);
+        w.field("added_volume", r.volumeSolid - r.volumeOriginal);
+        w.field("distance_solid_to_original", r.distanceSolidToOriginal);
+        w.field("distance_original_to_solid", r.distanceOriginalToSolid);
+        w.field("hausdorff", std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid));
+        w.fieldStr("hausdorff_kind", "sampled");
+        if (r.hullDistance > 0) w.field("hausdorff_convex_hull", r.hullDistance);
+        w.fieldInt("triangles", r.triangles.size() / 3);
+        w.fieldStr("closed_manifold", r.closedManifold ? "yes" : "no");
+        w.endInlineObject();
+    }
+    w.endArray();
+    const auto writeNames = [&](const char* key, const std::vector<uint32_t>& ids) {
+        w.key(key);
+        w.beginArray();
+        for (uint32_t i : ids) w.str(objects[i].name);
+        w.endArray();
+    };
+    writeNames("support_surfaces", h.supportObjects);
+    writeNames("left_out", h.leftOutObjects);
+
     w.key("merges");
     w.beginArray();
     for (const Merge& m : h.merges) {

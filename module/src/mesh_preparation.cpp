@@ -2,6 +2,8 @@
 // closedness / manifoldness / orientation analysis, inside-out repair per shell.
 #include "mesh_preparation.h"
 
+#include "mesh_distance.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -52,6 +54,45 @@ void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint
                    a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
         area += triangleArea(a, b, c);
     }
+}
+
+bool selfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& triangles) {
+    const size_t m = triangles.size() / 3;
+    std::vector<std::array<double, 6>> box(m);
+    for (size_t t = 0; t < m; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            box[t][k] = INFINITY;
+            box[t][3 + k] = -INFINITY;
+        }
+        for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < 3; ++k) {
+                const double v = positions[3 * triangles[3 * t + c] + k];
+                box[t][k] = std::min(box[t][k], v);
+                box[t][3 + k] = std::max(box[t][3 + k], v);
+            }
+    }
+    std::vector<uint32_t> order(m);
+    std::iota(order.begin(), order.end(), 0u);
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return std::make_pair(box[a][0], a) < std::make_pair(box[b][0], b); });
+    for (size_t i = 0; i < m; ++i) {
+        const uint32_t a = order[i];
+        const uint32_t* ta = &triangles[3 * a];
+        for (size_t j = i + 1; j < m; ++j) {
+            const uint32_t b = order[j];
+            if (box[b][0] > box[a][3]) break;
+            if (box[b][1] > box[a][4] || box[a][1] > box[b][4] || box[b][2] > box[a][5] || box[a][2] > box[b][5]) continue;
+            const uint32_t* tb = &triangles[3 * b];
+            bool shares = false;
+            for (int x = 0; x < 3; ++x)
+                for (int y = 0; y < 3; ++y) shares = shares || ta[x] == tb[y];
+            if (shares) continue;
+            bool intersecting = false;
+            triangleTriangleDistance(&positions[3 * ta[0]], &positions[3 * ta[1]], &positions[3 * ta[2]], &positions[3 * tb[0]],
+                                     &positions[3 * tb[1]], &positions[3 * tb[2]], nullptr, nullptr, &intersecting);
+            if (intersecting) return true;
+        }
+    }
+    return false;
 }
 
 void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject& out,

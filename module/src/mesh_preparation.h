@@ -27,6 +27,12 @@ struct PreparedObject {
 void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject& out,
                    std::vector<Diagnostic>& diagnostics);
 
+/// Whether two triangles of the mesh that share no vertex intersect or touch (exact
+/// triangle-triangle test of mesh_distance.h on the pairs whose boxes overlap, found by a
+/// sweep along x). Triangles sharing a vertex are not tested: a fold there is not seen.
+/// positions 3 * n, triangles 3 * m. O(m log m + overlapping pairs).
+bool selfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& triangles);
+
 /// Signed volume (divergence theorem) and area of a triangle mesh.
 void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint32_t>& triangles,
                     double& volume, double& area);

@@ -1,7 +1,9 @@
-// The 3D bake (DESIGN 2): prepare objects, group touching objects into models, triangulate
+// The 3D bake (DESIGN 2): prepare objects, set support surfaces aside and solidify what is
+// not a valid closed solid (DESIGN 2.0), group touching objects into models, triangulate
 // the free space once, build the neighbourhood graph and dendrogram, then shape and measure
 // every level from that one triangulation.
 #include "convex_hull.h"
+#include "solidify.h"
 #include "free_space.h"
 #include "mesh_distance.h"
 #include "mesh_preparation.h"
@@ -95,7 +97,12 @@ struct DisjointSets {
 /// A vertex of the neighbourhood graph: one object, or objects that touch.
 struct Model {
     std::vector<uint32_t> objects;    ///< ascending input indices
-    bool standIn = false;             ///< surface is the convex hull of its objects
+    /// What the surface given to the triangulator is: the objects' own faces, or a solid
+    /// standing in for them (DESIGN 2.0).
+    enum class Kind { Original, Wrap, Hull } kind = Kind::Original;
+    bool standIn() const { return kind != Kind::Original; }
+    std::string reason;               ///< why it is solidified
+    double alpha = 0, offset = 0;     ///< wrap parameters
     std::vector<double> positions;    ///< the surface given to the triangulator
     std::vector<uint32_t> triangles;
     TriangleBvh bvh;
@@ -195,7 +202,16 @@ private:
 
     bool prepare();
     void buildModels();
-    void makeStandIn(Model& m, const std::string& why);
+    /// Replaces the surfaces of models_[which[k]] by solids (SolidifyMethod), in parallel;
+    /// diagnostics in `which` order. A model that cannot be solidified loses its objects.
+    void solidifyModels(const std::vector<size_t>& which, const std::vector<std::string>& why);
+    void makeStandIn(size_t model, const std::string& why) { solidifyModels({model}, {why}); }
+    double nearestGap(const Model& m, double limit) const;
+    void detectSupport();
+    void measureSolids();
+    std::vector<TriangleBvh> objectBvh_;  ///< per prepared object (built in buildModels)
+    std::vector<char> support_;           ///< per object: a support surface
+    double smallestDelta_ = INFINITY;     ///< smallest positive explicit delta
     bool resolveStandInOverlaps();
     bool standInsChanged_ = true;  ///< a stand-in was made since the last resolveStandInOverlaps()
     bool triangulate();
@@ -220,6 +236,7 @@ private:
     enum class NearVertex { Skip, Insert };
     size_t insertSurfacePoints(std::vector<Insertion>& insertions, NearVertex nearVertex);
     void buildLevels();
+    std::vector<double> visibleDeltas() const;
 };
 
 bool Baker::prepare() {
@@ -260,39 +277,309 @@ bool Baker::prepare() {
         diag(out_, Diagnostic::Severity::Error, "", objects_.empty() ? "the scene has no objects" : "no usable object in the scene");
         return false;
     }
+    for (double d : settings_.deltas)
+        if (d > 0) smallestDelta_ = std::min(smallestDelta_, d);
+    detectSupport();
+    if (usable == out_.supportObjects.size()) {
+        diag(out_, Diagnostic::Severity::Error, "", "every usable object is a support surface: nothing to aggregate");
+        return false;
+    }
     return true;
 }
 
-void Baker::makeStandIn(Model& m, const std::string& why) {
-    std::vector<double> pts;
-    for (uint32_t o : m.objects) pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
-    m.standIn = true;
+// Support surfaces (DESIGN 2.0): ground, terrain, sky dome, road network, room shell. The
+// rule (Settings3D::supportSpanFraction): an object that spans most of the scene in two
+// axes and whose box meets the boxes of a large share of the other objects carries or
+// encloses them; aggregating it would join everything into one blob at the finest level.
+void Baker::detectSupport() {
+    const size_t n = objects_.size();
+    support_.assign(n, 0);
+    std::vector<uint32_t> usable;
+    for (uint32_t i = 0; i < n; ++i)
+        if (prepared_[i].usable) usable.push_back(i);
+    if (settings_.support == SupportDetection::Given) {
+        for (uint32_t i : settings_.supportObjects)
+            if (i < n && prepared_[i].usable) support_[i] = 1;
+    } else if (settings_.support == SupportDetection::Automatic) {
+        // Peeled in rounds: a huge outer ground hides the town's own ground and roads,
+        // which span the box of what is left once it is set aside.
+        for (int round = 0; round < 3; ++round) {
+            std::vector<uint32_t> rest;
+            for (uint32_t i : usable)
+                if (!support_[i]) rest.push_back(i);
+            if (rest.size() < 3) break;
+            double scene[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+            for (uint32_t i : rest)
+                for (int k = 0; k < 3; ++k) {
+                    scene[k] = std::min(scene[k], prepared_[i].bounds[k]);
+                    scene[3 + k] = std::max(scene[3 + k], prepared_[i].bounds[3 + k]);
+                }
+            // The scene's two longest axes (ties: lower axis first).
+            int axes[3] = {0, 1, 2};
+            std::stable_sort(axes, axes + 3, [&](int x, int y) { return scene[3 + x] - scene[x] > scene[3 + y] - scene[y]; });
+            const double pad = 0.01 * std::sqrt((scene[3] - scene[0]) * (scene[3] - scene[0]) + (scene[4] - scene[1]) * (scene[4] - scene[1]) +
+                                                (scene[5] - scene[2]) * (scene[5] - scene[2]));
+            auto pairs = overlappingPairs(rest.size(), [&](uint32_t k) { return prepared_[rest[k]].bounds; }, pad);
+            std::vector<size_t> meets(rest.size(), 0);
+            for (auto [x, y] : pairs) {
+                ++meets[x];
+                ++meets[y];
+            }
+            const double others = double(rest.size() - 1);
+            std::vector<uint32_t> found;
+            for (size_t k = 0; k < rest.size(); ++k) {
+                const PreparedObject& p = prepared_[rest[k]];
+                bool wide = true;
+                for (int j = 0; j < 2; ++j) {
+                    const int d = axes[j];
+                    wide = wide && p.bounds[3 + d] - p.bounds[d] >= settings_.supportSpanFraction * (scene[3 + d] - scene[d]);
+                }
+                if (wide && meets[k] >= 2 && double(meets[k]) >= settings_.supportShareFraction * others) found.push_back(rest[k]);
+            }
+            // At least two objects must be left to aggregate.
+            if (found.empty() || rest.size() - found.size() < 2) break;
+            for (uint32_t i : found) support_[i] = 1;
+        }
+    }
+    std::vector<uint32_t> ids;
+    for (uint32_t i = 0; i < n; ++i)
+        if (support_[i]) ids.push_back(i);
+    out_.supportObjects = ids;
+    if (!ids.empty())
+        diag(out_, Diagnostic::Severity::Warning, objectNames(objects_, ids, 20),
+             std::string(settings_.support == SupportDetection::Given ? "support surfaces as asked"
+                                                                      : "support surfaces (span the scene and meet most objects)") +
+                 ": kept out of aggregation and passed through unchanged (--support none aggregates them)");
+}
+
+// Sampled distances between each solid and its originals, both ways, and the same for the
+// convex hull of the originals (for comparison): vertices and triangle centroids of one
+// surface, closest point on the other (BVH). Not certified: a point between samples may lie
+// a little farther.
+void Baker::measureSolids() {
+    std::vector<size_t> which;
+    for (size_t m = 0; m < models_.size(); ++m)
+        if (models_[m].standIn() && !models_[m].objects.empty()) which.push_back(m);
+    if (which.empty()) return;
+    timer_.begin("solid measures");
+    auto sampled = [](const std::vector<double>& p, const std::vector<uint32_t>& t, const TriangleBvh& target) {
+        double worst = 0;
+        for (size_t v = 0; v + 2 < p.size(); v += 3) worst = std::max(worst, detail::closestPoint(target, &p[v]).distance);
+        for (size_t i = 0; i + 2 < t.size(); i += 3) {
+            double c[3];
+            for (int k = 0; k < 3; ++k) c[k] = (p[3 * t[i] + k] + p[3 * t[i + 1] + k] + p[3 * t[i + 2] + k]) / 3.0;
+            worst = std::max(worst, detail::closestPoint(target, c).distance);
+        }
+        return worst;
+    };
+    std::vector<SolidReport> reports(which.size());
+    detail::parallelFor(which.size(), settings_.threadCount, [&](size_t k) {
+        const Model& m = models_[which[k]];
+        SolidReport& r = reports[k];
+        r.objects = m.objects;
+        r.method = m.kind == Model::Kind::Wrap ? SolidifyMethod::Wrap : SolidifyMethod::Hull;
+        r.reason = m.reason;
+        r.alpha = m.alpha;
+        r.offset = m.offset;
+        std::vector<double> pts;
+        std::vector<uint32_t> tris;
+        for (uint32_t o : m.objects) {
+            const uint32_t base = static_cast<uint32_t>(pts.size() / 3);
+            pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
+            for (uint32_t i : prepared_[o].triangles) tris.push_back(base + i);
+            r.volumeOriginal += std::fabs(prepared_[o].volume);
+        }
+        double b[6];
+        computeBounds(pts, b);
+        r.bboxDiagonal = std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+        double area = 0;
+        detail::meshVolumeArea(m.positions, m.triangles, r.volumeSolid, area);
+        TriangleBvh original;
+        original.build(pts.data(), pts.size() / 3, tris.data(), tris.size() / 3);
+        r.distanceSolidToOriginal = sampled(m.positions, m.triangles, original);
+        r.distanceOriginalToSolid = sampled(pts, tris, m.bvh);
+        // Closed and edge-manifold as a fresh check of the triangulator's input.
+        InputObject solid;
+        solid.positions = m.positions;
+        solid.indices = m.triangles;
+        PreparedObject check;
+        std::vector<Diagnostic> ignored;
+        detail::prepareObject(solid, 0.0, check, ignored);
+        r.closedManifold = check.validSolid();
+        if (settings_.computeHullBaseline && r.method == SolidifyMethod::Wrap) {
+            std::vector<double> hp;
+            std::vector<uint32_t> ht;
+            if (detail::convexHull3(pts, hp, ht)) {
+                TriangleBvh hull;
+                hull.build(hp.data(), hp.size() / 3, ht.data(), ht.size() / 3);
+                r.hullDistance = std::max(sampled(hp, ht, original), sampled(pts, tris, hull));
+            }
+        }
+        r.positions = m.positions;
+        r.triangles = m.triangles;
+    }, [&](size_t done) { timer_.report(double(done) / which.size()); });
+    std::sort(reports.begin(), reports.end(), [](const SolidReport& a, const SolidReport& b) { return a.objects < b.objects; });
+    out_.solids = std::move(reports);
+}
+
+// Generalized winding number of a closed surface around q (Jacobson et al. 2013; solid
+// angles by Van Oosterom and Strackee 1983): about 1 inside, 0 outside, robust to small
+// defects. O(triangles).
+double windingNumber(const std::vector<double>& p, const std::vector<uint32_t>& t, const double* q) {
+    double total = 0;
+    for (size_t i = 0; i + 2 < t.size(); i += 3) {
+        double a[3], b[3], c[3];
+        for (int k = 0; k < 3; ++k) {
+            a[k] = p[3 * t[i] + k] - q[k];
+            b[k] = p[3 * t[i + 1] + k] - q[k];
+            c[k] = p[3 * t[i + 2] + k] - q[k];
+        }
+        const double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        const double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                           a[2] * (b[0] * c[1] - b[1] * c[0]);
+        const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+        const double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
+        total += 2.0 * std::atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
+    }
+    return total / (4.0 * M_PI);
+}
+
+// Distance from the original surfaces of m's objects to the nearest other model's objects,
+// looked for up to `limit` (returns `limit` when none is nearer). Support surfaces do not
+// count: they are not in the triangulation, so a wrap may reach into the ground.
+double Baker::nearestGap(const Model& m, double limit) const {
+    double box[6];
+    for (int k = 0; k < 3; ++k) {
+        box[k] = INFINITY;
+        box[3 + k] = -INFINITY;
+    }
+    for (uint32_t o : m.objects)
+        for (int k = 0; k < 3; ++k) {
+            box[k] = std::min(box[k], prepared_[o].bounds[k]);
+            box[3 + k] = std::max(box[3 + k], prepared_[o].bounds[3 + k]);
+        }
+    double best = limit;
+    for (uint32_t other = 0; other < prepared_.size(); ++other) {
+        if (!prepared_[other].usable || support_[other] || std::binary_search(m.objects.begin(), m.objects.end(), other)) continue;
+        if (!boxesOverlap(box, prepared_[other].bounds, best)) continue;
+        for (uint32_t o : m.objects) {
+            const detail::ClosestPair cp = detail::meshDistance(objectBvh_[o], objectBvh_[other], best);
+            if (cp.distance < best) best = cp.distance;
+        }
+    }
+    return best;
+}
+
+void Baker::solidifyModels(const std::vector<size_t>& which, const std::vector<std::string>& why) {
+    if (which.empty()) return;
+    const std::string stage = timer_.name;  // resumed afterwards: solidifying is timed on its own
+    timer_.begin("solidify");
     standInsChanged_ = true;
     modelsPrepared_ = false;
     distanceCache_.clear();
-    m.positions.clear();
-    m.triangles.clear();
-    if (!detail::convexHull3(pts, m.positions, m.triangles)) {
-        diag(out_, Diagnostic::Severity::Warning, objectNames(objects_, m.objects),
-             why + "; it is flat, has no convex hull with volume, and is left out");
-        m.objects.clear();
-        return;
+    std::vector<std::string> failure(which.size());
+    std::vector<char> flat(which.size(), 0);
+    std::vector<char> fellBack(which.size(), 0);
+    detail::parallelFor(which.size(), settings_.threadCount, [&](size_t k) {
+        Model& m = models_[which[k]];
+        m.reason = why[k];
+        m.positions.clear();
+        m.triangles.clear();
+        std::vector<double> pts;
+        std::vector<uint32_t> tris;
+        for (uint32_t o : m.objects) {
+            const uint32_t base = static_cast<uint32_t>(pts.size() / 3);
+            pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
+            for (uint32_t i : prepared_[o].triangles) tris.push_back(base + i);
+        }
+        if (settings_.solidify == SolidifyMethod::Wrap) {
+            double b[6];
+            computeBounds(pts, b);
+            const double size = std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+            double offset = settings_.wrapOffset;
+            if (!(offset > 0)) {
+                // Tight enough to keep the shape, never reaching a neighbour (a quarter of the
+                // gap each side leaves half of it free), never blurring the finest level.
+                const double cap = std::min(0.004 * size, 0.25 * smallestDelta_);
+                offset = std::min(cap, 0.25 * nearestGap(m, 4 * cap));
+                offset = std::max(offset, 5e-4 * size);
+            }
+            // 1.5 % keeps every truck_town house within 2 % of its diagonal (two-sided); the
+            // cost grows as 1 / alpha^2 (see docs/real-art.md).
+            const double alpha = std::max(0.015 * size, 2 * offset);
+            std::string error;
+            if (size > 0 && detail::alphaWrap(pts, tris, alpha, offset, m.positions, m.triangles, error)) {
+                // The wrap must be a valid solid piece of the triangulation's input.
+                InputObject wrapped;
+                wrapped.positions = m.positions;
+                wrapped.indices = m.triangles;
+                PreparedObject check;
+                std::vector<Diagnostic> ignored;
+                detail::prepareObject(wrapped, 0.0, check, ignored);
+                if (check.validSolid() && check.positions.size() == m.positions.size()) {
+                    m.positions = std::move(check.positions);
+                    m.triangles = std::move(check.triangles);
+                    m.kind = Model::Kind::Wrap;
+                    m.alpha = alpha;
+                    m.offset = offset;
+                    return;
+                }
+                error = "the wrap is not a closed, consistently oriented solid";
+            }
+            failure[k] = error;
+            m.positions.clear();
+            m.triangles.clear();
+            fellBack[k] = 1;
+        }
+        if (settings_.solidify == SolidifyMethod::Off) return;
+        m.alpha = m.offset = 0;
+        m.kind = Model::Kind::Hull;
+        if (!detail::convexHull3(pts, m.positions, m.triangles)) flat[k] = 1;
+    }, [&](size_t done) { timer_.report(double(done) / which.size()); });
+    for (size_t k = 0; k < which.size(); ++k) {
+        Model& m = models_[which[k]];
+        const std::string names = objectNames(objects_, m.objects);
+        if (settings_.solidify == SolidifyMethod::Off && m.positions.empty()) {
+            diag(out_, Diagnostic::Severity::Warning, names,
+                 why[k] + "; left out of aggregation (--solidify off) and passed through unchanged");
+            m.objects.clear();
+            continue;
+        }
+        if (flat[k]) {
+            diag(out_, Diagnostic::Severity::Warning, names,
+                 why[k] + (fellBack[k] ? "; could not be wrapped (" + failure[k] + ")" : std::string()) +
+                     "; it is flat, has no convex hull with volume, and is left out");
+            m.objects.clear();
+            continue;
+        }
+        if (m.kind == Model::Kind::Wrap)
+            diag(out_, Diagnostic::Severity::Note, names,
+                 why[k] + "; solidified by an alpha wrap (alpha " + fmt(m.alpha) + ", offset " + fmt(m.offset) +
+                     ") for the triangulation");
+        else
+            diag(out_, Diagnostic::Severity::Warning, names,
+                 why[k] + (fellBack[k] ? "; alpha wrap failed (" + failure[k] + ")" : std::string()) +
+                     "; stood in for by its convex hull in the triangulation");
     }
-    diag(out_, Diagnostic::Severity::Warning, objectNames(objects_, m.objects),
-         why + "; stood in for by its convex hull in the triangulation");
+    if (!stage.empty() && stage != "solidify") timer_.begin(stage);
 }
 
 void Baker::buildModels() {
     timer_.begin("models");
     const size_t n = objects_.size();
-    std::vector<TriangleBvh> bvh(n);
-    for (size_t i = 0; i < n; ++i)
+    objectBvh_.assign(n, TriangleBvh{});
+    std::vector<TriangleBvh>& bvh = objectBvh_;
+    detail::parallelFor(n, settings_.threadCount, [&](size_t i) {
         if (prepared_[i].usable)
             bvh[i].build(prepared_[i].positions.data(), prepared_[i].positions.size() / 3, prepared_[i].triangles.data(),
                          prepared_[i].triangles.size() / 3);
+    });
     std::vector<uint32_t> usable;
     for (uint32_t i = 0; i < n; ++i)
-        if (prepared_[i].usable) usable.push_back(i);
+        if (prepared_[i].usable && !support_[i]) usable.push_back(i);
     auto pairs = overlappingPairs(usable.size(), [&](uint32_t k) { return prepared_[usable[k]].bounds; }, tolerance_);
     DisjointSets sets(n);
     for (size_t p = 0; p < pairs.size(); ++p) {
@@ -318,17 +605,32 @@ void Baker::buildModels() {
         }
         models_[it->second].objects.push_back(i);
     }
-    for (Model& m : models_) {
+    // A closed surface that crosses itself would fail the triangulation (and TetGen's own
+    // search for the crossing facets is slow): find those first.
+    std::vector<char> crossing(models_.size(), 0);
+    detail::parallelFor(models_.size(), settings_.threadCount, [&](size_t i) {
+        const Model& m = models_[i];
+        if (m.objects.size() == 1 && prepared_[m.objects[0]].validSolid())
+            crossing[i] = detail::selfIntersects(prepared_[m.objects[0]].positions, prepared_[m.objects[0]].triangles);
+    });
+    std::vector<size_t> toSolidify;
+    std::vector<std::string> why;
+    for (size_t i = 0; i < models_.size(); ++i) {
+        Model& m = models_[i];
         for (uint32_t o : m.objects) m.volumeOriginal += prepared_[o].volume;
-        if (m.objects.size() == 1 && prepared_[m.objects[0]].validSolid()) {
+        if (crossing[i]) {
+            toSolidify.push_back(i);
+            why.push_back("self-intersecting surface");
+        } else if (m.objects.size() == 1 && prepared_[m.objects[0]].validSolid()) {
             m.positions = prepared_[m.objects[0]].positions;
             m.triangles = prepared_[m.objects[0]].triangles;
-        } else if (m.objects.size() == 1) {
-            makeStandIn(m, "not a closed, consistently oriented solid");
         } else {
-            makeStandIn(m, "touching or intersecting objects form one model");
+            toSolidify.push_back(i);
+            why.push_back(m.objects.size() == 1 ? "not a closed, consistently oriented solid"
+                                                : "touching or intersecting objects form one model");
         }
     }
+    solidifyModels(toSolidify, why);
 }
 
 // A convex-hull stand-in may reach into another model: merge them (and re-hull) until no
@@ -351,10 +653,15 @@ bool Baker::resolveStandInOverlaps() {
         for (auto [i, j] : pairs) {
             Model& a = models_[i];
             Model& b = models_[j];
-            if (!a.standIn && !b.standIn) continue;
+            if (!a.standIn() && !b.standIn()) continue;
             bool joins = detail::meshDistance(a.bvh, b.bvh, tolerance_, tolerance_).distance <= tolerance_;
-            if (!joins && a.standIn) joins = pointInsideConvex(a.positions, a.triangles, &b.positions[0]);
-            if (!joins && b.standIn) joins = pointInsideConvex(b.positions, b.triangles, &a.positions[0]);
+            // One inside the other (surfaces apart): a hull by its planes, any other closed
+            // surface by its winding number.
+            auto inside = [](const Model& outer, const double* q) {
+                return outer.kind == Model::Kind::Hull ? pointInsideConvex(outer.positions, outer.triangles, q)
+                                                       : windingNumber(outer.positions, outer.triangles, q) > 0.5;
+            };
+            if (!joins && boxesOverlap(a.bounds, b.bounds, 0) ) joins = inside(a, &b.positions[0]) || inside(b, &a.positions[0]);
             if (joins) merged |= sets.unite(i, j);
         }
         if (!merged) return changed;
@@ -372,14 +679,21 @@ bool Baker::resolveStandInOverlaps() {
                 Model& dst = next[at[r]];
                 dst.objects.insert(dst.objects.end(), models_[i].objects.begin(), models_[i].objects.end());
                 dst.volumeOriginal += models_[i].volumeOriginal;
-                dst.standIn = false;  // re-hulled below
+                dst.kind = Model::Kind::Original;  // solidified again below
             }
         }
-        for (Model& m : next) {
+        std::vector<size_t> again;
+        std::vector<std::string> why;
+        for (size_t k = 0; k < next.size(); ++k) {
+            Model& m = next[k];
             std::sort(m.objects.begin(), m.objects.end());
-            if (!m.standIn && m.objects.size() > 1) makeStandIn(m, "a convex-hull stand-in reaches other objects; merged");
+            if (!m.standIn() && m.objects.size() > 1) {
+                again.push_back(k);
+                why.push_back("a solidified stand-in reaches other objects; merged");
+            }
         }
         models_ = std::move(next);
+        solidifyModels(again, why);
     }
     return changed;
 }
@@ -443,14 +757,15 @@ bool Baker::triangulate() {
             detail::TetgenOutcome found = detail::findIntersectingFacets(plc, markers);
             bool repaired = false;
             if (found.status == detail::TetgenStatus::Ok) {
+                std::vector<size_t> which;
                 for (int marker : markers) {
                     if (marker <= 0 || static_cast<size_t>(marker) > models_.size()) continue;
-                    Model& m = models_[marker - 1];
-                    if (!m.standIn) {
-                        makeStandIn(m, "self-intersecting surface");
-                        repaired = true;
-                    }
+                    if (!models_[marker - 1].standIn()) which.push_back(static_cast<size_t>(marker - 1));
                 }
+                std::sort(which.begin(), which.end());
+                which.erase(std::unique(which.begin(), which.end()), which.end());
+                solidifyModels(which, std::vector<std::string>(which.size(), "self-intersecting surface"));
+                repaired = !which.empty();
             }
             if (repaired) continue;
         }
@@ -887,7 +1202,15 @@ void Baker::prepareModels(int threadCount) {
     detail::parallelFor(models_.size(), threadCount, [&](size_t m) {
         Model& model = models_[m];
         model.bvh.build(model.positions.data(), model.positions.size() / 3, model.triangles.data(), model.triangles.size() / 3);
-        if (settings_.computeHullBaseline) model.hullVolume = detail::convexHullVolume(model.positions, &model.hullPoints);
+        if (!settings_.computeHullBaseline) return;
+        if (!model.standIn()) {
+            model.hullVolume = detail::convexHullVolume(model.positions, &model.hullPoints);
+            return;
+        }
+        // The baseline is the hull of the originals, not of their (slightly larger) solid.
+        std::vector<double> points;
+        for (uint32_t o : model.objects) points.insert(points.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
+        model.hullVolume = detail::convexHullVolume(points, &model.hullPoints);
     });
     modelsPrepared_ = true;
 }
@@ -921,6 +1244,34 @@ bool Baker::refineCoarseConnections() {
     return inserted > 0;
 }
 
+// Automatic thresholds that change something one can see (DESIGN 2.3). Merges closer than
+// 0.1 % of the diagonal of the aggregated objects (support surfaces left out) look the same
+// as touching at any distance where the scene is seen whole: the geometric series of levels
+// starts at the first merge above that, and runs to the last merge. The finest level sits
+// at half of that first visible merge, so it shows every model apart (except those nearer
+// than that) before anything visible is joined.
+std::vector<double> Baker::visibleDeltas() const {
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (const Model& m : models_)
+        for (uint32_t o : m.objects)
+            for (int k = 0; k < 3; ++k) {
+                box[k] = std::min(box[k], prepared_[o].bounds[k]);
+                box[3 + k] = std::max(box[3 + k], prepared_[o].bounds[3 + k]);
+            }
+    const double diagonal = box[0] <= box[3] ? std::sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
+                                                         (box[5] - box[2]) * (box[5] - box[2]))
+                                             : 0.0;
+    const double visible = 1e-3 * diagonal;
+    std::vector<Merge> seen;
+    for (const Merge& m : out_.merges)
+        if (m.height >= visible) seen.push_back(m);
+    if (seen.empty()) seen = out_.merges;
+    const int count = settings_.automaticLevelCount;
+    std::vector<double> deltas = automaticDeltas(seen, count > 1 ? count - 1 : count);
+    if (count > 1 && !seen.empty() && seen.front().height > 0) deltas.insert(deltas.begin(), 0.5 * seen.front().height);
+    return deltas;
+}
+
 void Baker::buildLevels() {
     timer_.begin("hierarchy");
     detail::precomputeTetEdges(space_, settings_.threadCount);
@@ -929,7 +1280,7 @@ void Baker::buildLevels() {
     out_.merges = kruskalMerges(models_.size(), graph);
     std::vector<double> deltas = settings_.deltas;
     if (deltas.empty()) {
-        deltas = automaticDeltas(out_.merges, settings_.automaticLevelCount);
+        deltas = visibleDeltas();
         if (deltas.empty()) {
             deltas.push_back(0.0);
             diag(out_, Diagnostic::Severity::Note, "",
@@ -1066,11 +1417,17 @@ void Baker::buildLevels() {
             detail::sculptLevel(space_, w.request, label, &constantLabel, &scratch->surfaceTets, scratch.get());
             detail::extractSurfaces(space_, label, w.groupCount, w.aggregates, &scratch->surfaceTets, scratch.get());
             // Per-aggregate sources and measures, on the same thread (levels are independent).
+            std::vector<std::array<size_t, 2>> kinds(w.aggregates.size(), {0, 0});  // original, solidified models
             for (size_t m = 0; m < models_.size(); ++m) {
                 Aggregate& agg = w.aggregates[w.modelGroup[m]];
                 agg.sourceObjects.insert(agg.sourceObjects.end(), models_[m].objects.begin(), models_[m].objects.end());
                 agg.volumeOriginal += models_[m].volumeOriginal;
+                ++kinds[w.modelGroup[m]][models_[m].standIn() ? 1 : 0];
             }
+            for (size_t g = 0; g < w.aggregates.size(); ++g)
+                w.aggregates[g].surface = kinds[g][1] == 0   ? Aggregate::Surface::Original
+                                          : kinds[g][0] == 0 ? Aggregate::Surface::Solidified
+                                                             : Aggregate::Surface::Mixed;
             for (Aggregate& agg : w.aggregates) {
                 std::sort(agg.sourceObjects.begin(), agg.sourceObjects.end());
                 std::vector<const InputObject*> sources;
@@ -1130,6 +1487,8 @@ bool Baker::run() {
     out_.objectModel.assign(objects_.size(), UINT32_MAX);
     for (size_t m = 0; m < models_.size(); ++m)
         for (uint32_t o : models_[m].objects) out_.objectModel[o] = static_cast<uint32_t>(m);
+    for (uint32_t o = 0; o < objects_.size(); ++o)
+        if (out_.objectModel[o] == UINT32_MAX && !support_[o]) out_.leftOutObjects.push_back(o);
     if (!modelsPrepared_) {
         timer_.begin("model hulls");
         prepareModels(settings_.threadCount);
@@ -1142,6 +1501,7 @@ bool Baker::run() {
         }
         buildGraph();
     }
+    measureSolids();
     buildLevels();
     timer_.end();
     return true;

@@ -40,6 +40,21 @@ enum class DistanceMode {
     Cdt     ///< shortest triangulation edge joining the models (the paper's choice)
 };
 
+/// What stands in, in the triangulation, for an object or model that is not a valid closed
+/// solid (open, non-manifold, self-intersecting, or several touching objects; DESIGN 2.0).
+enum class SolidifyMethod {
+    Wrap,  ///< a tight watertight wrap containing it (CGAL alpha wrap; default)
+    Hull,  ///< its convex hull
+    Off    ///< nothing: such objects are left out of aggregation (passed through as support)
+};
+
+/// How support surfaces (ground, terrain, sky dome, road network, room shell) are found.
+enum class SupportDetection {
+    Automatic,  ///< the documented rule (see Settings3D::supportSpanFraction)
+    None,       ///< no object is a support surface
+    Given       ///< exactly Settings3D::supportObjects
+};
+
 struct Settings3D {
     std::vector<double> deltas;       ///< explicit thresholds (world units, ascending); empty = automatic
     int automaticLevelCount = 8;      ///< number of automatic levels when deltas is empty
@@ -53,6 +68,23 @@ struct Settings3D {
     /// figure only (the hull baseline is the one reported by default) and costs about a tenth
     /// of the levels stage.
     bool computeConstantBaseline = false;
+    SolidifyMethod solidify = SolidifyMethod::Wrap;
+    /// Offset of the wrap from the original surface (world units); < 0: automatic, the
+    /// smallest of 0.4 % of the model's bounding-box diagonal, a quarter of its gap to the
+    /// nearest other model (support surfaces not counted) and a quarter of the smallest
+    /// positive explicit delta, but at least 0.05 % of that diagonal. Alpha (smallest cavity
+    /// the wrap enters) is 1.5 % of the diagonal, and at least 2 x offset.
+    double wrapOffset = -1;
+    SupportDetection support = SupportDetection::Automatic;
+    std::vector<uint32_t> supportObjects; ///< input indices, for SupportDetection::Given
+    /// Automatic rule: an object is a support surface when its bounding box spans at least
+    /// this fraction of the scene box along the scene box's two longest axes AND its box
+    /// (padded by 1 % of the scene diagonal) overlaps the boxes of at least
+    /// supportShareFraction of the other objects (and of at least 2). Applied in up to three
+    /// rounds, each on the objects left by the previous one (a huge outer ground hides the
+    /// town's own ground); a round that would leave fewer than 2 objects finds nothing.
+    double supportSpanFraction = 0.5;
+    double supportShareFraction = 0.3;
     ProgressCallback progress;        ///< optional; called from the calling thread only
     int threadCount = 0;              ///< threads for sculpting levels; 0 = hardware concurrency.
                                       ///< Results are identical for every thread count.
@@ -78,6 +110,33 @@ struct Aggregate {
     SolidMeasures measures;
     double volumeOriginal = 0;           ///< sum of the source objects' volumes
     double volumeHull = 0;               ///< convex hull of the group (0 when not computed)
+    /// Whose surface the aggregate's faces come from where they lie on an object: the
+    /// original faces (every source model a valid solid), a solidified stand-in's (every
+    /// source model solidified), or both.
+    enum class Surface { Original, Solidified, Mixed };
+    Surface surface = Surface::Original;
+};
+
+/// One solidified model (DESIGN 2.0): what stood in for its objects in the triangulation.
+struct SolidReport {
+    std::vector<uint32_t> objects;   ///< input indices, ascending
+    SolidifyMethod method = SolidifyMethod::Wrap;
+    std::string reason;              ///< why the objects were not a valid solid
+    double alpha = 0, offset = 0;    ///< wrap parameters (world units; 0 for a hull)
+    double volumeOriginal = 0;       ///< |enclosed volume| of the objects (open ones: of their faces as given)
+    double volumeSolid = 0;          ///< units^3
+    /// Sampled (not certified) distances, world units: from every vertex and triangle
+    /// centroid of one surface to the other surface (closest point, BVH).
+    double distanceSolidToOriginal = 0;
+    double distanceOriginalToSolid = 0;
+    /// The same two-sided figure, max of both directions, for the convex hull of the objects
+    /// (for comparison; 0 when not measured or for Hull itself).
+    double hullDistance = 0;
+    double bboxDiagonal = 0;         ///< of the objects, world units
+    double seconds = 0;              ///< time to build the solid (one thread)
+    bool closedManifold = false;     ///< closed, edge-manifold, consistently outward oriented
+    std::vector<double> positions;   ///< the solid, 3 * vertexCount
+    std::vector<uint32_t> triangles; ///< 3 * triangleCount, outward
 };
 
 struct Level {
@@ -102,6 +161,12 @@ struct Hierarchy3D {
     std::vector<std::pair<std::string, double>> timings; ///< stage name -> seconds, in run order
     size_t tetrahedronCount = 0;
     size_t inputTriangleCount = 0;
+    std::vector<SolidReport> solids;         ///< every solidified model, by smallest object index
+    /// Support surfaces (ascending input indices): kept out of aggregation, in no level;
+    /// the outputs pass them through unchanged.
+    std::vector<uint32_t> supportObjects;
+    /// Objects in no level for another reason (unusable, flat, or left out by SolidifyMethod::Off).
+    std::vector<uint32_t> leftOutObjects;
 };
 
 /// Bakes the whole hierarchy.

@@ -1,0 +1,304 @@
+// Real game art (DESIGN 2.0): every shared real scene bakes as given; support surfaces are
+// found by the default rule; objects that are not closed solids are wrapped, not hulled; the
+// wraps are closed, contain their originals and stay near them; objects can be chosen in
+// real files (index paths, own meshes, assembly depth, animated nodes).
+#include "scene_io.h"
+#include "test_support.h"
+
+#include <aggrelod/aggregate3d.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace aggrelod;
+using namespace aggrelod::testing;
+
+namespace {
+
+struct Baked {
+    RunResult run;
+    fs::path dir;
+    std::vector<io::LevelsGlbNode> levels;  ///< aggregates of levels.glb
+    std::set<std::string> support;          ///< names of the support nodes of levels.glb
+    std::string stats;
+};
+
+/// Bakes a real scene once per test run with no options (only output paths).
+const Baked& bakedAsGiven(const std::string& relative) {
+    static std::map<std::string, Baked> cache;
+    auto found = cache.find(relative);
+    if (found != cache.end()) return found->second;
+    Baked& b = cache[relative];
+    b.dir = freshTestDir("real_art_" + fs::path(relative).stem().string());
+    b.run = runProgram({AGGRELOD_CLI, "bake", sharedData(relative).string(), "-o", (b.dir / "out").string(), "--stats",
+                        (b.dir / "stats.json").string()},
+                       b.dir);
+    if (b.run.exited && b.run.exitCode == 0) {
+        std::string error;
+        EXPECT_TRUE(io::readLevelsGlb((b.dir / "out" / "levels.glb").string(), b.levels, error)) << error;
+        io::SceneReadResult all;
+        EXPECT_TRUE(io::readGltfScene((b.dir / "out" / "levels.glb").string(), {}, all, error)) << error;
+        for (const InputObject& o : all.objects)
+            if (o.name.rfind("support_", 0) == 0) b.support.insert(o.name.substr(8));
+        b.stats = readFile(b.dir / "stats.json");
+    }
+    return b;
+}
+
+size_t levelCount(const Baked& b) {
+    uint32_t top = 0;
+    for (const auto& n : b.levels) top = std::max(top, n.level + 1);
+    return top;
+}
+size_t groupsAt(const Baked& b, uint32_t level) {
+    size_t g = 0;
+    for (const auto& n : b.levels) g += n.level == level;
+    return g;
+}
+
+#define REQUIRE_DATA(relative)                                                              \
+    if (!fs::exists(sharedData(relative))) GTEST_SKIP() << sharedData(relative) << " absent"
+
+void expectHierarchy(const std::string& relative, const std::set<std::string>& support) {
+    REQUIRE_DATA(relative);
+    const Baked& b = bakedAsGiven(relative);
+    ASSERT_TRUE(b.run.exited && b.run.exitCode == 0) << b.run.describe();
+    EXPECT_GT(levelCount(b), 1u) << relative;
+    EXPECT_GT(groupsAt(b, 0), 1u) << relative;
+    for (const std::string& s : support) EXPECT_TRUE(b.support.count(s)) << relative << ": " << s << " is not a support surface";
+    // No object stood in for by its convex hull unless asked.
+    EXPECT_EQ(b.stats.find("\"convex_hull\""), std::string::npos) << relative;
+    EXPECT_EQ(lower(b.run.err).find("convex hull in the triangulation"), std::string::npos) << b.run.err;
+}
+
+}  // namespace
+
+TEST(RealArt, TruckTownAsGiven) {
+    expectHierarchy("3d/truck_town/town_model.gltf", {"OuterGroundMesh", "GrassMesh", "RoadMesh"});
+}
+TEST(RealArt, CollisionWorldAsGiven) { expectHierarchy("3d/collision-world/collision-world.glb", {"Cube.004"}); }
+TEST(RealArt, GodotOcclusionRoomAsGiven) { expectHierarchy("3d/godot_occlusion_room/room.glb", {"Cube"}); }
+TEST(RealArt, DeccerCubesAsGiven) { expectHierarchy("3d/deccer-cubes/SM_Deccer_Cubes.glb", {}); }
+TEST(RealArt, DeccerCubesWithRotationAsGiven) { expectHierarchy("3d/deccer-cubes/SM_Deccer_Cubes_With_Rotation.glb", {}); }
+TEST(RealArt, OrientationTestAsGiven) { expectHierarchy("3d/OrientationTest/OrientationTest.glb", {}); }
+
+TEST(RealArt, TwoCylinderEngineAsGivenIsOneWrappedModel) {
+    const std::string relative = "3d/2CylinderEngine/2CylinderEngine.glb";
+    REQUIRE_DATA(relative);
+    const Baked& b = bakedAsGiven(relative);
+    ASSERT_TRUE(b.run.exited && b.run.exitCode == 0) << b.run.describe();
+    EXPECT_NE(b.stats.find("\"alpha_wrap\""), std::string::npos);
+    EXPECT_EQ(b.stats.find("\"convex_hull\""), std::string::npos);
+}
+
+// Assemblies one level below the root (docs/real-art.md): more than one model at level 0,
+// wrapped (not hulled).
+TEST(RealArt, TwoCylinderEngineObjectDepthOne) {
+    const std::string relative = "3d/2CylinderEngine/2CylinderEngine.glb";
+    REQUIRE_DATA(relative);
+    const fs::path dir = freshTestDir(currentTestName());
+    const RunResult r = runProgram({AGGRELOD_CLI, "bake", sharedData(relative).string(), "-o", (dir / "out").string(), "--stats",
+                                    (dir / "stats.json").string(), "--object-depth", "1"},
+                                   dir);
+    ASSERT_TRUE(r.exited && r.exitCode == 0) << r.describe();
+    std::vector<io::LevelsGlbNode> levels;
+    std::string error;
+    ASSERT_TRUE(io::readLevelsGlb((dir / "out" / "levels.glb").string(), levels, error)) << error;
+    size_t level0 = 0;
+    for (const auto& n : levels) level0 += n.level == 0;
+    EXPECT_GT(level0, 1u);
+    const std::string stats = readFile(dir / "stats.json");
+    EXPECT_NE(stats.find("\"alpha_wrap\""), std::string::npos);
+    EXPECT_EQ(stats.find("\"convex_hull\""), std::string::npos);
+}
+
+// The solids themselves, through the module: closed, edge-manifold, containing every
+// original vertex, near the original (offset + alpha: wrap faces may bridge cavities
+// narrower than alpha), and for the houses within 2 % of their diagonal, far below the hull.
+TEST(RealArt, TruckTownSolidsAreTightAndClosed) {
+    const std::string relative = "3d/truck_town/town_model.gltf";
+    REQUIRE_DATA(relative);
+    io::SceneReadResult scene;
+    std::string error;
+    ASSERT_TRUE(io::readGltfScene(sharedData(relative).string(), {}, scene, error)) << error;
+    Settings3D settings;
+    settings.automaticLevelCount = 2;
+    Hierarchy3D h;
+    ASSERT_TRUE(buildHierarchy3D(scene.objects, settings, h));
+    size_t houses = 0;
+    ASSERT_FALSE(h.solids.empty());
+    for (const SolidReport& r : h.solids) {
+        std::string names;
+        for (uint32_t o : r.objects) names += scene.objects[o].name + " ";
+        EXPECT_EQ(r.method, SolidifyMethod::Wrap) << names;
+        EXPECT_TRUE(r.closedManifold) << names;
+        InputObject solid;
+        solid.positions = r.positions;
+        solid.indices = r.triangles;
+        const ClosedCheck c = checkClosedAfterWeld(solid);
+        EXPECT_EQ(c.problem, "") << names;
+        EXPECT_EQ(c.edgesUsedMoreThanTwice, 0u) << names;
+        EXPECT_GT(signedVolumeOf(solid), 0.0) << names;
+        for (uint32_t o : r.objects) {
+            const auto& p = scene.objects[o].positions;
+            for (size_t v = 0; v + 2 < p.size(); v += 3)
+                ASSERT_GT(windingNumber(r.positions, r.triangles, &p[v]), 0.5) << names << " vertex " << v / 3 << " outside its solid";
+        }
+        EXPECT_LE(r.distanceSolidToOriginal, (r.offset + r.alpha) * 1.001) << names;
+        const double twoSided = std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid);
+        if (names.rfind("House", 0) == 0) {
+            ++houses;
+            std::printf("%-14s wrap %.3f (%.2f %% of diagonal)  convex hull %.3f (%.2f %%)\n", names.c_str(), twoSided,
+                        100 * twoSided / r.bboxDiagonal, r.hullDistance, 100 * r.hullDistance / r.bboxDiagonal);
+            EXPECT_LE(twoSided, 0.02 * r.bboxDiagonal) << names;
+            EXPECT_LT(twoSided, r.hullDistance) << names;
+        }
+    }
+    EXPECT_EQ(houses, 10u);
+}
+
+TEST(RealArt, HullOnlyWhenAsked) {
+    const std::string relative = "3d/collision-world/collision-world.glb";
+    REQUIRE_DATA(relative);
+    const fs::path dir = freshTestDir(currentTestName());
+    const RunResult r = runProgram({AGGRELOD_CLI, "bake", sharedData(relative).string(), "-o", (dir / "out").string(), "--stats",
+                                    (dir / "stats.json").string(), "--solidify", "hull"},
+                                   dir);
+    ASSERT_TRUE(r.exited && r.exitCode == 0) << r.describe();
+    EXPECT_NE(readFile(dir / "stats.json").find("\"convex_hull\""), std::string::npos);
+}
+
+TEST(RealArt, OneAndTwoThreadsGiveIdenticalFiles) {
+    const std::string relative = "3d/collision-world/collision-world.glb";
+    REQUIRE_DATA(relative);
+    const fs::path dir = freshTestDir(currentTestName());
+    std::string files[2][4];
+    for (int t = 0; t < 2; ++t) {
+        const fs::path out = dir / ("t" + std::to_string(t + 1));
+        const RunResult r = runProgram({AGGRELOD_CLI, "bake", sharedData(relative).string(), "-o", out.string(), "--stats",
+                                        (out / "stats.json").string(), "--threads", std::to_string(t + 1)},
+                                       dir);
+        ASSERT_TRUE(r.exited && r.exitCode == 0) << r.describe();
+        files[t][0] = readFile(out / "levels.glb");
+        files[t][1] = readFile(out / "proxies.glb");
+        files[t][2] = readFile(out / "scene.aglod");
+        const std::string stats = readFile(out / "stats.json");
+        files[t][3] = stats.substr(0, stats.find("\"timings\""));
+    }
+    for (int k = 0; k < 4; ++k) EXPECT_TRUE(files[0][k] == files[1][k]) << "output " << k << " differs";
+}
+
+// ---------------------------------------------------------------------------------------
+// Choosing objects in a hand-written glTF: an unnamed root node carrying a "terrain" mesh
+// with two children (one unnamed), and an animated node.
+// ---------------------------------------------------------------------------------------
+namespace {
+
+std::string base64(const std::string& bytes) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    size_t i = 0;
+    for (; i + 2 < bytes.size(); i += 3) {
+        const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8 | (unsigned char)bytes[i + 2];
+        for (int k = 3; k >= 0; --k) out += table[(v >> (6 * k)) & 63];
+    }
+    if (i < bytes.size()) {
+        unsigned v = (unsigned char)bytes[i] << 16;
+        if (i + 1 < bytes.size()) v |= (unsigned char)bytes[i + 1] << 8;
+        out += table[(v >> 18) & 63];
+        out += table[(v >> 12) & 63];
+        out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
+        out += '=';
+    }
+    return out;
+}
+
+/// A unit cube mesh (one buffer); nodes place it with translations.
+std::string assemblyGltf() {
+    const float p[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    const uint16_t idx[36] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+    std::string bytes(reinterpret_cast<const char*>(p), sizeof p);
+    bytes.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 3]}],
+ "nodes": [
+  {"mesh": 1, "children": [1, 2]},
+  {"mesh": 0, "translation": [3, 0, 0]},
+  {"name": "Tower", "mesh": 0, "translation": [6, 0, 0]},
+  {"name": "Windmill", "mesh": 0, "translation": [0, 0, 6]}],
+ "meshes": [{"name": "Box", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]},
+            {"name": "Terrain", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+ "animations": [{"channels": [{"sampler": 0, "target": {"node": 3, "path": "rotation"}}],
+                 "samplers": [{"input": 2, "output": 3}]}],
+ "accessors": [
+  {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+  {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
+  {"bufferView": 0, "componentType": 5126, "count": 1, "type": "SCALAR", "min": [0], "max": [0]},
+  {"bufferView": 0, "byteOffset": 0, "componentType": 5126, "count": 1, "type": "VEC4"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 72}],
+ "buffers": [{"byteLength": 168, "uri": "data:application/octet-stream;base64,)" +
+           base64(bytes) + R"("}]})";
+}
+
+std::vector<std::string> readNames(const fs::path& file, const io::SceneReadOptions& options, std::string* notes = nullptr) {
+    io::SceneReadResult scene;
+    std::string error;
+    EXPECT_TRUE(io::readGltfScene(file.string(), options, scene, error)) << error;
+    std::vector<std::string> names;
+    for (const auto& o : scene.objects) names.push_back(o.name);
+    if (notes)
+        for (const auto& d : scene.diagnostics) *notes += d.message + "\n";
+    return names;
+}
+
+}  // namespace
+
+TEST(RealArtChoosing, UnnamedNodesGetStableNamesAndAreExcludableByPath) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "scene.gltf", assemblyGltf());
+    io::SceneReadOptions options;
+    EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Terrain@0", "Box@0/0", "Tower"}));
+    options.excludeRegex = "^@0/0$";
+    EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Terrain@0", "Tower"}));
+}
+
+TEST(RealArtChoosing, RootTerrainDroppedWhileChildrenStay) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "scene.gltf", assemblyGltf());
+    io::SceneReadOptions options;
+    options.excludeRegex = "mesh:Terrain";
+    EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Box@0/0", "Tower"}));
+    options.excludeRegex = "^@0/mesh$";
+    EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Box@0/0", "Tower"}));
+    options.excludeRegex = "^Terrain@0$";  // the node itself: its subtree goes too
+    EXPECT_TRUE(readNames(dir / "scene.gltf", options).empty());
+}
+
+TEST(RealArtChoosing, AnimatedNodesLeftOutAndListed) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "scene.gltf", assemblyGltf());
+    io::SceneReadOptions options;
+    std::string notes;
+    const auto names = readNames(dir / "scene.gltf", options, &notes);
+    EXPECT_EQ(std::count(names.begin(), names.end(), "Windmill"), 0);
+    EXPECT_NE(notes.find("animated"), std::string::npos) << notes;
+    EXPECT_NE(notes.find("Windmill"), std::string::npos) << notes;
+    options.includeAnimated = true;
+    const auto all = readNames(dir / "scene.gltf", options);
+    EXPECT_EQ(std::count(all.begin(), all.end(), "Windmill"), 1);
+}
+
+TEST(RealArtChoosing, ObjectDepthMakesAssemblies) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "scene.gltf", assemblyGltf());
+    io::SceneReadOptions options;
+    options.objectDepth = 0;  // each scene root with its subtree is one object
+    EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Terrain@0"}));
+    options.objectDepth = 1;
+    EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Terrain@0", "Box@0/0", "Tower"}));
+}
