@@ -351,7 +351,8 @@ int runBake(BakeOptions o) {
     if (o.tiles && !writeTilesTmp(nodes, scene.objects, outDir, tiles, error)) return fail(error);
     if (!statsPath.empty()) {
         if (statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
-        if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, outputs[3].first.string(), error))
+        if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, outputs[3].first.string(), error,
+                               &nodes))
             return fail(error);
     }
     for (const auto& [tmp, final] : outputs)

@@ -109,9 +109,11 @@ struct TileMesh {
 bool writeTileGlb(const TileMesh& tile, const std::string& path, std::string& error);
 
 /// Writes the stats JSON (see README "Stats file"). Timings are written last, in their
-/// own object, so determinism checks can drop them.
+/// own object, so determinism checks can drop them. With `nodes`, each level also gets its
+/// proxies' figures (nodes drawn at that level: budget and certified error, max and median,
+/// triangles) and "object_lods" the same for the per-object LOD nodes.
 bool writeStatsJson(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                     const std::vector<Diagnostic>& readDiagnostics, const std::string& path,
-                    std::string& error);
+                    std::string& error, const HierarchyNodes* nodes = nullptr);
 
 }  // namespace aggrelod::io

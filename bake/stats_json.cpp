@@ -166,8 +166,40 @@ void writeDiagnostic(JsonWriter& w, const Diagnostic& d) {
     w.endInlineObject();
 }
 
+/// Largest and median of `values` (0, 0 when empty).
+std::pair<double, double> maxAndMedian(std::vector<double> values) {
+    if (values.empty()) return {0, 0};
+    std::sort(values.begin(), values.end());
+    return {values.back(), values[values.size() / 2]};
+}
+
+/// The proxies of the nodes a cut of `nodes` would draw at one level (or the per-object LOD
+/// nodes): their budgets, certified errors and triangles.
+void writeProxyFigures(JsonWriter& w, const HierarchyNodes& nodes, int level) {
+    std::vector<double> budgets, errors;
+    size_t triangles = 0, count = 0;
+    for (const HierarchyNode& n : nodes.nodes) {
+        if (n.leaf) continue;
+        if (level >= 0 ? !(n.objectLod == 0 && n.firstLevel <= level && level <= n.lastLevel) : n.objectLod == 0) continue;
+        ++count;
+        budgets.push_back(n.budget);
+        errors.push_back(n.error.bound());
+        triangles += n.indices.size() / 3;
+    }
+    const auto [budgetMax, budgetMedian] = maxAndMedian(budgets);
+    const auto [errorMax, errorMedian] = maxAndMedian(errors);
+    w.beginInlineObject();
+    w.fieldInt("nodes", count);
+    w.field("budget_max", budgetMax);
+    w.field("budget_median", budgetMedian);
+    w.field("error_max", errorMax);
+    w.field("error_median", errorMedian);
+    w.fieldInt("triangles", triangles);
+    w.endInlineObject();
+}
+
 std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& objects,
-                          const std::vector<Diagnostic>& readDiagnostics) {
+                          const std::vector<Diagnostic>& readDiagnostics, const HierarchyNodes* nodes) {
     std::string text;
     JsonWriter w(text);
     w.beginObject();
@@ -199,9 +231,17 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
         w.field("area", l.measures.area);
         w.field("sphericity", l.measures.sphericity);
         w.fieldSigned("components", components);
+        if (nodes) {
+            w.key("proxies");
+            writeProxyFigures(w, *nodes, int(k));
+        }
         w.endInlineObject();
     }
     w.endArray();
+    if (nodes) {  // the per-object LOD nodes below the levels
+        w.key("object_lods");
+        writeProxyFigures(w, *nodes, -1);
+    }
 
     // Solidified models (DESIGN 2.0): distances sampled, not certified.
     w.key("solids");
@@ -281,9 +321,9 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
 
 bool writeStatsJson(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                     const std::vector<Diagnostic>& readDiagnostics, const std::string& path,
-                    std::string& error) {
+                    std::string& error, const HierarchyNodes* nodes) {
     try {
-        const std::string text = statsJsonText(hierarchy, objects, readDiagnostics);
+        const std::string text = statsJsonText(hierarchy, objects, readDiagnostics, nodes);
         std::ofstream out(path, std::ios::binary | std::ios::trunc);
         if (!out) {
             error = path + ": cannot create: " + std::strerror(errno);
