@@ -133,12 +133,49 @@ ProxyError measureEnclosure(const std::vector<double>& exact, const std::vector<
                                              settings.maxRefinementsPerDirection, options);
 }
 
+/// Enclosing simplifications of one closed mesh at ascending push-out targets (world units):
+/// one pass of the simplifier for the whole series; a snapshot that intersects itself is
+/// made again on demand with the corners of the crossing faces pinned.
+class EnclosureSeries {
+public:
+    EnclosureSeries(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
+                    std::vector<double> targets)
+        : positions_(positions), indices_(indices), targets_(std::move(targets)), checked_(targets_.size(), 0) {
+        detail::simplifyConservativeSeries(positions, indices, targets_, 0, snapshots_);
+    }
+    size_t size() const { return snapshots_.size(); }
+    /// Triangles of snapshot i before any repair (a repair keeps more).
+    size_t triangleCount(size_t i) const { return snapshots_[i].indices.size() / 3; }
+    double target(size_t i) const { return targets_[i]; }
+    /// Snapshot i without self-intersections, or null when pinning could not remove them.
+    const detail::ConservativeSnapshot* clean(size_t i) {
+        if (!checked_[i]) {
+            checked_[i] = 1;
+            if (detail::meshSelfIntersects(snapshots_[i].positions, snapshots_[i].indices)) {
+                detail::ConservativeSnapshot redone;
+                checked_[i] = detail::simplifyConservativeClean(positions_, indices_, targets_[i], pinned_,
+                                                                kCleanRounds, redone) ? 1 : 2;
+                snapshots_[i] = std::move(redone);
+            }
+        }
+        return checked_[i] == 1 ? &snapshots_[i] : nullptr;
+    }
+
+private:
+    /// Rounds of pinning crossing faces before a snapshot is given up for a finer one.
+    static constexpr int kCleanRounds = 6;
+    const std::vector<double>& positions_;
+    const std::vector<uint32_t>& indices_;
+    std::vector<double> targets_;
+    std::vector<detail::ConservativeSnapshot> snapshots_;
+    std::vector<char> checked_;  ///< 0 unchecked, 1 clean, 2 intersecting
+    std::vector<char> pinned_;
+};
+
 /// Push-out allowances tried for a proxy, as fractions of the room its budget leaves above
 /// the exact aggregate's own error, coarsest first (the simplification's estimate is a
 /// vertex-to-plane distance, not the certified one, so the largest can still miss).
 constexpr double kRoomFractions[] = {1.0 / 4, 1.0 / 2, 1.0, 2.0, 4.0};
-/// Rounds of pinning crossing faces before a simplification is given up for a finer one.
-constexpr int kCleanRounds = 6;
 
 /// The proxy of an aggregate node (DESIGN section 2.6). Its budget is the exact aggregate's
 /// own certified error (the fill between the originals: nothing that encloses the aggregate
@@ -154,12 +191,13 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
     const double room = settings.simplifyFraction * n.delta;
     n.budget = n.error.bound() + room;
     if (!(room > 0)) return;
-    std::vector<char> pinned;
-    for (size_t i = std::size(kRoomFractions); i-- > 0;) {
-        detail::ConservativeSnapshot s;
-        const double target = kRoomFractions[i] * room;
-        const bool clean = detail::simplifyConservativeClean(agg.positions, agg.indices, target, pinned, kCleanRounds, s);
+    std::vector<double> targets;
+    for (double f : kRoomFractions) targets.push_back(f * room);
+    EnclosureSeries series(agg.positions, agg.indices, targets);
+    for (size_t i = series.size(); i-- > 0;) {
+        const detail::ConservativeSnapshot* clean = series.clean(i);
         if (!clean) continue;
+        const detail::ConservativeSnapshot& s = *clean;
         if (s.indices.size() >= agg.indices.size()) break;  // no coarser than the exact one
         std::vector<float> positions = toFloats(s.positions);
         const ProxyError e = measureEnclosure(s.positions, positions, s.indices, originals, tolerance, settings, n.budget);
@@ -172,43 +210,55 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
     }
 }
 
-/// Per-object LOD below an object's first aggregate (DESIGN section 2.6): conservative
-/// simplifications of the object at errors halving down from its parent's error, each kept
-/// when it is a valid enclosure, fits its budget and saves a quarter of the triangles of
-/// the finer one. Returned finest first; empty for an object that is not a closed solid
-/// (only a closed mesh can be simplified into an enclosure of it).
-std::vector<HierarchyNode> objectLodChain(const InputObject& object, const detail::PreparedOriginal& original,
-                                          double parentError, const ProxySettings& settings) {
+/// Error targets of per-object LOD chains: a geometric series sqrt(2) apart, from this
+/// fraction of the object's box diagonal up.
+constexpr double kChainFinestFraction = 1.0 / 1024;
+constexpr double kChainRatio = 1.4142135623730951;
+
+/// Per-object LOD (DESIGN section 2.6): conservative simplifications of one object at error
+/// targets sqrt(2) apart, from a thousandth of its diagonal up to below `ceiling` (the error
+/// of the first aggregate above it holding other objects; infinity for none, then up to its
+/// diagonal). A level is kept when it does not intersect itself, its certified error fits its
+/// budget (twice its target) and stays below the ceiling, and it has at most 80 % of the
+/// triangles of the finer one kept. Returned finest first; empty for an object that is not a
+/// closed solid (only a closed mesh can be simplified into an enclosure of it).
+std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t objectIndex,
+                                          const detail::PreparedOriginal& original, double ceiling,
+                                          const ProxySettings& settings) {
     std::vector<HierarchyNode> chain;
-    if (!(parentError > 0) || settings.objectLodCount <= 0) return chain;
+    if (settings.objectLodCount <= 0) return chain;
     detail::PreparedObject prepared;
     std::vector<Diagnostic> ignored;  // the bake reported the object's problems already
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i + 2 < object.positions.size(); i += 3) growBox(lo, hi, &object.positions[i]);
     const double diagonal = distance(lo, hi);
+    if (!(diagonal > 0)) return chain;
     detail::prepareObject(object, 1e-14 * diagonal * diagonal, prepared, ignored);
     if (!prepared.validSolid()) return chain;
+    const double top = std::min(ceiling, diagonal);
     std::vector<double> targets;  // ascending
-    for (int j = settings.objectLodCount; j >= 1; --j) targets.push_back(parentError * std::ldexp(1.0, -j));
+    for (double t = kChainFinestFraction * diagonal; t < top; t *= kChainRatio) targets.push_back(t);
+    if (targets.empty()) return chain;
+    EnclosureSeries series(prepared.positions, prepared.triangles, targets);
     size_t finerTriangles = object.indices.size() / 3;
     const std::vector<const detail::PreparedOriginal*> originals{&original};
-    std::vector<char> pinned;
-    for (size_t i = 0; i < targets.size(); ++i) {
-        detail::ConservativeSnapshot s;
-        if (!detail::simplifyConservativeClean(prepared.positions, prepared.triangles, targets[i], pinned, kCleanRounds, s))
-            continue;
+    for (size_t i = 0; i < series.size() && int(chain.size()) < settings.objectLodCount; ++i) {
+        if (5 * (series.triangleCount(i)) > 4 * finerTriangles) continue;  // not worth a node
+        const detail::ConservativeSnapshot* clean = series.clean(i);
+        if (!clean) continue;
+        const detail::ConservativeSnapshot& s = *clean;
         const size_t triangles = s.indices.size() / 3;
-        if (4 * triangles > 3 * finerTriangles) continue;
+        if (5 * triangles > 4 * finerTriangles) continue;
         HierarchyNode n;
         n.objectLod = static_cast<int>(chain.size()) + 1;
-        n.sources = {object.id};
-        n.budget = std::min(2 * targets[i], parentError);
+        n.sources = {objectIndex};
+        n.budget = 2 * targets[i];
         n.positions = toFloats(s.positions);
         n.indices = s.indices;
         n.exactTriangleCount = object.indices.size() / 3;
         n.error = measureEnclosure(s.positions, n.positions, n.indices, originals, settings.toleranceFraction * targets[i],
-                                   settings, n.budget);
-        if (!(n.error.bound() <= n.budget) || !(n.error.bound() < parentError)) continue;
+                                   settings, std::min(n.budget, ceiling));
+        if (!(n.error.bound() <= n.budget) || !(n.error.bound() < ceiling)) continue;
         finerTriangles = triangles;
         chain.push_back(std::move(n));
     }
@@ -357,69 +407,104 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (levelCount > 0 && groupOf[0][o] != kNoNode) detail::prepareOriginal(objects[o], prepared[o]);
     });
-    detail::parallelFor(nodes.size() - objectCount, settings.threadCount, [&](size_t j) {
-        HierarchyNode& n = nodes[objectCount + j];
-        const Aggregate& agg = aggregateOf(n);
-        std::vector<const detail::PreparedOriginal*> originals;
-        for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
-        n.budget = settings.simplifyFraction * n.delta;
-        makeAggregateProxy(agg, originals, settings, n);
-        std::vector<const InputObject*> sourceObjects;
-        for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
-        detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
-        detail::optimizeVertexCache(n.positions, n.indices, n.faceColors);
-    }, [&](size_t done) {
-        if (settings.progress) settings.progress("proxies", double(done) / double(nodes.size() - objectCount));
-    });
+    // Proxies of the aggregates that hold several objects first: their errors cap the
+    // per-object LOD chains below them.
+    const auto makeProxies = [&](const std::vector<uint32_t>& which, double progressFrom, double progressTo) {
+        detail::parallelFor(which.size(), settings.threadCount, [&](size_t j) {
+            HierarchyNode& n = nodes[which[j]];
+            std::vector<const detail::PreparedOriginal*> originals;
+            for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
+            makeAggregateProxy(aggregateOf(n), originals, settings, n);
+            std::vector<const InputObject*> sourceObjects;
+            for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
+            detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
+            detail::optimizeVertexCache(n.positions, n.indices, n.faceColors);
+        }, [&](size_t done) {
+            if (settings.progress)
+                settings.progress("proxies", progressFrom + (progressTo - progressFrom) * double(done) / double(which.size()));
+        });
+    };
+    std::vector<uint32_t> groupNodes, singleNodes;
+    for (uint32_t i = static_cast<uint32_t>(objectCount); i < nodes.size(); ++i)
+        (nodes[i].sources.size() > 1 ? groupNodes : singleNodes).push_back(i);
+    makeProxies(groupNodes, 0.0, 0.6);
 
-    // Per-object LOD chains between each leaf and its first aggregate, then renumbered:
-    // leaves, chains (object by object, finest first), aggregates.
+    // Per-object LOD chains. An object's chain stands in for the aggregates of that object
+    // alone (the object with its concavities filled), up to its first aggregate with other
+    // objects; those single-object aggregates stay only where the object has no chain.
     std::vector<std::vector<HierarchyNode>> chains(objectCount);
+    std::vector<uint32_t> firstGroup(objectCount, kNoNode);  // first ancestor with several objects
+    for (size_t o = 0; o < objectCount; ++o) {
+        uint32_t up = nodes[o].parent;
+        while (up != kNoNode && nodes[up].sources.size() == 1) up = nodes[up].parent;
+        firstGroup[o] = up;
+    }
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
-        const uint32_t parent = nodes[o].parent;
-        if (parent == kNoNode || nodes[o].positions.empty()) return;
-        InputObject object = objects[o];
-        object.id = static_cast<uint32_t>(o);  // sources are object indices
-        chains[o] = objectLodChain(object, prepared[o], nodes[parent].error.bound(), settings);
+        if (nodes[o].parent == kNoNode || nodes[o].positions.empty()) return;
+        const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
+        chains[o] = objectLodChain(objects[o], static_cast<uint32_t>(o), prepared[o], ceiling, settings);
         std::vector<const InputObject*> source{&objects[o]};
         for (HierarchyNode& c : chains[o]) {
             detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);
             detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
         }
+    }, [&](size_t done) {
+        if (settings.progress) settings.progress("proxies", 0.6 + 0.3 * double(done) / double(objectCount));
     });
-    size_t chainCount = 0;
-    for (const auto& c : chains) chainCount += c.size();
-    if (chainCount > 0) {
-        auto shifted = [&](uint32_t i) { return i == kNoNode || i < objectCount ? i : uint32_t(i + chainCount); };
-        std::vector<HierarchyNode> renumbered;
-        renumbered.reserve(nodes.size() + chainCount);
-        for (size_t o = 0; o < objectCount; ++o) renumbered.push_back(std::move(nodes[o]));
-        for (size_t o = 0; o < objectCount; ++o)
-            for (HierarchyNode& c : chains[o]) renumbered.push_back(std::move(c));
-        for (size_t i = objectCount; i < nodes.size(); ++i) renumbered.push_back(std::move(nodes[i]));
-        for (HierarchyNode& n : renumbered) {
-            n.parent = shifted(n.parent);
-            for (uint32_t& c : n.children) c = shifted(c);
-        }
-        for (uint32_t& r : out.roots) r = shifted(r);
-        for (auto& level : out.nodeOfAggregate)
-            for (uint32_t& i : level) i = shifted(i);
+    std::vector<char> dropped(nodes.size(), 0);
+    std::vector<uint32_t> keptSingles;
+    for (uint32_t i : singleNodes) {
+        if (!chains[nodes[i].sources.front()].empty()) dropped[i] = 1;
+        else keptSingles.push_back(i);
+    }
+    makeProxies(keptSingles, 0.9, 1.0);
+
+    // The tree again: leaves, chains (object by object, finest first), the aggregates kept.
+    {
+        std::vector<uint32_t> newIndex(nodes.size(), kNoNode);
         uint32_t next = static_cast<uint32_t>(objectCount);
+        std::vector<uint32_t> chainTop(objectCount);
         for (size_t o = 0; o < objectCount; ++o) {
-            uint32_t below = static_cast<uint32_t>(o);
-            const uint32_t top = renumbered[o].parent;
-            for (size_t j = 0; j < chains[o].size(); ++j, ++next) {
-                renumbered[below].parent = next;
-                renumbered[next].children = {below};
-                below = next;
-            }
-            if (below != o) {
-                renumbered[below].parent = top;
-                for (uint32_t& c : renumbered[top].children)
-                    if (c == o) c = below;
-                std::sort(renumbered[top].children.begin(), renumbered[top].children.end());
-            }
+            newIndex[o] = static_cast<uint32_t>(o);
+            next += static_cast<uint32_t>(chains[o].size());
+            chainTop[o] = chains[o].empty() ? static_cast<uint32_t>(o) : next - 1;
         }
+        for (size_t i = objectCount; i < nodes.size(); ++i)
+            newIndex[i] = dropped[i] ? chainTop[nodes[i].sources.front()] : next++;
+        // Nearest kept ancestor of old node i (kNoNode at the top).
+        const auto keptParent = [&](uint32_t i) {
+            uint32_t up = nodes[i].parent;
+            while (up != kNoNode && dropped[up]) up = nodes[up].parent;
+            return up == kNoNode ? kNoNode : newIndex[up];
+        };
+        std::vector<HierarchyNode> renumbered(next);
+        std::vector<uint32_t> parentOf(next, kNoNode);
+        for (size_t o = 0; o < objectCount; ++o) {
+            const uint32_t above = keptParent(static_cast<uint32_t>(o));
+            uint32_t below = static_cast<uint32_t>(o);
+            for (size_t j = 0; j < chains[o].size(); ++j) {
+                const uint32_t at = chainTop[o] - uint32_t(chains[o].size() - 1 - j);
+                parentOf[below] = at;
+                renumbered[at] = std::move(chains[o][j]);
+                below = at;
+            }
+            parentOf[below] = above;
+        }
+        for (size_t i = objectCount; i < nodes.size(); ++i)
+            if (!dropped[i]) parentOf[newIndex[i]] = keptParent(static_cast<uint32_t>(i));
+        for (size_t i = 0; i < nodes.size(); ++i)
+            if (i < objectCount || !dropped[i]) renumbered[newIndex[i]] = std::move(nodes[i]);
+        out.roots.clear();
+        for (uint32_t i = 0; i < next; ++i) {
+            renumbered[i].children.clear();
+            renumbered[i].parent = parentOf[i];
+        }
+        for (uint32_t i = 0; i < next; ++i) {  // ascending, so children lists come out sorted
+            if (parentOf[i] == kNoNode) out.roots.push_back(i);
+            else renumbered[parentOf[i]].children.push_back(i);
+        }
+        for (auto& level : out.nodeOfAggregate)
+            for (uint32_t& i : level) i = newIndex[i];
         nodes = std::move(renumbered);
     }
 

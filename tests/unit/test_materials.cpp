@@ -381,8 +381,10 @@ void checkForestColours(const std::vector<InputObject>& generated, const fs::pat
             }
         for (int c = 0; c < 3; ++c) mean[c] /= float(covered);
         size_t groupsWithBoth = 0;
-        for (const HierarchyNode& n : nodes.nodes)
-            if (!n.leaf && n.firstLevel <= k && k <= n.lastLevel) {
+        // The nodes standing for the level's aggregates (an object alone: its LOD chain's top).
+        std::set<uint32_t> atLevel(nodes.nodeOfAggregate[size_t(k)].begin(), nodes.nodeOfAggregate[size_t(k)].end());
+        for (uint32_t i : atLevel)
+            if (const HierarchyNode& n = nodes.nodes[i]; !n.leaf) {
                 proxies.add(n.positions, n.indices, n.faceColors);
                 std::vector<float> one;
                 for (size_t t = 0; t < n.indices.size() / 3; ++t) one.insert(one.end(), mean, mean + 4);

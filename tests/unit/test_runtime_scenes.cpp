@@ -156,7 +156,8 @@ std::unique_ptr<BakedScene> bakeScene(const std::string& label, const fs::path& 
         s->problem = error;
         return s;
     }
-    for (InputObject& o : levels.objects) {  // names "level<k>_group<g>"
+    for (InputObject& o : levels.objects) {  // names "level<k>_group<g>"; support surfaces are not levels
+        if (o.name.rfind("level", 0) != 0) continue;
         const size_t k = std::stoul(o.name.substr(5, o.name.find('_') - 5));
         if (s->levels.size() <= k) s->levels.resize(k + 1);
         s->levels[k].push_back(std::move(o));
@@ -229,6 +230,12 @@ BakedScene& scene(SceneId id) {
 std::pair<uint32_t, uint32_t> levelRange(const runtime::RuntimeFile& f, uint32_t node, uint32_t levelCount) {
     const runtime::NodeRecord& n = f.node(node);
     const uint32_t last = n.parent == runtime::kNoIndex ? levelCount - 1 : f.node(n.parent).level - 1;
+    if (n.level == runtime::kObjectLodLevel) {
+        // The top of an object's LOD chain stands for the object at the levels where it is
+        // alone (its single-object aggregates are not nodes); the rest of the chain at none.
+        if (n.parent != runtime::kNoIndex && f.node(n.parent).level == runtime::kObjectLodLevel) return {1, 0};
+        return {0, last};
+    }
     return {n.level, last};
 }
 
@@ -312,8 +319,10 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
             bvhOfNode[i].build(p.data(), p.size() / 3, t.data, t.size / 3);
         }
         proxies.commit();
-        for (size_t o = 0; o < s.originals.size(); ++o)
+        for (size_t o = 0; o < s.originals.size(); ++o) {
+            if (f.node(leafOf[o]).parent == runtime::kNoIndex) continue;  // left out of the levels (a support surface)
             ASSERT_NE(nodeAtLevel[o], runtime::kNoIndex) << s.label << ": object " << o << " has no node at level " << level;
+        }
 
         size_t hits = 0, exactViolations = 0, proxyViolations = 0;
         double maxExcess = 0, maxDepth = 0;
@@ -329,7 +338,8 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
             const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             for (double& x : d) x /= len;
             const RayHit ho = originals.intersect(o, d);
-            if (!ho.hit()) continue;
+            // Support surfaces (ground) are no level's and have no proxy: rays onto them say nothing.
+            if (!ho.hit() || nodeAtLevel[ho.mesh] == runtime::kNoIndex) continue;
             ++hits;
             const RayHit he = exact.intersect(o, d);
             double excess = he.hit() ? double(he.t) - double(ho.t) : INFINITY;
@@ -681,7 +691,7 @@ TEST(RuntimeScenes, LevelsGlbExtrasNameTheRuntimeNodes) {
     uint32_t jsonLength = 0;
     std::memcpy(&jsonLength, glb.data() + 12, 4);
     const std::string json = glb.substr(20, jsonLength);
-    const std::regex entry("\"geometric_error\":([^,]+),\"group\":[0-9]+,\"last_level\":([0-9]+),\"level\":([0-9]+),"
+    const std::regex entry("\"geometric_error\":([^,]+),\"group\":[0-9]+,\"last_level\":(-?[0-9]+),\"level\":([0-9]+),"
                            "\"node\":([0-9]+),\"parent\":(-?[0-9]+)");
     size_t aggregates = 0, matched = 0;
     for (const auto& level : s.levels) aggregates += level.size();
@@ -692,8 +702,10 @@ TEST(RuntimeScenes, LevelsGlbExtrasNameTheRuntimeNodes) {
         const runtime::NodeRecord& n = s.file.node(node);
         const uint32_t level = uint32_t(std::stoul((*it)[3]));
         EXPECT_EQ(float(std::stod((*it)[1])), n.geometricError) << "node " << node;
-        EXPECT_LE(n.level, level);
-        EXPECT_GE(std::stoul((*it)[2]), level);
+        if (n.level != runtime::kObjectLodLevel) {  // else: an object alone, stood in for by its LOD chain
+            EXPECT_LE(n.level, level);
+            EXPECT_GE(std::stol((*it)[2]), long(level));
+        }
         const long parent = std::stol((*it)[5]);
         EXPECT_EQ(parent < 0 ? runtime::kNoIndex : uint32_t(parent), n.parent) << "node " << node;
     }

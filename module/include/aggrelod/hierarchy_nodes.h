@@ -31,9 +31,11 @@ struct ProxySettings {
     /// the aggregate can undercut) plus this. The proxy is the coarsest enclosing
     /// simplification whose certified error fits the budget. 0 keeps the exact aggregate.
     double simplifyFraction = 0.25;
-    /// Most simplified versions of one object below its first aggregate (per-object LOD);
-    /// their errors halve down from that aggregate's error. 0 = none.
-    int objectLodCount = 8;
+    /// Most simplified versions of one object (per-object LOD) between its leaf and its first
+    /// aggregate with other objects: enclosing simplifications at error targets sqrt(2)
+    /// apart from a thousandth of the object's diagonal up to that aggregate's error. They
+    /// stand in for the aggregates of the object alone. 0 = none (those aggregates stay).
+    int objectLodCount = 16;
     /// How far (world units, as a fraction of delta_k) the certified upper bound of the
     /// error may exceed the largest distance actually found; the refinement stops there ...
     double toleranceFraction = 0.02;
