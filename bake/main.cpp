@@ -158,8 +158,8 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
     cmd->add_option("--threads", o.threads, "Threads for the parallel stages (default 0: all cores); output is identical for any count")
         ->check(CLI::Range(0, 1024));
     cmd->add_option("--proxy-error", o.proxyError,
-                    "Simplification target of each level's proxies, as a fraction of the level's delta "
-                    "(default 0.25; 0 keeps the exact aggregates)")
+                    "Room each level's proxies get above their exact aggregate's certified error, as a "
+                    "fraction of the level's delta (default 0.25; 0 keeps the exact aggregates)")
         ->check(CLI::Range(0.0, 10.0));
     cmd->add_flag("--tiles", o.tiles,
                   "Also write OUTDIR/tiles/: a 3D Tiles 1.1 tileset (tileset.json, one GLB per hierarchy node) "

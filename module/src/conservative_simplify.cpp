@@ -83,6 +83,20 @@ public:
         double lo[3], hi[3];
     };
 
+    /// Replaces the tree by a balanced one over `boxes` (face f has boxes[f]), split at the
+    /// median centroid along the longest axis; leafOut[f] = the leaf of face f. Incremental
+    /// inserts alone would let the tree degenerate on a large mesh.
+    void build(const std::vector<Box>& boxes, std::vector<uint32_t>& leafOut) {
+        nodes_.clear();
+        free_.clear();
+        root_ = kNone;
+        leafOut.assign(boxes.size(), kNone);
+        if (boxes.empty()) return;
+        std::vector<uint32_t> faces(boxes.size());
+        for (uint32_t f = 0; f < faces.size(); ++f) faces[f] = f;
+        root_ = buildRange(boxes, faces, 0, faces.size(), kNone, leafOut);
+    }
+
     uint32_t insert(uint32_t face, const Box& box) {
         const uint32_t leaf = allocate();
         nodes_[leaf].box = box;
@@ -163,6 +177,33 @@ private:
         Box box;
         uint32_t parent = kNone, child[2] = {kNone, kNone}, face = kNone;
     };
+    uint32_t buildRange(const std::vector<Box>& boxes, std::vector<uint32_t>& faces, size_t begin, size_t end,
+                        uint32_t parent, std::vector<uint32_t>& leafOut) {
+        const uint32_t at = allocate();
+        nodes_[at].parent = parent;
+        if (end - begin == 1) {
+            nodes_[at].face = faces[begin];
+            nodes_[at].box = boxes[faces[begin]];
+            leafOut[faces[begin]] = at;
+            return at;
+        }
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        auto centre = [&](uint32_t f, int k) { return boxes[f].lo[k] + boxes[f].hi[k]; };
+        for (size_t i = begin; i < end; ++i)
+            for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], centre(faces[i], k)), hi[k] = std::max(hi[k], centre(faces[i], k));
+        int axis = 0;
+        for (int k = 1; k < 3; ++k)
+            if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+        const size_t mid = begin + (end - begin) / 2;
+        std::nth_element(faces.begin() + long(begin), faces.begin() + long(mid), faces.begin() + long(end),
+                         [&](uint32_t a, uint32_t b) { return centre(a, axis) < centre(b, axis) || (centre(a, axis) == centre(b, axis) && a < b); });
+        const uint32_t left = buildRange(boxes, faces, begin, mid, at, leafOut);
+        const uint32_t right = buildRange(boxes, faces, mid, end, at, leafOut);
+        nodes_[at].child[0] = left;
+        nodes_[at].child[1] = right;
+        nodes_[at].box = merge(nodes_[left].box, nodes_[right].box);
+        return at;
+    }
     static double perimeter(const Box& b) { return (b.hi[0] - b.lo[0]) + (b.hi[1] - b.lo[1]) + (b.hi[2] - b.lo[2]); }
     static bool overlap(const Box& a, const Box& b) {
         for (int k = 0; k < 3; ++k)
@@ -240,8 +281,9 @@ public:
             for (size_t v = 0; v < std::min(n, pinned->size()); ++v) locked_[v] |= (*pinned)[v];
         liveFaces_ = faces_.size();
         mark_.assign(n, 0);
-        faceLeaf_.assign(faces_.size(), FaceTree::kNone);
-        for (uint32_t f = 0; f < faces_.size(); ++f) faceLeaf_[f] = tree_.insert(f, faceBox(f));
+        std::vector<FaceTree::Box> boxes(faces_.size());
+        for (uint32_t f = 0; f < faces_.size(); ++f) boxes[f] = faceBox(f);
+        tree_.build(boxes, faceLeaf_);
     }
 
     /// Collapses while the cheapest collapse costs <= maxError and more than minTriangles
