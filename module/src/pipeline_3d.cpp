@@ -103,6 +103,7 @@ struct Model {
     bool standIn() const { return kind != Kind::Original; }
     std::string reason;               ///< why it is solidified
     double alpha = 0, offset = 0;     ///< wrap parameters
+    double seconds = 0;               ///< time its solid took (one thread)
     std::vector<double> positions;    ///< the surface given to the triangulator
     std::vector<uint32_t> triangles;
     TriangleBvh bvh;
@@ -381,6 +382,7 @@ void Baker::measureSolids() {
         r.reason = m.reason;
         r.alpha = m.alpha;
         r.offset = m.offset;
+        r.seconds = m.seconds;
         std::vector<double> pts;
         std::vector<uint32_t> tris;
         for (uint32_t o : m.objects) {
@@ -485,6 +487,12 @@ void Baker::solidifyModels(const std::vector<size_t>& which, const std::vector<s
     std::vector<char> fellBack(which.size(), 0);
     detail::parallelFor(which.size(), settings_.threadCount, [&](size_t k) {
         Model& m = models_[which[k]];
+        const auto started = std::chrono::steady_clock::now();
+        struct Clock {  // the solid's own time, however this lambda ends
+            Model& m;
+            std::chrono::steady_clock::time_point started;
+            ~Clock() { m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(); }
+        } clock{m, started};
         m.reason = why[k];
         m.positions.clear();
         m.triangles.clear();
@@ -705,6 +713,8 @@ bool Baker::triangulate() {
         // Model order: by smallest object index (deterministic).
         std::sort(models_.begin(), models_.end(), [](const Model& a, const Model& b) { return a.objects[0] < b.objects[0]; });
         detail::PlcInput plc;
+        plc.cpuSeconds = settings_.triangulationSeconds;
+        plc.memoryBytes = settings_.triangulationMemory;
         std::vector<int> pointModel;
         for (size_t m = 0; m < models_.size(); ++m) {
             const int base = static_cast<int>(plc.points.size() / 3);

@@ -85,6 +85,11 @@ struct Settings3D {
     /// town's own ground); a round that would leave fewer than 2 objects finds nothing.
     double supportSpanFraction = 0.5;
     double supportShareFraction = 0.3;
+    /// Budget of each tetrahedralization (it runs in a child process): CPU seconds and bytes
+    /// of memory; 0 = automatic (120 s + 0.5 ms per input triangle; half the physical memory).
+    /// Over budget, the bake stops with an error saying so instead of waiting.
+    double triangulationSeconds = 0;
+    uint64_t triangulationMemory = 0;
     ProgressCallback progress;        ///< optional; called from the calling thread only
     int threadCount = 0;              ///< threads for sculpting levels; 0 = hardware concurrency.
                                       ///< Results are identical for every thread count.
