@@ -15,6 +15,7 @@
 #include <new>
 #include <system_error>
 #include <thread>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -169,6 +170,7 @@ TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
     // A larger pipe buffer: the result (tens of MB) then crosses in fewer context switches.
     ::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);
     std::fflush(nullptr);
+    const pid_t parent = ::getpid();
     pid_t pid = ::fork();
     if (pid < 0) {
         ::close(fds[0]);
@@ -176,6 +178,8 @@ TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
         return {TetgenStatus::InternalError, std::string("fork: ") + std::strerror(errno)};
     }
     if (pid == 0) {
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // a parent that dies takes TetGen with it
+        if (::getppid() != parent) ::_exit(0);  // the parent died before the line above
         ::close(fds[0]);
         int devnull = ::open("/dev/null", O_WRONLY);
         if (devnull >= 0) ::dup2(devnull, STDOUT_FILENO);  // TetGen prints to stdout

@@ -2,7 +2,7 @@
 // as `aggrelod bake SCENE` with no options does it (default read options and settings, then
 // the proxies), the seconds of the "solidify" stage against the whole bake, the peak resident
 // memory during solidification (sampled at every progress report of that stage) against the
-// bake's peak (getrusage), and per scene the solids' added volume and sampled Hausdorff
+// bake's peak (getrusage; each scene runs in its own process), and per scene the solids' added volume and sampled Hausdorff
 // distance (worst solid, in % of its own bounding-box diagonal). With --solids, one line per
 // solid with its own time. A benchmark: nothing is asserted.
 //
@@ -23,6 +23,7 @@
 #include <vector>
 
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 using namespace aggrelod;
@@ -68,11 +69,21 @@ int main(int argc, char** argv) {
                 "mem solid", "mem bake", "added vol", "hausdorff");
     std::printf("%-34s %7s %6s %8s %6s %9s %9s %7s %10s %10s\n", "", "", "(k)", "s", "s", "%", "MiB", "MiB", "% orig", "% diag");
     for (const std::string& path : scenes) {
+        // Each scene in its own process: its peak memory is its own.
+        std::fflush(stdout);
+        const pid_t child = ::fork();
+        if (child < 0) return 1;
+        if (child > 0) {
+            int status = 0;
+            ::waitpid(child, &status, 0);
+            continue;
+        }
         io::SceneReadResult scene;
         std::string error;
         if (!io::readGltfScene(path, io::SceneReadOptions{}, scene, error)) {
             std::printf("%s: %s\n", path.c_str(), error.c_str());
-            continue;
+            std::fflush(stdout);
+            ::_exit(1);
         }
         size_t triangles = 0;
         for (const InputObject& o : scene.objects) triangles += o.indices.size() / 3;
@@ -104,7 +115,7 @@ int main(int argc, char** argv) {
         }
         std::string name = path.substr(path.find_last_of('/') + 1);
         if (name.size() > 34) name.resize(34);
-        std::printf("%-34s %7zu %6.0f %8.2f %6.1f %9.1f %9.0f %7.0f %10.1f %10.2f%s\n", name.c_str(), h.solids.size(),
+        std::printf("%-34s %7zu %6.1f %8.2f %6.1f %9.1f %9.0f %7.0f %10.1f %10.2f%s\n", name.c_str(), h.solids.size(),
                     triangles / 1000.0, solidify, bake, 100 * solidify / bake, solidPeak, peakMiB(),
                     original > 0 ? 100 * added / original : 0.0, 100 * worst, ok ? "" : "  (bake failed)");
         if (perSolid)
@@ -117,6 +128,7 @@ int main(int argc, char** argv) {
                             100 * std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid) / r.bboxDiagonal);
             }
         std::fflush(stdout);
+        ::_exit(0);
     }
     return 0;
 }

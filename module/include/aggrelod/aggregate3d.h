@@ -73,7 +73,8 @@ struct Settings3D {
     /// smallest of 0.4 % of the model's bounding-box diagonal, a quarter of its gap to the
     /// nearest other model (support surfaces not counted) and a quarter of the smallest
     /// positive explicit delta, but at least 0.05 % of that diagonal. Alpha (smallest cavity
-    /// the wrap enters) is 1.5 % of the diagonal, and at least 2 x offset.
+    /// the wrap enters) is 1.5 % of the diagonal (3 % when every object of the model is a
+    /// closed solid that only crosses itself or touches others), and at least 2 x offset.
     double wrapOffset = -1;
     SupportDetection support = SupportDetection::Automatic;
     std::vector<uint32_t> supportObjects; ///< input indices, for SupportDetection::Given
