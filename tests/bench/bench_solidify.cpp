@@ -117,7 +117,8 @@ int main(int argc, char** argv) {
         if (name.size() > 34) name.resize(34);
         std::printf("%-34s %7zu %6.1f %8.2f %6.1f %9.1f %9.0f %7.0f %10.1f %10.2f%s\n", name.c_str(), h.solids.size(),
                     triangles / 1000.0, solidify, bake, 100 * solidify / bake, solidPeak, peakMiB(),
-                    original > 0 ? 100 * added / original : 0.0, 100 * worst, ok ? "" : "  (bake failed)");
+                    // flat originals (labels) have no volume to compare with: NaN
+                    original > 1e-6 * std::fabs(added) ? 100 * added / original : NAN, 100 * worst, ok ? "" : "  (bake failed)");
         if (perSolid)
             for (const SolidReport& r : h.solids) {
                 std::string names;
