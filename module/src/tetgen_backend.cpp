@@ -5,14 +5,18 @@
 #include <tetgen.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <csignal>
 #include <cstring>
 #include <fcntl.h>
+#include <new>
 #include <system_error>
 #include <thread>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -118,15 +122,55 @@ void reapInBackground(pid_t pid) {
     }
 }
 
-// Runs `work` in a child process; it writes its result (starting with an int32 code, 0 = ok)
-// to the fd it gets. `receive` reads the rest of an ok result in this process.
+// Address space the process has mapped now (bytes), 0 when unknown. Read without allocating.
+uint64_t mappedBytes() {
+    int fd = ::open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return 0;
+    char text[64] = {};
+    const ssize_t n = ::read(fd, text, sizeof text - 1);
+    ::close(fd);
+    if (n <= 0) return 0;
+    return std::strtoull(text, nullptr, 10) * static_cast<uint64_t>(::sysconf(_SC_PAGESIZE));
+}
+
+// In the child: CPU time (SIGXCPU at the soft limit, SIGKILL at the hard one) and address
+// space beyond what the fork inherited (allocations past it fail: TetGen reports out of
+// memory). AddressSanitizer maps terabytes of shadow up front, so there only CPU is bounded.
+void limitChild(double cpuSeconds, uint64_t memoryBytes) {
+    const rlim_t seconds = static_cast<rlim_t>(std::ceil(std::max(1.0, cpuSeconds)));
+    const rlimit cpu{seconds, seconds + 5};
+    ::setrlimit(RLIMIT_CPU, &cpu);
+#if !defined(__SANITIZE_ADDRESS__)
+    if (memoryBytes > 0) {
+        const uint64_t limit = mappedBytes() + memoryBytes;
+        const rlimit as{static_cast<rlim_t>(limit), static_cast<rlim_t>(limit)};
+        ::setrlimit(RLIMIT_AS, &as);
+    }
+#else
+    (void)memoryBytes;
+#endif
+}
+
+// Runs `work` in a child process within the PLC's budget; it writes its result (starting with
+// an int32 code, 0 = ok) to the fd it gets. `receive` reads the rest of an ok result in this
+// process.
 template <class Work, class Receive>
-TetgenOutcome runIsolated(Work work, Receive receive) {
+TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
+    double cpuSeconds = plc.cpuSeconds;
+    uint64_t memoryBytes = plc.memoryBytes;
+    if (!(cpuSeconds > 0) || memoryBytes == 0) {
+        double autoSeconds = 0;
+        uint64_t autoBytes = 0;
+        tetgenBudget(plc, autoSeconds, autoBytes);
+        if (!(cpuSeconds > 0)) cpuSeconds = autoSeconds;
+        if (memoryBytes == 0) memoryBytes = autoBytes;
+    }
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) return {TetgenStatus::InternalError, std::string("pipe: ") + std::strerror(errno)};
     // A larger pipe buffer: the result (tens of MB) then crosses in fewer context switches.
     ::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);
     std::fflush(nullptr);
+    const pid_t parent = ::getpid();
     pid_t pid = ::fork();
     if (pid < 0) {
         ::close(fds[0]);
@@ -134,11 +178,17 @@ TetgenOutcome runIsolated(Work work, Receive receive) {
         return {TetgenStatus::InternalError, std::string("fork: ") + std::strerror(errno)};
     }
     if (pid == 0) {
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // a parent that dies takes TetGen with it
+        if (::getppid() != parent) ::_exit(0);  // the parent died before the line above
         ::close(fds[0]);
         int devnull = ::open("/dev/null", O_WRONLY);
         if (devnull >= 0) ::dup2(devnull, STDOUT_FILENO);  // TetGen prints to stdout
+        limitChild(cpuSeconds, memoryBytes);
         try {
             work(fds[1]);
+        } catch (const std::bad_alloc&) {
+            int32_t c32 = 1;
+            writeAll(fds[1], &c32, sizeof c32);
         } catch (int c) {
             int32_t c32 = c;
             writeAll(fds[1], &c32, sizeof c32);
@@ -159,17 +209,32 @@ TetgenOutcome runIsolated(Work work, Receive receive) {
         return {};
     }
     int wstatus = 0;
-    while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+    rusage usage{};
+    while (::wait4(pid, &wstatus, 0, &usage) < 0 && errno == EINTR) {
     }
     std::string signal;
     if (WIFSIGNALED(wstatus))
         signal = std::string(" (signal ") + std::to_string(WTERMSIG(wstatus)) + ": " + strsignal(WTERMSIG(wstatus)) + ")";
+    const double used = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+    if (WIFSIGNALED(wstatus) && (WTERMSIG(wstatus) == SIGXCPU || (WTERMSIG(wstatus) == SIGKILL && used >= cpuSeconds)))
+        return {TetgenStatus::OverBudget, "TetGen used up its budget of " + std::to_string(static_cast<long long>(std::ceil(cpuSeconds))) +
+                                              " CPU seconds and was stopped (" + std::to_string(plc.triangles.size() / 3) +
+                                              " input triangles)"};
     if (!gotCode) return {TetgenStatus::Crashed, "TetGen stopped without a result" + signal};
+    if (code == 1)
+        return {TetgenStatus::OutOfMemory, "TetGen ran out of memory (budget " + std::to_string(memoryBytes >> 20) + " MiB)"};
     if (code != 0) return {statusFromCode(code), "TetGen reported error code " + std::to_string(code)};
     return {TetgenStatus::Crashed, "TetGen's result was cut short" + signal};
 }
 
 }  // namespace
+
+void tetgenBudget(const PlcInput& input, double& cpuSeconds, uint64_t& memoryBytes) {
+    cpuSeconds = 120.0 + 5e-4 * double(input.triangles.size() / 3);
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long pageSize = ::sysconf(_SC_PAGESIZE);
+    memoryBytes = pages > 0 && pageSize > 0 ? static_cast<uint64_t>(pages) * static_cast<uint64_t>(pageSize) / 2 : (uint64_t(8) << 30);
+}
 
 const char* tetgenStatusName(TetgenStatus status) {
     switch (status) {
@@ -180,12 +245,14 @@ const char* tetgenStatusName(TetgenStatus status) {
         case TetgenStatus::OutOfMemory: return "out of memory";
         case TetgenStatus::InternalError: return "internal error";
         case TetgenStatus::Crashed: return "triangulator crashed";
+        case TetgenStatus::OverBudget: return "triangulator over its time budget";
     }
     return "unknown";
 }
 
 TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out, const char* extraSwitches) {
     TetgenOutcome outcome = runIsolated(
+        input,
         [&](int fd) {
             // Never freed: the child ends with _exit right after sending the result.
             tetgenio& in = tetgenInputForChild(input);
@@ -223,6 +290,7 @@ TetgenOutcome tetrahedralizePlc(const PlcInput& input, TetMesh& out, const char*
 TetgenOutcome findIntersectingFacets(const PlcInput& input, std::vector<int>& intersectingMarkers) {
     std::vector<int> markers;
     TetgenOutcome outcome = runIsolated(
+        input,
         [&](int fd) {
             tetgenio& in = tetgenInputForChild(input);  // never freed: see tetrahedralizePlc
             tetgenio& result = *new tetgenio;

@@ -16,7 +16,15 @@ struct PlcInput {
     std::vector<double> points;         ///< 3 * pointCount
     std::vector<int> triangles;         ///< 3 * triangleCount, indices into points
     std::vector<int> triangleMarkers;   ///< per triangle: model index + 1 (> 0)
+    /// Budget of the TetGen child: CPU seconds and bytes of address space; 0 = automatic
+    /// (tetgenBudget). A child over budget is stopped and reported, never waited for.
+    double cpuSeconds = 0;
+    uint64_t memoryBytes = 0;
 };
+
+/// The budget a PLC gets when it names none: 120 s + 0.5 ms per input triangle of CPU (about
+/// 20x what TetGen needs on well-spaced input), and half the machine's physical memory.
+void tetgenBudget(const PlcInput& input, double& cpuSeconds, uint64_t& memoryBytes);
 
 /// Tetrahedral mesh of the convex hull of the input.
 struct TetMesh {
@@ -37,7 +45,8 @@ enum class TetgenStatus {
     ToleranceError,    ///< codes 4/5: points or facets too close for TetGen's tolerance
     OutOfMemory,       ///< code 1
     InternalError,     ///< code 2, or anything else TetGen reported
-    Crashed            ///< the child process died (assert, signal)
+    Crashed,           ///< the child process died (assert, signal)
+    OverBudget         ///< the child used up its CPU time budget and was stopped
 };
 
 struct TetgenOutcome {

@@ -42,13 +42,25 @@ void setAsanOptions() {
              ("detect_leaks=0:abort_on_error=0:exitcode=" + std::to_string(kAsanExitCode)).c_str(), 1);
 }
 
-/// Reads OUTDIR/levels.glb back (one object per aggregate node).
+/// Reads the aggregates of OUTDIR/levels.glb back (one object per aggregate node). Support
+/// surfaces are passed through as given (open, like the ground they are) and are not
+/// aggregates: every other mesh node must be one.
 std::vector<InputObject> readLevels(const fs::path& levelsGlb) {
-    io::SceneReadResult scene;
+    std::vector<io::LevelsGlbNode> nodes;
     std::string error;
-    EXPECT_TRUE(io::readGltfScene(levelsGlb.string(), io::SceneReadOptions{}, scene, error))
-        << levelsGlb << ": " << error;
-    return scene.objects;
+    EXPECT_TRUE(io::readLevelsGlb(levelsGlb.string(), nodes, error)) << levelsGlb << ": " << error;
+    io::SceneReadResult scene;
+    EXPECT_TRUE(io::readGltfScene(levelsGlb.string(), io::SceneReadOptions{}, scene, error)) << levelsGlb << ": " << error;
+    size_t support = 0;
+    for (const auto& o : scene.objects) support += o.name.rfind("support_", 0) == 0;
+    EXPECT_EQ(scene.objects.size(), nodes.size() + support) << levelsGlb << ": mesh nodes that are neither aggregates nor support surfaces";
+    std::vector<InputObject> objects(nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        objects[i].name = nodes[i].name;
+        objects[i].positions = nodes[i].positions;
+        objects[i].indices = nodes[i].indices;
+    }
+    return objects;
 }
 
 /// Every aggregate in levels.glb is a closed, consistently and outward-oriented surface.

@@ -3,6 +3,7 @@
 // wraps are closed, contain their originals and stay near them; objects can be chosen in
 // real files (index paths, own meshes, assembly depth, animated nodes).
 #include "scene_io.h"
+#include "tetgen_backend.h"
 #include "test_support.h"
 
 #include <aggrelod/aggregate3d.h>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <map>
 #include <set>
@@ -174,10 +176,12 @@ TEST(RealArt, HullOnlyWhenAsked) {
     EXPECT_NE(readFile(dir / "stats.json").find("\"convex_hull\""), std::string::npos);
 }
 
-TEST(RealArt, OneAndTwoThreadsGiveIdenticalFiles) {
-    const std::string relative = "3d/collision-world/collision-world.glb";
+namespace {
+// Every output of a bake as given, with 1 and with 2 threads: the same bytes (stats up to the
+// timings).
+void expectSameFilesForOneAndTwoThreads(const std::string& relative, const std::string& label) {
     REQUIRE_DATA(relative);
-    const fs::path dir = freshTestDir(currentTestName());
+    const fs::path dir = freshTestDir(label);
     std::string files[2][4];
     for (int t = 0; t < 2; ++t) {
         const fs::path out = dir / ("t" + std::to_string(t + 1));
@@ -191,7 +195,98 @@ TEST(RealArt, OneAndTwoThreadsGiveIdenticalFiles) {
         const std::string stats = readFile(out / "stats.json");
         files[t][3] = stats.substr(0, stats.find("\"timings\""));
     }
-    for (int k = 0; k < 4; ++k) EXPECT_TRUE(files[0][k] == files[1][k]) << "output " << k << " differs";
+    for (int k = 0; k < 4; ++k) {
+        EXPECT_FALSE(files[0][k].empty()) << relative << ": output " << k << " is empty";
+        EXPECT_TRUE(files[0][k] == files[1][k]) << relative << ": output " << k << " differs";
+    }
+}
+}  // namespace
+
+TEST(RealArt, OneAndTwoThreadsGiveIdenticalFiles) {
+    expectSameFilesForOneAndTwoThreads("3d/collision-world/collision-world.glb", currentTestName());
+}
+// Fifteen wraps in parallel (largest first), support surfaces, proxies.
+TEST(RealArt, TruckTownOneAndTwoThreadsGiveIdenticalFiles) {
+    expectSameFilesForOneAndTwoThreads("3d/truck_town/town_model.gltf", currentTestName());
+}
+
+// The spring assembly of 2CylinderEngine lies inside the engine's box: it waits for the
+// engine's wrap, is found inside it and joins it without a wrap of its own.
+TEST(RealArt, TwoCylinderEngineNestedModelJoinsTheOuterWrap) {
+    const std::string relative = "3d/2CylinderEngine/2CylinderEngine.glb";
+    REQUIRE_DATA(relative);
+    const Baked& b = bakedAsGiven(relative);
+    ASSERT_TRUE(b.run.exited && b.run.exitCode == 0) << b.run.describe();
+    EXPECT_NE(b.run.err.find("joins that model, whose wrap stands for both"), std::string::npos) << b.run.err;
+    EXPECT_EQ(b.run.err.find("a solidified stand-in reaches other objects"), std::string::npos) << b.run.err;
+}
+
+// The triangulator never runs away: a child over its CPU or memory budget is stopped and
+// reported as such. MetalRoughSpheresNoTextures (102 finely tessellated spheres close together)
+// keeps TetGen's boundary recovery busy for minutes: a budget far below that must end it.
+namespace {
+detail::PlcInput sphereSceneLowerHalf() {
+    io::SceneReadResult scene;
+    std::string error;
+    EXPECT_TRUE(io::readGltfScene(sharedData("3d/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb").string(), {},
+                                  scene, error))
+        << error;
+    detail::PlcInput plc;
+    for (size_t o = 0; o < scene.objects.size() && o < 48; ++o) {
+        const InputObject& object = scene.objects[o];
+        const int base = static_cast<int>(plc.points.size() / 3);
+        plc.points.insert(plc.points.end(), object.positions.begin(), object.positions.end());
+        for (uint32_t i : object.indices) plc.triangles.push_back(base + static_cast<int>(i));
+        plc.triangleMarkers.insert(plc.triangleMarkers.end(), object.indices.size() / 3, static_cast<int>(o) + 1);
+    }
+    return plc;
+}
+}  // namespace
+
+TEST(RealArtBudget, TriangulatorOverItsTimeBudgetIsStoppedAndReported) {
+    REQUIRE_DATA("3d/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb");
+    detail::PlcInput plc = sphereSceneLowerHalf();
+    ASSERT_GT(plc.triangles.size() / 3, 400000u);
+    plc.cpuSeconds = 2;
+    detail::TetMesh mesh;
+    const auto start = std::chrono::steady_clock::now();
+    const detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, mesh);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(outcome.status, detail::TetgenStatus::OverBudget) << outcome.message;
+    EXPECT_NE(outcome.message.find("budget of 2 CPU seconds"), std::string::npos) << outcome.message;
+    EXPECT_EQ(mesh.tetCount(), 0u);
+    std::printf("stopped after %.1f s (wall)\n", seconds);
+}
+
+#if !defined(__SANITIZE_ADDRESS__)
+TEST(RealArtBudget, TriangulatorOverItsMemoryBudgetIsStoppedAndReported) {
+    REQUIRE_DATA("3d/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb");
+    detail::PlcInput plc = sphereSceneLowerHalf();
+    plc.memoryBytes = uint64_t(64) << 20;
+    detail::TetMesh mesh;
+    const detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, mesh);
+    EXPECT_EQ(outcome.status, detail::TetgenStatus::OutOfMemory) << outcome.message;
+    EXPECT_NE(outcome.message.find("64 MiB"), std::string::npos) << outcome.message;
+}
+#endif
+
+// Through the bake: the error names the budget instead of the bake waiting.
+TEST(RealArtBudget, BakeOverTheTriangulationBudgetFailsWithAClearMessage) {
+    REQUIRE_DATA("3d/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb");
+    io::SceneReadResult scene;
+    std::string error;
+    ASSERT_TRUE(io::readGltfScene(sharedData("3d/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb").string(), {},
+                                  scene, error))
+        << error;
+    Settings3D settings;
+    settings.triangulationSeconds = 2;
+    settings.threadCount = 2;
+    Hierarchy3D h;
+    EXPECT_FALSE(buildHierarchy3D(scene.objects, settings, h));
+    std::string errors;
+    for (const Diagnostic& d : h.diagnostics)
+        if (d.severity == Diagnostic::Severity::Error) errors += d.message + "\n";
+    EXPECT_NE(errors.find("time budget"), std::string::npos) << errors;
 }
 
 // ---------------------------------------------------------------------------------------

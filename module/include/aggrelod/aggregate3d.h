@@ -73,7 +73,8 @@ struct Settings3D {
     /// smallest of 0.4 % of the model's bounding-box diagonal, a quarter of its gap to the
     /// nearest other model (support surfaces not counted) and a quarter of the smallest
     /// positive explicit delta, but at least 0.05 % of that diagonal. Alpha (smallest cavity
-    /// the wrap enters) is 1.5 % of the diagonal, and at least 2 x offset.
+    /// the wrap enters) is 1.5 % of the diagonal (3 % when every object of the model is a
+    /// closed solid that only crosses itself or touches others), and at least 2 x offset.
     double wrapOffset = -1;
     SupportDetection support = SupportDetection::Automatic;
     std::vector<uint32_t> supportObjects; ///< input indices, for SupportDetection::Given
@@ -85,6 +86,11 @@ struct Settings3D {
     /// town's own ground); a round that would leave fewer than 2 objects finds nothing.
     double supportSpanFraction = 0.5;
     double supportShareFraction = 0.3;
+    /// Budget of each tetrahedralization (it runs in a child process): CPU seconds and bytes
+    /// of memory; 0 = automatic (120 s + 0.5 ms per input triangle; half the physical memory).
+    /// Over budget, the bake stops with an error saying so instead of waiting.
+    double triangulationSeconds = 0;
+    uint64_t triangulationMemory = 0;
     ProgressCallback progress;        ///< optional; called from the calling thread only
     int threadCount = 0;              ///< threads for sculpting levels; 0 = hardware concurrency.
                                       ///< Results are identical for every thread count.
