@@ -115,15 +115,29 @@ const pixelsPerUnitAtOne = HEIGHT / (2 * Math.tan((FOV * Math.PI) / 360));
  * it elsewhere and the viewer would not draw it). Null when no leaf qualifies.
  */
 function nearLeaf(root, sceneCenter) {
+  const parentOf = new Map();
+  (function walk(tile) {
+    for (const c of tile.children || []) { parentOf.set(c, tile); walk(c); }
+  })(root);
   let best = null, bestDistance = -1;
-  for (const { leaf, parent } of leavesOf(root)) {
-    if (!parent) continue;
+  for (const { leaf } of leavesOf(root)) {
+    // The node to see drawn: the original, or the finest of its per-object LODs whose parent is
+    // still too coarse on screen at 3, 2 or 1.5 radii (a fine per-object LOD makes the original
+    // itself needless at any distance outside it).
     const bounds = sceneBounds(leaf);
-    const camera = cameraAt(bounds.center, 3 * bounds.radius);
-    const parentError = parent.geometricError * pixelsPerUnitAtOne / Math.max(distanceToBox(parent, camera), 1e-9);
-    if (parentError < 1.5 * ERROR_TARGET) continue;
-    const d = Math.hypot(...bounds.center.map((c, k) => c - sceneCenter[k]));
-    if (d > bestDistance) { best = leaf; bestDistance = d; }
+    for (let node = leaf; parentOf.get(node); node = parentOf.get(node)) {
+      const parent = parentOf.get(node);
+      const radii = [3, 2, 1.5].find((r) => {
+        const camera = cameraAt(bounds.center, r * bounds.radius);
+        return parent.geometricError * pixelsPerUnitAtOne / Math.max(distanceToBox(parent, camera), 1e-9) >= 1.5 * ERROR_TARGET;
+      });
+      if (radii !== undefined) {
+        const d = Math.hypot(...bounds.center.map((c, k) => c - sceneCenter[k]));
+        if (d > bestDistance) { best = { leaf, node, radii }; bestDistance = d; }
+        break;
+      }
+      if (!(node.extras && node.extras.objectLod !== undefined) && node !== leaf) break;  // stop at aggregates
+    }
   }
   return best;
 }
@@ -178,14 +192,15 @@ async function run(o) {
   // leaf (the original object farthest from the centre) from that leaf.
   const scene = sceneBounds(tileset.root);
   const farDistance = 3 * scene.radius;
-  const leafTile = nearLeaf(tileset.root, scene.center);
-  if (!leafTile) {
-    console.log('error: no original object whose parent is coarse enough on screen from 3 of its radii');
+  const nearPick = nearLeaf(tileset.root, scene.center);
+  if (!nearPick) {
+    console.log('error: no original object whose parent is coarse enough on screen from 1.5 of its radii');
     return 1;
   }
-  const leafNode = leafTile.extras ? leafTile.extras.node : undefined;
+  const leafTile = nearPick.leaf;
+  const leafNode = nearPick.node.extras ? nearPick.node.extras.node : undefined;
   const leaf = sceneBounds(leafTile);
-  const nearDistance = 3 * leaf.radius;
+  const nearDistance = nearPick.radii * leaf.radius;
   const views = [
     { name: 'far', camera: cameraAt(scene.center, farDistance), target: scene.center },
     { name: 'near', camera: cameraAt(leaf.center, nearDistance), target: leaf.center },
@@ -254,8 +269,8 @@ async function run(o) {
   const farLeaves = far.filter((t) => t.leaf), nearLeaves = near.filter((t) => t.leaf);
   if (far.length === 0) failures.push('far: no tile drawn');
   if (farLeaves.length > 0) failures.push(`far: ${farLeaves.length} original objects drawn (expected proxies only)`);
-  if (!near.some((t) => t.leaf && t.node === leafNode)) {
-    failures.push(`near: the original object in front of the camera (node ${leafNode}) is not drawn`);
+  if (!near.some((t) => t.node === leafNode)) {
+    failures.push(`near: the object in front of the camera (node ${leafNode}, its original or finest LOD) is not drawn`);
   }
   const farMinError = Math.min(...far.map((t) => t.geometricError));
   const nearMinError = Math.min(...near.map((t) => t.geometricError));
