@@ -45,6 +45,19 @@ using detail::TriangleBvh;
 
 using Clock = std::chrono::steady_clock;
 
+/// The cleaned meshes of `objects` as one triangle soup (positions 3 per vertex, triangles 3
+/// per triangle, each object's indices shifted by the vertices before it).
+void concatenateMeshes(const std::vector<PreparedObject>& prepared, const std::vector<uint32_t>& objects,
+                       std::vector<double>& positions, std::vector<uint32_t>& triangles) {
+    positions.clear();
+    triangles.clear();
+    for (uint32_t o : objects) {
+        const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
+        positions.insert(positions.end(), prepared[o].positions.begin(), prepared[o].positions.end());
+        for (uint32_t i : prepared[o].triangles) triangles.push_back(base + i);
+    }
+}
+
 struct StageTimer {
     Hierarchy3D& out;
     const ProgressCallback& progress;
@@ -388,12 +401,8 @@ void Baker::measureSolids() {
         r.seconds = m.seconds;
         std::vector<double> pts;
         std::vector<uint32_t> tris;
-        for (uint32_t o : m.objects) {
-            const uint32_t base = static_cast<uint32_t>(pts.size() / 3);
-            pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
-            for (uint32_t i : prepared_[o].triangles) tris.push_back(base + i);
-            r.volumeOriginal += std::fabs(prepared_[o].volume);
-        }
+        concatenateMeshes(prepared_, m.objects, pts, tris);
+        for (uint32_t o : m.objects) r.volumeOriginal += std::fabs(prepared_[o].volume);
         double b[6];
         computeBounds(pts, b);
         r.bboxDiagonal = std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
@@ -508,11 +517,7 @@ void Baker::solidifyModels(const std::vector<size_t>& which, const std::vector<s
         m.triangles.clear();
         std::vector<double> pts;
         std::vector<uint32_t> tris;
-        for (uint32_t o : m.objects) {
-            const uint32_t base = static_cast<uint32_t>(pts.size() / 3);
-            pts.insert(pts.end(), prepared_[o].positions.begin(), prepared_[o].positions.end());
-            for (uint32_t i : prepared_[o].triangles) tris.push_back(base + i);
-        }
+        concatenateMeshes(prepared_, m.objects, pts, tris);
         if (settings_.solidify == SolidifyMethod::Wrap) {
             double b[6];
             computeBounds(pts, b);
