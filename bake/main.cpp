@@ -422,8 +422,9 @@ void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int dept
                     cli::formatNumber(n.sphereRadius).c_str());
     } else {
         // A per-object LOD (a simplified version of one object) has no level of its own.
-        const std::string level = n.level == runtime::kObjectLodLevel
-                                      ? std::string("object LOD")
+        const std::string level = n.level == runtime::kObjectLodLevel ? std::string("object LOD")
+                                  : n.level == runtime::kCoarserLevel
+                                      ? "coarser version  delta " + cli::formatNumber(n.delta)
                                       : "level " + std::to_string(n.level) + "  delta " + cli::formatNumber(n.delta);
         std::printf("%snode %u  %s  error %s  triangles %u  box [%s %s %s]..[%s %s %s]  sphere r %s  "
                     "%u objects:",

@@ -222,7 +222,10 @@ struct FileValidator {
             if (r.level == kObjectLodLevel && r.sourceCount != 1)
                 return fail(FileStatus::BadValue, where() + ": per-object LOD node standing for " +
                                                       std::to_string(r.sourceCount) + " objects");
-            if (!leaf && r.level != kObjectLodLevel && r.level >= kMaxAggregateLevel)
+            if (r.level == kCoarserLevel && r.childCount != 1)
+                return fail(FileStatus::BadValue, where() + ": coarser version with " + std::to_string(r.childCount) +
+                                                      " children");
+            if (!leaf && r.level != kObjectLodLevel && r.level != kCoarserLevel && r.level >= kMaxAggregateLevel)
                 return fail(FileStatus::BadValue, where() + ": level " + std::to_string(r.level));
         }
         for (size_t i = 0; i < out.positions_.size; ++i)
