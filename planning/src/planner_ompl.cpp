@@ -232,7 +232,13 @@ PlanResult plan(const PlanningWorld& world, const PlanRequest& request) {
     // Vertex and edge of the roadmap -> level at which they first appeared (for pictures).
     std::map<Point, int> vertexLevel;
     std::map<std::pair<Point, Point>, int> edgeLevel;
+    Clock::duration recordTime{};
     auto record = [&](int level) {
+        struct Add {
+            Clock::duration& total;
+            Clock::time_point t0;
+            ~Add() { total += Clock::now() - t0; }
+        } add{recordTime, Clock::now()};
         ob::PlannerData data(si);
         planner->getPlannerData(data);
         for (unsigned i = 0; i < data.numVertices(); ++i) vertexLevel.emplace(ctx.point(data.getVertex(i).getState()), level);
@@ -265,6 +271,8 @@ PlanResult plan(const PlanningWorld& world, const PlanRequest& request) {
         if (Clock::now() >= deadline) break;
     }
 
+    // Time to the answer, without the bookkeeping for pictures (record).
+    result.seconds = std::chrono::duration<double>(Clock::now() - begin - recordTime).count();
     result.status = solved ? PlanStatus::Solved : PlanStatus::NotFound;
     if (solved) {
         const auto& path = static_cast<const og::PathGeometric&>(*pdef->getSolutionPath());
@@ -307,7 +315,6 @@ PlanResult plan(const PlanningWorld& world, const PlanRequest& request) {
     }
     result.stateChecks = ctx.stateChecks;
     result.motionChecks = ctx.motionChecks;
-    result.seconds = std::chrono::duration<double>(Clock::now() - begin).count();
     return result;
 }
 
