@@ -83,6 +83,7 @@ struct BakeOptions {
     std::string support = "auto";       ///< auto | none | a regex on object names
     int objectDepth = -1;               ///< >= 0: each node at this depth, with its subtree, is one object
     bool includeAnimated = false;
+    bool allowExternalUris = false;
 };
 
 /// The settings that shape the outputs, as canonical text (hashed into scene.aglod so that an
@@ -148,6 +149,8 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "through: auto (default, documented rule), none, or an ECMAScript regex on object names");
     cmd->add_flag("--include-animated", o.includeAnimated,
                   "Bake animated and skinned nodes at their rest pose (default: left out and listed)");
+    cmd->add_flag("--allow-external-uris", o.allowExternalUris,
+                  "Let buffer uris name files outside the input's folder (refused by default)");
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
     cmd->add_flag("--constant-baseline", o.constantBaseline,
                   "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
@@ -247,6 +250,7 @@ int runBake(BakeOptions o) {
     readOptions.objectUnit = o.objectUnit == "subtree" ? io::ObjectUnit::Subtree : io::ObjectUnit::Node;
     readOptions.objectDepth = o.objectDepth;
     readOptions.includeAnimated = o.includeAnimated;
+    readOptions.allowExternalUris = o.allowExternalUris;
     io::SceneReadResult scene;
     std::string error;
     if (!io::readGltfScene(o.scene, readOptions, scene, error)) {
