@@ -1207,6 +1207,7 @@ struct ExternalFiles {
     std::vector<uint64_t> bufferLengths;  ///< JsonSummary::externalBufferLengths
     size_t calls = 0;
     size_t imagesSkipped = 0;
+    std::string refusal;  ///< why a buffer's file was refused: the error, instead of tinygltf's
 };
 
 const char* const kImageNotRead = "external image not read (only geometry is baked)";
@@ -1226,22 +1227,24 @@ bool writeNothing(std::string* err, const std::string&, const std::vector<unsign
 bool readExternalFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
     ExternalFiles& files = *static_cast<ExternalFiles*>(user);
     const size_t call = files.calls++;
-    const auto refuse = [&](const std::string& why) {
-        if (err) *err += why;
-        return false;
-    };
     if (call >= files.bufferLengths.size()) {
         ++files.imagesSkipped;
-        return refuse(kImageNotRead);
+        if (err) *err += kImageNotRead;
+        return false;
     }
+    const auto refuse = [&](const std::string& why) {
+        if (err) *err += why;
+        if (files.refusal.empty()) files.refusal = "external buffer file " + path + ": " + why;
+        return false;
+    };
     std::error_code ec;
     const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
     if (ec) return refuse("cannot resolve: " + ec.message());
     if (!files.allowOutside) {
         const std::string folder = files.folder.string(), file = canonical.string();
         if (file.compare(0, folder.size(), folder) != 0)
-            return refuse("refused: the uri leads outside the input's folder " + folder +
-                          " (to " + file + "); --allow-external-uris allows it");
+            return refuse("refused: the uri leads outside the input's folder (--allow-external-uris allows it): " +
+                          file + " is not under " + folder);
     }
     // The descriptor is checked, not the name, so that what is checked is what is read.
     const int fd = ::open(canonical.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
@@ -1328,6 +1331,10 @@ bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diag
         return false;
     } catch (...) {
         error = "invalid glTF (the glTF parser failed)";
+        return false;
+    }
+    if (!ok && !files.refusal.empty()) {
+        error = files.refusal;
         return false;
     }
     if (!ok) {

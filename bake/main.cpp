@@ -412,12 +412,15 @@ CLI::App* addInspectCommand(CLI::App& app, InspectOptions& o) {
     return cmd;
 }
 
-/// One node and, indented below it, its children (depth first, children in file order).
-void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int depth, const InspectOptions& o) {
+/// One node's line, indented by its depth (capped, so that a very deep tree cannot print
+/// quadratic output; deeper lines say their depth).
+void printInspectLine(const runtime::RuntimeFile& file, uint32_t index, size_t depth, const InspectOptions& o) {
     const runtime::NodeRecord& n = file.node(index);
     const bool leaf = n.level == runtime::kLeafLevel;
     if (leaf && o.noLeaves) return;
-    const std::string indent(size_t(2 * depth), ' ');
+    constexpr size_t kMaxIndent = 32;
+    std::string indent(2 * std::min(depth, kMaxIndent), ' ');
+    if (depth > kMaxIndent) indent += "(depth " + std::to_string(depth) + ") ";
     const auto sources = file.sources(index);
     if (leaf) {
         std::printf("%sobject %u '%.*s'  triangles %u  sphere r %s\n", indent.c_str(), sources.empty() ? 0u : sources[0],
@@ -449,7 +452,19 @@ void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int dept
         }
         std::printf("\n");
     }
-    for (uint32_t c : file.children(index)) printInspectNode(file, c, depth + 1, o);
+}
+
+/// Every node below `root`, depth first, children in file order, with an explicit stack (a
+/// valid file may nest hundreds of thousands of levels deep).
+void printInspectTree(const runtime::RuntimeFile& file, uint32_t root, const InspectOptions& o) {
+    std::vector<std::pair<uint32_t, size_t>> stack = {{root, 0}};
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        printInspectLine(file, index, depth, o);
+        const auto children = file.children(index);
+        for (size_t c = children.size; c-- > 0;) stack.emplace_back(children[c], depth + 1);
+    }
 }
 
 int runInspect(const InspectOptions& o) {
@@ -482,7 +497,7 @@ int runInspect(const InspectOptions& o) {
                 file.nodeCount(), aggregates, static_cast<unsigned long long>(proxyTriangles), objectLods,
                 static_cast<unsigned long long>(objectLodTriangles), leaves,
                 static_cast<unsigned long long>(leafTriangles), file.roots().size, file.depth());
-    for (uint32_t r : file.roots()) printInspectNode(file, r, 0, o);
+    for (uint32_t r : file.roots()) printInspectTree(file, r, o);
     std::fflush(stdout);
     return kOk;
 }

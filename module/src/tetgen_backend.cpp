@@ -5,7 +5,11 @@
 #include <tetgen.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -151,11 +155,90 @@ void limitChild(double cpuSeconds, uint64_t memoryBytes) {
 #endif
 }
 
+// CPU time (user + system, clock ticks) a process has used so far; -1 when it cannot be read.
+long long cpuTicksOf(pid_t pid) {
+    char path[64];
+    std::snprintf(path, sizeof path, "/proc/%d/stat", int(pid));
+    const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return -1;
+    char text[1024] = {};
+    const ssize_t n = ::read(fd, text, sizeof text - 1);
+    ::close(fd);
+    if (n <= 0) return -1;
+    // Fields after the command name, which is in parentheses and may contain spaces.
+    const char* p = std::strrchr(text, ')');
+    if (!p) return -1;
+    char state = 0;
+    unsigned long long utime = 0, stime = 0;
+    if (std::sscanf(p + 1, " %c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &state, &utime, &stime) != 3)
+        return -1;
+    if (state == 'Z' || state == 'X') return -1;  // exited: nothing left to watch
+    return static_cast<long long>(utime + stime);
+}
+
+// Kills a child that stops gaining CPU time for `hangSeconds` (a deadlock: blocked threads
+// use no CPU, so RLIMIT_CPU never fires and the parent would wait for ever).
+class HangWatchdog {
+public:
+    HangWatchdog(pid_t pid, double hangSeconds) : pid_(pid), hangSeconds_(hangSeconds) {
+        try {
+            thread_ = std::thread([this] { watch(); });
+        } catch (const std::system_error&) {
+            // No thread to be had: the CPU limit still bounds a busy child.
+        }
+    }
+    ~HangWatchdog() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            done_ = true;
+        }
+        wake_.notify_all();
+        if (thread_.joinable()) thread_.join();
+    }
+    bool fired() const { return fired_.load(); }
+
+private:
+    void watch() {
+        using Clock = std::chrono::steady_clock;
+        long long lastTicks = cpuTicksOf(pid_);
+        Clock::time_point lastProgress = Clock::now();
+        std::unique_lock<std::mutex> lock(mutex_);
+        while (!done_) {
+            wake_.wait_for(lock, std::chrono::milliseconds(200));
+            if (done_) break;
+            const long long ticks = cpuTicksOf(pid_);
+            if (ticks < 0) break;  // gone (or a zombie the parent is about to reap)
+            if (ticks != lastTicks) {
+                lastTicks = ticks;
+                lastProgress = Clock::now();
+            } else if (std::chrono::duration<double>(Clock::now() - lastProgress).count() >= hangSeconds_) {
+                fired_ = true;
+                ::kill(pid_, SIGKILL);
+                break;
+            }
+        }
+    }
+
+    pid_t pid_;
+    double hangSeconds_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    bool done_ = false;
+    std::atomic<bool> fired_{false};
+    std::thread thread_;
+};
+
+// Fault injection for the watchdog's test: the first N children block for ever.
+bool childShouldHangForTest(int attempt) {
+    const char* value = std::getenv("AGGRELOD_TEST_TETGEN_HANGS");
+    return value && attempt < std::atoi(value);
+}
+
 // Runs `work` in a child process within the PLC's budget; it writes its result (starting with
 // an int32 code, 0 = ok) to the fd it gets. `receive` reads the rest of an ok result in this
 // process.
 template <class Work, class Receive>
-TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
+TetgenOutcome runIsolatedOnce(const PlcInput& plc, Work& work, Receive& receive, int attempt) {
     double cpuSeconds = plc.cpuSeconds;
     uint64_t memoryBytes = plc.memoryBytes;
     if (!(cpuSeconds > 0) || memoryBytes == 0) {
@@ -184,6 +267,8 @@ TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
         int devnull = ::open("/dev/null", O_WRONLY);
         if (devnull >= 0) ::dup2(devnull, STDOUT_FILENO);  // TetGen prints to stdout
         limitChild(cpuSeconds, memoryBytes);
+        if (childShouldHangForTest(attempt))
+            for (;;) ::pause();
         try {
             work(fds[1]);
         } catch (const std::bad_alloc&) {
@@ -201,10 +286,15 @@ TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
     }
     ::close(fds[1]);
     int32_t code = -1;
-    const bool gotCode = readAll(fds[0], &code, sizeof code);
-    const bool complete = gotCode && code == 0 && receive(fds[0]);
+    bool gotCode = false, complete = false, hung = false;
+    {
+        HangWatchdog watchdog(pid, plc.hangSeconds > 0 ? plc.hangSeconds : kDefaultHangSeconds);
+        gotCode = readAll(fds[0], &code, sizeof code);
+        complete = gotCode && code == 0 && receive(fds[0]);
+        hung = watchdog.fired();
+    }
     ::close(fds[0]);
-    if (complete) {
+    if (complete && !hung) {
         reapInBackground(pid);
         return {};
     }
@@ -212,6 +302,11 @@ TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
     rusage usage{};
     while (::wait4(pid, &wstatus, 0, &usage) < 0 && errno == EINTR) {
     }
+    if (hung)
+        return {TetgenStatus::Hung, "TetGen's process made no progress for " +
+                                        std::to_string(static_cast<long long>(plc.hangSeconds > 0 ? plc.hangSeconds
+                                                                                                   : kDefaultHangSeconds)) +
+                                        " s (hung) and was stopped"};
     std::string signal;
     if (WIFSIGNALED(wstatus))
         signal = std::string(" (signal ") + std::to_string(WTERMSIG(wstatus)) + ": " + strsignal(WTERMSIG(wstatus)) + ")";
@@ -225,6 +320,15 @@ TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
         return {TetgenStatus::OutOfMemory, "TetGen ran out of memory (budget " + std::to_string(memoryBytes >> 20) + " MiB)"};
     if (code != 0) return {statusFromCode(code), "TetGen reported error code " + std::to_string(code)};
     return {TetgenStatus::Crashed, "TetGen's result was cut short" + signal};
+}
+
+// A hung child is most likely a lock another thread held when it was forked: a transient
+// race, so one more child is tried before the hang is reported.
+template <class Work, class Receive>
+TetgenOutcome runIsolated(const PlcInput& plc, Work work, Receive receive) {
+    TetgenOutcome outcome = runIsolatedOnce(plc, work, receive, 0);
+    if (outcome.status == TetgenStatus::Hung) outcome = runIsolatedOnce(plc, work, receive, 1);
+    return outcome;
 }
 
 }  // namespace
@@ -246,6 +350,7 @@ const char* tetgenStatusName(TetgenStatus status) {
         case TetgenStatus::InternalError: return "internal error";
         case TetgenStatus::Crashed: return "triangulator crashed";
         case TetgenStatus::OverBudget: return "triangulator over its time budget";
+        case TetgenStatus::Hung: return "triangulator hung";
     }
     return "unknown";
 }
