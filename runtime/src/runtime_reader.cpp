@@ -327,6 +327,7 @@ struct FileValidator {
     }
 
     /// Order of levels from fine to coarse: leaves, per-object LODs, aggregate levels 0, 1, ...
+    /// A child's level must be below its parent's (per-object LODs may also chain).
     static int64_t levelRank(uint32_t level) {
         if (level == kLeafLevel) return -2;
         if (level == kObjectLodLevel) return -1;
@@ -350,7 +351,9 @@ struct FileValidator {
                                                          " has parent " + std::to_string(nodes[c].parent));
                 if (++references[c] > 1)
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + " is listed twice as a child");
-                if (levelRank(nodes[c].level) >= levelRank(r.level))
+                // Per-object LODs form chains: one may stand under another.
+                if (levelRank(nodes[c].level) >= levelRank(r.level) &&
+                    !(r.level == kObjectLodLevel && nodes[c].level == kObjectLodLevel))
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + ": level " +
                                                          std::to_string(nodes[c].level) + " is not below its parent's (" +
                                                          std::to_string(r.level) + ")");

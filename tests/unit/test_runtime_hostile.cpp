@@ -56,8 +56,8 @@ NodeRecord* nodesOf(std::vector<uint8_t>& bytes, uint64_t& count) {
     return reinterpret_cast<NodeRecord*>(bytes.data() + offset);
 }
 
-/// A valid chain: one leaf under `depth - 1` aggregates, each with one child and levels
-/// rising upwards; every node has its own source entry.
+/// A valid chain: one leaf under `depth - 1` per-object LOD nodes, each with one child;
+/// every node has its own source entry.
 BuildParams makeChain(uint32_t depth) {
     BuildParams p;
     p.objectNames = {"deep"};
@@ -72,12 +72,11 @@ BuildParams makeChain(uint32_t depth) {
             n.level = kLeafLevel;
             at::appendBoxMesh(p, n, lo, hi);
         } else {
-            n.level = k - 1;
+            n.level = kObjectLodLevel;
             n.firstChild = uint32_t(p.childIndices.size());
             n.childCount = 1;
             p.childIndices.push_back(k - 1);
             n.geometricError = 0.5f;
-            n.delta = 0.5f;
         }
         if (k + 1 < depth) n.parent = k + 1;
         for (int c = 0; c < 3; ++c) {
@@ -155,6 +154,9 @@ TEST(RuntimeHostile, SharedRangesCostLinearTime) {
 }
 
 TEST(RuntimeHostile, ChildLevelMustBeBelowItsParents) {
+    // Chains of per-object LODs are the one exception.
+    std::string chainMessage;
+    EXPECT_EQ(openCopy(writeOrDie(makeChain(5)), chainMessage), FileStatus::Ok) << chainMessage;
     const BuildParams p = makeSyntheticHierarchy(60, 4);
     std::vector<uint8_t> bytes = writeOrDie(p);
     uint64_t count = 0;
@@ -254,7 +256,7 @@ TEST(RuntimeHostile, CApiRefusesNonFiniteAndHugeFloats) {
 }
 
 TEST(RuntimeHostile, InspectPrintsAVeryDeepTreeWithoutRecursion) {
-    const uint32_t depth = 60000;  // levels must stay below kMaxAggregateLevel (65280)
+    const uint32_t depth = 200000;
     const std::vector<uint8_t> bytes = writeOrDie(makeChain(depth));
     std::string message;
     ASSERT_EQ(openCopy(bytes, message), FileStatus::Ok) << message;
@@ -268,5 +270,5 @@ TEST(RuntimeHostile, InspectPrintsAVeryDeepTreeWithoutRecursion) {
     EXPECT_GE(lines, size_t(depth));
     // Indentation is capped: the output grows linearly with the node count.
     EXPECT_LT(r.out.size(), size_t(depth) * 400) << "output of " << r.out.size() << " bytes";
-    EXPECT_NE(r.out.find("(depth 59999)"), std::string::npos);
+    EXPECT_NE(r.out.find("(depth 199999)"), std::string::npos);
 }
