@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The libFuzzer targets of tests/fuzz, for CTest (tests/CMakeLists.txt):
 #   fuzz.sh build DIR SOURCE_DIR MODULE_LIBRARY CLANGXX   configure and build them with clang++
-#   fuzz.sh seeds DIR MAKE_SAMPLE CLI MAKE_SYNTHETIC DATA  seed corpora from the samples
+#   fuzz.sh seeds DIR MAKE_SAMPLE CLI MAKE_SYNTHETIC DATA  seed corpora from the samples, and
+#                                                          2,000 mutants per reader (mutate.py)
 #   fuzz.sh run DIR TARGET SECONDS                         fuzz TARGET (gltf, geo, runtime)
-# A run fuzzes a fresh copy of the seeds for SECONDS (AGGRELOD_FUZZ_SECONDS overrides) with a
-# 2 GB memory limit; its exit status is non-zero on any finding (crash, sanitizer report,
-# timeout of one input, allocation over the limit). Findings are kept in DIR/findings/TARGET.
+# A run first executes every mutant of its reader once, then fuzzes a fresh copy of the seeds
+# for SECONDS (AGGRELOD_FUZZ_SECONDS overrides) with a 2 GB memory limit; its exit status is
+# non-zero on any finding (crash, sanitizer report, an input running over 30 s, an allocation
+# over the limit). Findings are kept in DIR/findings/TARGET.
 set -euo pipefail
 mode=$1
 dir=$2
@@ -48,7 +50,8 @@ GLTF
     for f in "$data/2d/nc_counties.wkt" "$data/2d/london_boroughs.geojson"; do
       if [ -f "$f" ]; then head -c 20000 "$f" > "$dir/seeds/geo/$(basename "$f")"; fi
     done
-    ls "$dir/seeds"/* | wc -l
+    rm -rf "$dir/mutants"
+    python3 "$(dirname "${BASH_SOURCE[0]}")/mutate.py" "$dir/seeds" "$dir/mutants" 2000
     ;;
   run)
     target=$3 seconds=${AGGRELOD_FUZZ_SECONDS:-$4}
@@ -60,7 +63,7 @@ GLTF
     export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
     cd "$findings"
     "$dir/build/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=30 \
-      -max_len=1048576 -print_final_stats=1 -artifact_prefix="$findings/" "$corpus"
+      -max_len=1048576 -print_final_stats=1 -artifact_prefix="$findings/" "$corpus" "$dir/mutants/$target"
     ;;
   *)
     echo "usage: fuzz.sh build|seeds|run ..." >&2
