@@ -29,6 +29,13 @@ struct PlcInput {
 /// Seconds without CPU progress after which a TetGen child counts as hung.
 constexpr double kDefaultHangSeconds = 60.0;
 
+/// main() of the helper executable aggrelod-tetgen, which runs TetGen for
+/// tetrahedralizePlc / findIntersectingFacets: started with posix_spawn, a fresh process
+/// holds no lock of the bake (a forked child can inherit one, held by another thread, and
+/// deadlock). It is looked up as AGGRELOD_TETGEN_HELPER (set but empty: none), beside the
+/// running executable, then in the build tree; without one a forked child does the work.
+int tetgenHelperMain(int argc, char** argv);
+
 /// The budget a PLC gets when it names none: 120 s + 0.5 ms per input triangle of CPU (about
 /// 20x what TetGen needs on well-spaced input), and half the machine's physical memory.
 void tetgenBudget(const PlcInput& input, double& cpuSeconds, uint64_t& memoryBytes);

@@ -1,7 +1,9 @@
-// The TetGen child process: a hung child (blocked, gaining no CPU time, as on a lock held at
+// The TetGen child process: it runs in the helper executable aggrelod-tetgen (started with
+// posix_spawn, so it inherits no lock of the bake); a hung child (blocked, gaining no CPU time, as on a lock held at
 // fork time) is stopped by the watchdog and retried once, then reported; a child never
 // outlives the process that started it.
 #include "tetgen_backend.h"
+#include "test_support.h"
 
 #include <aggrelod/samples.h>
 
@@ -106,4 +108,35 @@ TEST(TetgenChild, TheChildDiesWithItsParent) {
     }
     ::prctl(PR_SET_CHILD_SUBREAPER, 0);
     EXPECT_FALSE(childrenLeft) << "a TetGen child outlived its parent by more than 1 s";
+}
+
+TEST(TetgenChild, TheBakeRunsTetgenInTheHelperExecutable) {
+    const aggrelod::testing::fs::path dir = aggrelod::testing::freshTestDir(aggrelod::testing::currentTestName());
+    aggrelod::testing::writeFile(dir / "in.glb", aggrelod::testing::makeGlb({aggrelod::testing::rawMeshOf(samples::makeBox("a", {0, 0, 0}, {1, 1, 1})),
+                                                         aggrelod::testing::rawMeshOf(samples::makeBox("b", {3, 0, 0}, {4, 1, 1}))}));
+    // A "helper" that ends at once without a result: the bake must notice, so it used it.
+    ::setenv("AGGRELOD_TETGEN_HELPER", "/bin/true", 1);
+    const aggrelod::testing::RunResult broken =
+        aggrelod::testing::runProgram({AGGRELOD_CLI, "bake", (dir / "in.glb").string(), "-o", (dir / "out").string()}, dir);
+    ::unsetenv("AGGRELOD_TETGEN_HELPER");
+    EXPECT_NE(broken.exitCode, 0) << broken.describe();
+    EXPECT_NE(broken.err.find("TetGen stopped without a result"), std::string::npos) << broken.describe();
+    // The real helper (found in the build tree) bakes.
+    const aggrelod::testing::RunResult r =
+        aggrelod::testing::runProgram({AGGRELOD_CLI, "bake", (dir / "in.glb").string(), "-o", (dir / "out").string()}, dir);
+    EXPECT_EQ(r.exitCode, 0) << r.describe();
+    // Run by hand, it refuses: it only talks to the bake.
+    const aggrelod::testing::RunResult alone = aggrelod::testing::runProgram({AGGRELOD_TETGEN_HELPER_BIN}, dir);
+    EXPECT_EQ(alone.exitCode, 2) << alone.describe();
+    EXPECT_NE(alone.err.find("started by aggrelod"), std::string::npos) << alone.describe();
+}
+
+TEST(TetgenChild, WithoutTheHelperAForkedChildDoesTheWork) {
+    ::setenv("AGGRELOD_TETGEN_HELPER", "", 1);  // none: the forked child
+    detail::PlcInput plc = twoCubes();
+    detail::TetMesh mesh;
+    const detail::TetgenOutcome outcome = detail::tetrahedralizePlc(plc, mesh);
+    ::unsetenv("AGGRELOD_TETGEN_HELPER");
+    EXPECT_EQ(outcome.status, detail::TetgenStatus::Ok) << outcome.message;
+    EXPECT_GT(mesh.tetCount(), 0u);
 }
