@@ -19,9 +19,10 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev
   libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
   libompl-dev
-  chromium
+  chromium clang libclang-rt-14-dev
 )
 # libompl-dev: motion planning on the hierarchy (planning/, `aggrelod plan`).
+# clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz.
 # chromium: the web viewer test (tests/web) loads samples/web in headless Chromium.
 # node and npm run the glTF validator in the tests. Take them from Debian only when they are
 # missing: a node installed otherwise (e.g. a vendor repack) conflicts with Debian's npm.

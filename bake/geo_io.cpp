@@ -573,12 +573,46 @@ void appendMeasures(std::string& out, const char* key, const Measures2D& m, cons
     out += comma ? "},\n" : "}\n";
 }
 
+/// Largest magnitude of a coordinate: squares of coordinates (areas, distances) must stay
+/// far inside double range, and their differences meaningful.
+constexpr double kMaxCoordinate2D = 1e15;
+
+/// A finite coordinate beyond kMaxCoordinate2D refuses the whole file (non-finite ones are
+/// reported per feature by the geometry check).
+bool checkCoordinateRange(const GeoReadResult& in, std::string& error) {
+    for (const Feature2D& f : in.features) {
+        for (const Polygon2D& p : f.polygons) {
+            const auto ringOk = [&](const std::vector<double>& ring) {
+                for (double v : ring) {
+                    if (std::isfinite(v) && std::fabs(v) > kMaxCoordinate2D) {
+                        char text[48];
+                        std::snprintf(text, sizeof text, "%.6g", v);
+                        error = f.name + ": coordinate " + text +
+                                " is beyond the supported range (|coordinate| <= 1e15); refused";
+                        return false;
+                    }
+                }
+                return true;
+            };
+            if (!ringOk(p.exterior)) return false;
+            for (const auto& hole : p.holes)
+                if (!ringOk(hole)) return false;
+        }
+    }
+    return true;
+}
+
 }  // namespace
 
 bool readPolygonText(const std::string& text, const std::string& format, GeoReadResult& out, std::string& error) {
     out = GeoReadResult{};
-    if (format == "wkt") return readWkt(text, out);
-    return readGeoJson(text, out, error);
+    const bool ok = format == "wkt" ? readWkt(text, out) : readGeoJson(text, out, error);
+    if (!ok) return false;
+    if (!checkCoordinateRange(out, error)) {
+        out = GeoReadResult{};
+        return false;
+    }
+    return true;
 }
 
 bool readPolygonFile(const std::string& path, GeoReadResult& out, std::string& error) {

@@ -16,6 +16,7 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -28,10 +29,30 @@
 #include <sstream>
 #include <utility>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 namespace aggrelod::io {
 namespace {
 
 using Severity = Diagnostic::Severity;
+
+// Limits on hostile structure (documented in docs/command-line.md, "Limits").
+/// JSON nesting deeper than this is refused: tinygltf's parser recurses once per level.
+constexpr size_t kMaxJsonDepth = 100;
+/// Nodes in one file.
+constexpr size_t kMaxNodes = 1000000;
+/// Mesh nodes reached by the traversal (instances of meshes).
+constexpr size_t kMaxMeshInstances = 200000;
+/// Triangles in world space after instancing.
+constexpr size_t kMaxWorldTriangles = 50000000;
+/// Largest magnitude of a world coordinate. Far below where squares and cubes of
+/// coordinates (areas, volumes, ray distances) leave double or float range.
+constexpr double kMaxCoordinate = 1e15;
+/// Depth of the node hierarchy.
+constexpr size_t kMaxNodeDepth = 1000;
+
 
 // ---------------------------------------------------------------------------
 // Small double-precision 4x4 matrix (column-major, as glTF).
@@ -266,9 +287,14 @@ bool readAccessor(const tinygltf::Model& model, int index, bool indices,
     const size_t elementSize = size_t(csize) * size_t(components);
 
     if (acc.bufferView < 0) {
-        // Nothing bounds the count by the file's size here: refuse absurd ones.
-        if (count > (size_t(1) << 28)) {
-            why = name + " has no bufferView and too many elements (" + std::to_string(count) + ")";
+        // Nothing bounds the count by the file's size here: an accessor without data may not
+        // be larger than all the file's buffers together (a tiny file must not ask for GBs).
+        uint64_t bufferBytes = 0;
+        for (const tinygltf::Buffer& b : model.buffers) bufferBytes += b.data.size();
+        if (count > (size_t(1) << 28) || uint64_t(count) * elementSize > std::max<uint64_t>(bufferBytes, 4096)) {
+            why = name + " has no bufferView and " + std::to_string(count) + " elements (" +
+                  std::to_string(uint64_t(count) * elementSize) + " bytes), more than the file's buffers hold (" +
+                  std::to_string(bufferBytes) + " bytes); refused";
             return false;
         }
         if (!acc.sparse.isSparse) {
@@ -441,17 +467,30 @@ private:
     }
     /// The node with its subtree is left out: its name or index path matches.
     bool excluded(int node) const {
-        return hasRegex_ && (matches(name(node)) || matches(paths_[size_t(node)]));
+        return hasRegex_ && (matches(name(node)) || matches(path(node)));
     }
     /// Only the node's own mesh is left out (see SceneReadOptions::excludeRegex).
     bool meshExcluded(int node) const {
         const tinygltf::Node& n = model_.nodes[size_t(node)];
         if (!hasRegex_ || n.mesh < 0) return false;
         const std::string meshName = size_t(n.mesh) < model_.meshes.size() ? model_.meshes[size_t(n.mesh)].name : std::string();
-        return matches(name(node) + "/mesh") || matches(paths_[size_t(node)] + "/mesh") ||
+        return matches(name(node) + "/mesh") || matches(path(node) + "/mesh") ||
                (!meshName.empty() && matches("mesh:" + meshName));
     }
-    std::string name(int node) const { return displayName(model_, node, paths_[size_t(node)]); }
+    std::string name(int node) const { return displayName(model_, node, path(node)); }
+    /// Index path "@0/3/1" of a node the traversal reached (empty before), built from the
+    /// parent links on demand: storing every path would cost depth x nodes.
+    std::string path(int node) const {
+        if (pathParent_[size_t(node)] == kUnreached) return std::string();
+        std::vector<uint32_t> parts;
+        for (int n = node;; n = pathParent_[size_t(n)]) {
+            parts.push_back(pathPosition_[size_t(n)]);
+            if (pathParent_[size_t(n)] < 0) break;
+        }
+        std::string text = "@" + std::to_string(parts.back());
+        for (size_t i = parts.size() - 1; i-- > 0;) text += "/" + std::to_string(parts[i]);
+        return text;
+    }
     void addMeshOfNode(int node, const Mat4& world, ObjectBuilder& object);
     bool addPrimitive(int node, int meshIndex, int primIndex, const Mat4& world, bool flip,
                       ObjectBuilder& object);
@@ -469,7 +508,13 @@ private:
     std::vector<Diagnostic>& diags_;
     std::regex regex_;
     bool hasRegex_ = false;
-    std::vector<std::string> paths_;  ///< per node: index path "@0/3/1", set when the traversal reaches it
+    static constexpr int kUnreached = -2;
+    std::vector<int> pathParent_;          ///< per node: parent in the traversal, -1 for a root
+    std::vector<uint32_t> pathPosition_;   ///< per node: position among its parent's children (or roots)
+    size_t meshInstances_ = 0;             ///< mesh nodes read (kMaxMeshInstances)
+    size_t worldTriangles_ = 0;            ///< triangles read (kMaxWorldTriangles)
+    size_t worldVertices_ = 0;             ///< vertices read (3 kMaxWorldTriangles)
+    std::string fatal_;                    ///< input refused as a whole (limits, coordinate range)
     std::vector<std::string> nonTriangle_;  ///< "node 'name' mesh m primitive p: mode", listed in one note
     bool notedTexture_ = false;  ///< the texture note is given once per file
 };
@@ -517,6 +562,12 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
         return false;
     }
     const size_t vertexCount = p.size() / 3;
+    worldVertices_ += vertexCount;
+    if (worldVertices_ > 3 * kMaxWorldTriangles) {
+        fatal_ = "more than " + std::to_string(3 * kMaxWorldTriangles) + " vertices in the scene after instancing, at node " +
+                 std::to_string(node) + " '" + name(node) + "'; refused (limit of aggrelod)";
+        return false;
+    }
     std::vector<double> idx;
     if (prim.indices >= 0) {
         if (!readAccessor(model_, prim.indices, true, idx, why)) {
@@ -572,6 +623,12 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
         }
     }
     if (tri.empty()) return true;
+    worldTriangles_ += tri.size() / 3;
+    if (worldTriangles_ > kMaxWorldTriangles) {
+        fatal_ = "more than " + std::to_string(kMaxWorldTriangles) + " triangles in the scene after instancing, at node " +
+                 std::to_string(node) + " '" + name(node) + "'; refused (limit of aggrelod)";
+        return false;
+    }
 
     // Base colour of each triangle: the material's baseColorFactor (white without a
     // material), times the mean COLOR_0 of its corners when the primitive has vertex colours.
@@ -635,9 +692,23 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
     const double* m = world.m;
     for (size_t v = 0; v < vertexCount; ++v) {
         const double x = p[3 * v], y = p[3 * v + 1], z = p[3 * v + 2];
-        object.positions.push_back(m[0] * x + m[4] * y + m[8] * z + m[12]);
-        object.positions.push_back(m[1] * x + m[5] * y + m[9] * z + m[13]);
-        object.positions.push_back(m[2] * x + m[6] * y + m[10] * z + m[14]);
+        const double w[3] = {m[0] * x + m[4] * y + m[8] * z + m[12], m[1] * x + m[5] * y + m[9] * z + m[13],
+                             m[2] * x + m[6] * y + m[10] * z + m[14]};
+        // A non-finite coordinate in the data is reported per object later (NaN, inf); a
+        // finite one that the node transforms (or the data itself) make too large is refused.
+        if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
+            for (int c = 0; c < 3; ++c) {
+                if (!(std::fabs(w[c]) <= kMaxCoordinate)) {
+                    char text[64];
+                    std::snprintf(text, sizeof text, "%.6g", w[c]);
+                    fatal_ = "node " + std::to_string(node) + " '" + name(node) + "' " + where + ": vertex " +
+                             std::to_string(v) + " lies at world coordinate " + text +
+                             " (coordinates and transforms must keep every |coordinate| <= 1e15); refused";
+                    return false;
+                }
+            }
+        }
+        object.positions.insert(object.positions.end(), w, w + 3);
     }
     object.indices.reserve(object.indices.size() + tri.size());
     for (size_t t = 0; t < tri.size(); t += 3) {
@@ -652,6 +723,11 @@ void SceneReader::addMeshOfNode(int node, const Mat4& world, ObjectBuilder& obje
     const tinygltf::Node& n = model_.nodes[size_t(node)];
     if (n.mesh < 0) return;
     object.hadMesh = true;
+    if (++meshInstances_ > kMaxMeshInstances) {
+        fatal_ = "more than " + std::to_string(kMaxMeshInstances) + " mesh nodes (instances) in the scene, at node " +
+                 std::to_string(node) + " '" + name(node) + "'; refused (limit of aggrelod)";
+        return;
+    }
     if (object.failed) return;
     if (size_t(n.mesh) >= model_.meshes.size()) {
         fail(object, node, "mesh " + std::to_string(n.mesh) + " does not exist (" +
@@ -749,7 +825,8 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
     std::vector<ObjectBuilder> builders;
     std::vector<char> visited(size_t(nodeCount), 0);
     std::vector<std::string> excludedNames, excludedMeshes, animatedNames, cameraNames, lightNames;
-    paths_.assign(size_t(nodeCount), std::string());
+    pathParent_.assign(size_t(nodeCount), kUnreached);
+    pathPosition_.assign(size_t(nodeCount), 0);
     // Nodes an animation moves (their subtrees move with them).
     std::vector<char> animated(size_t(nodeCount), 0);
     for (const tinygltf::Animation& a : model_.animations)
@@ -764,12 +841,13 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
         Mat4 parent;
         int group;  ///< builder index of the enclosing subtree object, -1 if none
         int depth;  ///< 0 for a scene root
-        std::string path;
+        int parentNode;  ///< -1 for a scene root
+        uint32_t position;  ///< among the parent's children (or the roots)
     };
     std::vector<Item> stack;
-    for (size_t r = roots.size(); r-- > 0;) stack.push_back(Item{roots[r], Mat4{}, -1, 0, "@" + std::to_string(r)});
+    for (size_t r = roots.size(); r-- > 0;) stack.push_back(Item{roots[r], Mat4{}, -1, 0, -1, uint32_t(r)});
 
-    while (!stack.empty()) {
+    while (!stack.empty() && fatal_.empty()) {
         const Item item = stack.back();
         stack.pop_back();
         const int node = item.node;
@@ -781,7 +859,13 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
             continue;
         }
         visited[size_t(node)] = 1;
-        paths_[size_t(node)] = item.path;
+        pathParent_[size_t(node)] = item.parentNode;
+        pathPosition_[size_t(node)] = item.position;
+        if (item.depth >= int(kMaxNodeDepth)) {
+            fatal_ = "node " + std::to_string(node) + " '" + name(node) + "' lies deeper than " +
+                     std::to_string(kMaxNodeDepth) + " levels in the node hierarchy; refused (limit of aggrelod)";
+            break;
+        }
         if (excluded(node)) {
             excludedNames.push_back(name(node));
             continue;
@@ -838,8 +922,12 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
                 continue;
             }
             const size_t position = size_t(n.children.rend() - c) - 1;
-            stack.push_back(Item{*c, world, group, item.depth + 1, item.path + "/" + std::to_string(position)});
+            stack.push_back(Item{*c, world, group, item.depth + 1, node, uint32_t(position)});
         }
+    }
+    if (!fatal_.empty()) {
+        error = fatal_;
+        return false;
     }
 
     // One note per kind, each listing the nodes.
@@ -885,12 +973,14 @@ bool SceneReader::run(std::vector<InputObject>& objects, std::string& error) {
     std::set<std::string> taken;
     for (const ObjectBuilder* b : kept) taken.insert(b->name);
     std::set<std::string> used;
+    std::map<std::string, int> nextSuffix;  // per repeated name: the next "#k" to try (linear, not quadratic)
     objects.clear();
     objects.reserve(kept.size());
     for (ObjectBuilder* b : kept) {
         std::string name = b->name;
         if (used.count(name)) {
-            for (int k = 2;; ++k) {
+            int& start = nextSuffix.emplace(b->name, 2).first->second;
+            for (int& k = start;; ++k) {
                 std::string candidate = b->name + "#" + std::to_string(k);
                 if (!taken.count(candidate) && !used.count(candidate)) {
                     name = candidate;
@@ -1012,8 +1102,180 @@ std::string tidyMessage(std::string s) {
     return s;
 }
 
+// ---------------------------------------------------------------------------
+// Limits and confinement: hostile structure is refused before tinygltf spends memory or
+// stack on it (see docs/command-line.md, "Limits").
+
+/// What a linear pass over the JSON text finds before the real parse.
+struct JsonSummary {
+    size_t nodeCount = 0;
+    /// byteLength of every buffer whose uri names an external file, in buffer order
+    /// (the order in which tinygltf loads them).
+    std::vector<uint64_t> externalBufferLengths;
+};
+
+/// One pass over JSON text without recursion: refuses nesting deeper than kMaxJsonDepth and
+/// more than kMaxNodes nodes, and collects the declared sizes of external buffers. Syntax
+/// errors are left for tinygltf to report.
+bool scanJson(const unsigned char* s, size_t n, JsonSummary& out, std::string& error) {
+    struct Frame {
+        bool object;
+        bool expectKey;
+        std::string key;     ///< current key (objects of depth <= 3 only)
+        std::string uri;     ///< buffers[i].uri
+        bool hasLength = false;
+        uint64_t length = 0;
+    };
+    std::vector<Frame> stack;
+    const auto inBufferElement = [&] {
+        return stack.size() == 3 && stack[0].object && stack[0].key == "buffers" && !stack[1].object &&
+               stack[2].object;
+    };
+    size_t i = 0;
+    while (i < n) {
+        const unsigned char c = s[i];
+        if (c == '{' || c == '[') {
+            if (stack.size() >= kMaxJsonDepth) {
+                error = "JSON nests deeper than " + std::to_string(kMaxJsonDepth) + " levels (at byte " +
+                        std::to_string(i) + "); refused";
+                return false;
+            }
+            if (stack.size() == 2 && stack[0].object && stack[0].key == "nodes" && !stack[1].object) {
+                if (++out.nodeCount > kMaxNodes) {
+                    error = "more than " + std::to_string(kMaxNodes) + " nodes; refused (limit of aggrelod)";
+                    return false;
+                }
+            }
+            stack.push_back(Frame{c == '{', c == '{', std::string(), std::string()});
+            ++i;
+        } else if (c == '}' || c == ']') {
+            if (!stack.empty()) {
+                if (inBufferElement() && stack[2].hasLength && !stack[2].uri.empty() &&
+                    stack[2].uri.compare(0, 5, "data:") != 0)
+                    out.externalBufferLengths.push_back(stack[2].length);
+                stack.pop_back();
+            }
+            ++i;
+        } else if (c == '"') {
+            const size_t start = ++i;
+            while (i < n && s[i] != '"') i += s[i] == '\\' ? 2 : 1;
+            const size_t end = std::min(i, n);
+            ++i;
+            if (stack.empty()) continue;
+            Frame& f = stack.back();
+            if (f.object && f.expectKey) {
+                if (stack.size() <= 3) f.key.assign(reinterpret_cast<const char*>(s + start), end - start);
+            } else if (inBufferElement() && f.key == "uri") {
+                f.uri.assign(reinterpret_cast<const char*>(s + start), std::min<size_t>(end - start, 16));
+            }
+        } else if (c == ':') {
+            if (!stack.empty()) stack.back().expectKey = false;
+            ++i;
+        } else if (c == ',') {
+            if (!stack.empty() && stack.back().object) stack.back().expectKey = true;
+            ++i;
+        } else if (c == ' ' || c == '\t' || c == '\n' || c == '\r') {
+            ++i;
+        } else {
+            const size_t start = i;
+            while (i < n && s[i] != ',' && s[i] != '}' && s[i] != ']' && s[i] != ' ' && s[i] != '\n' &&
+                   s[i] != '\r' && s[i] != '\t')
+                ++i;
+            if (inBufferElement() && stack[2].key == "byteLength") {
+                const std::string number(reinterpret_cast<const char*>(s + start), i - start);
+                char* endp = nullptr;
+                const double v = std::strtod(number.c_str(), &endp);
+                if (endp && *endp == '\0' && v >= 0 && v < 1.8e19) {
+                    stack[2].hasLength = true;
+                    stack[2].length = uint64_t(v);
+                }
+            }
+        }
+    }
+    return true;
+}
+
+/// Largest external file read (as the main file: glTF loading stays below 4 GiB).
+constexpr uint64_t kMaxExternalFileBytes = uint64_t(std::numeric_limits<uint32_t>::max()) - 1;
+
+/// File access handed to tinygltf: external files must be regular files inside the input's
+/// folder (unless allowed), of exactly their buffer's declared size, checked before reading;
+/// external images are never read (only geometry is baked).
+struct ExternalFiles {
+    std::filesystem::path folder;  ///< canonical folder of the input, ends with a separator
+    bool allowOutside = false;
+    std::vector<uint64_t> bufferLengths;  ///< JsonSummary::externalBufferLengths
+    size_t calls = 0;
+    size_t imagesSkipped = 0;
+    std::string refusal;  ///< why a buffer's file was refused: the error, instead of tinygltf's
+};
+
+const char* const kImageNotRead = "external image not read (only geometry is baked)";
+
+bool externalFileExists(const std::string& path, void*) {
+    std::error_code ec;
+    return std::filesystem::exists(std::filesystem::symlink_status(path, ec));
+}
+
+std::string expandNothing(const std::string& path, void*) { return path; }
+
+bool writeNothing(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "writing is not used";
+    return false;
+}
+
+bool readExternalFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    ExternalFiles& files = *static_cast<ExternalFiles*>(user);
+    const size_t call = files.calls++;
+    if (call >= files.bufferLengths.size()) {
+        ++files.imagesSkipped;
+        if (err) *err += kImageNotRead;
+        return false;
+    }
+    const auto refuse = [&](const std::string& why) {
+        if (err) *err += why;
+        if (files.refusal.empty()) files.refusal = "external buffer file " + path + ": " + why;
+        return false;
+    };
+    std::error_code ec;
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
+    if (ec) return refuse("cannot resolve: " + ec.message());
+    if (!files.allowOutside) {
+        const std::string folder = files.folder.string(), file = canonical.string();
+        if (file.compare(0, folder.size(), folder) != 0)
+            return refuse("refused: the uri leads outside the input's folder (--allow-external-uris allows it): " +
+                          file + " is not under " + folder);
+    }
+    // The descriptor is checked, not the name, so that what is checked is what is read.
+    const int fd = ::open(canonical.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+    if (fd < 0) return refuse(std::string("cannot open: ") + std::strerror(errno));
+    struct FdCloser {
+        int fd;
+        ~FdCloser() { ::close(fd); }
+    } closer{fd};
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) return refuse(std::string("cannot stat: ") + std::strerror(errno));
+    if (S_ISDIR(st.st_mode)) return refuse("refused: the uri names a directory, not a file");
+    if (!S_ISREG(st.st_mode)) return refuse("refused: the uri names a device, pipe or socket, not a regular file");
+    const uint64_t size = uint64_t(st.st_size);
+    const uint64_t declared = files.bufferLengths[call];
+    if (size > kMaxExternalFileBytes) return refuse("refused: file of " + std::to_string(size) + " bytes is 4 GiB or larger");
+    if (size != declared)
+        return refuse("refused: file has " + std::to_string(size) + " bytes, its buffer declares byteLength " +
+                      std::to_string(declared));
+    out->resize(size_t(size));
+    size_t done = 0;
+    while (done < size) {
+        const ssize_t got = ::pread(fd, out->data() + done, size_t(size) - done, off_t(done));
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) return refuse(std::string("read error: ") + (got < 0 ? std::strerror(errno) : "file shrank"));
+        done += size_t(got);
+    }
+    return true;
+}
+
 bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diagnostic>& diags,
-               std::string& error) {
+               std::string& error, bool allowExternalUris = false) {
     std::vector<unsigned char> bytes;
     if (!readWholeFile(path, bytes, error)) return false;
     const bool magicGlb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
@@ -1026,15 +1288,32 @@ bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diag
     std::string baseDir = std::filesystem::path(path).parent_path().string();
     if (baseDir.empty()) baseDir = ".";
 
+    uint32_t glbLength = 0;
+    if (magicGlb && !checkGlbHeader(bytes, glbLength, error)) return false;
+    JsonSummary summary;
+    if (!scanJson(bytes.data() + (magicGlb ? 20 : 0), magicGlb ? size_t(readLe32(&bytes[12])) : bytes.size(),
+                  summary, error))
+        return false;
+    ExternalFiles files;
+    std::error_code ec;
+    files.folder = std::filesystem::weakly_canonical(std::filesystem::absolute(baseDir, ec), ec);
+    if (ec) {
+        error = "cannot resolve the input's folder: " + ec.message();
+        return false;
+    }
+    files.folder /= "";  // trailing separator: "/in" must not admit "/inside"
+    files.allowOutside = allowExternalUris;
+    files.bufferLengths = summary.externalBufferLengths;
+
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(&acceptImageWithoutDecoding, nullptr);
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{&externalFileExists, &expandNothing, &readExternalFile,
+                                                &writeNothing, &files});
     std::string err, warn;
     bool ok = false;
     try {
         if (magicGlb) {
-            uint32_t length = 0;
-            if (!checkGlbHeader(bytes, length, error)) return false;
-            ok = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), length, baseDir);
+            ok = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), glbLength, baseDir);
         } else {
             if (bytes.empty()) {
                 error = "empty file";
@@ -1054,6 +1333,10 @@ bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diag
         error = "invalid glTF (the glTF parser failed)";
         return false;
     }
+    if (!ok && !files.refusal.empty()) {
+        error = files.refusal;
+        return false;
+    }
     if (!ok) {
         err = tidyMessage(err);
         error = "invalid glTF: " + (err.empty() ? std::string("the glTF parser failed") : err);
@@ -1066,9 +1349,16 @@ bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diag
     std::istringstream lines(warn);
     std::string line;
     while (std::getline(lines, line)) {
+        // External images are left unread on purpose: one note below instead of two lines each.
+        if (line.find(kImageNotRead) != std::string::npos || line.find("Failed to load external 'uri' for image[") != std::string::npos)
+            continue;
         line = tidyMessage(line);
         if (!line.empty()) diags.push_back(Diagnostic{Severity::Note, "", "glTF loader: " + line});
     }
+    if (files.imagesSkipped)
+        diags.push_back(Diagnostic{Severity::Note, "",
+                                   std::to_string(files.imagesSkipped) +
+                                       " external image file(s) not read: only geometry is baked"});
     return true;
 }
 
@@ -1262,7 +1552,7 @@ bool readGltfScene(const std::string& path, const SceneReadOptions& options,
     error.clear();
     try {
         tinygltf::Model model;
-        if (!loadModel(path, model, out.diagnostics, error)) {
+        if (!loadModel(path, model, out.diagnostics, error, options.allowExternalUris)) {
             error = path + ": " + error;
             return false;
         }

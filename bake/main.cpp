@@ -30,6 +30,14 @@
 #include <system_error>
 #include <vector>
 
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #ifndef AGGRELOD_VERSION
 #define AGGRELOD_VERSION "unknown"
 #endif
@@ -45,21 +53,181 @@ void printError(const std::string& message) {
     std::fprintf(stderr, "aggrelod: error: %s\n", message.c_str());
 }
 
-/// Removes a temporary file if it exists (best effort).
-void removeQuietly(const fs::path& p) {
-    std::error_code ec;
-    fs::remove(p, ec);
-}
+// ---------------------------------------------------------------------------
+// The output set of a bake: every file is written into a fresh private folder inside OUTDIR
+// (created exclusively, so nothing can be planted in it), synced, then moved into place; the
+// files being replaced are kept as backups until every move succeeded, and put back if one
+// fails. A folder left behind by a bake that was killed is removed by the next bake.
 
-/// Renames `from` to `to`, replacing `to` (atomic on POSIX within one file system).
-bool renameOver(const fs::path& from, const fs::path& to, std::string& error) {
-    std::error_code ec;
-    fs::rename(from, to, ec);
-    if (ec) {
-        error = to.string() + ": cannot replace: " + ec.message();
+/// Prefix of the temporary folders; the rest is "<pid>-<random>".
+constexpr const char* kTempPrefix = ".aggrelod-tmp-";
+
+bool syncPath(const fs::path& p, std::string& error) {
+    const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0 || ::fsync(fd) != 0) {
+        error = p.string() + ": cannot sync: " + std::strerror(errno);
+        if (fd >= 0) ::close(fd);
         return false;
     }
+    ::close(fd);
     return true;
+}
+
+/// Creates an empty file that did not exist, never through a symbolic link.
+bool createExclusive(const fs::path& p, std::string& error) {
+    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        error = p.string() + ": cannot create: " + std::strerror(errno);
+        return false;
+    }
+    ::close(fd);
+    return true;
+}
+
+/// Removes temporary folders of bakes that are no longer running (killed, or the machine
+/// stopped), and the fixed-name temporaries of older versions.
+void removeStaleTemporaries(const fs::path& outDir) {
+    std::error_code ec;
+    for (const char* legacy : {"levels.glb.tmp", "proxies.glb.tmp", "scene.aglod.tmp", "tiles.tmp", "tiles.old"})
+        fs::remove_all(outDir / legacy, ec);  // a symbolic link is removed, not followed
+    for (fs::directory_iterator it(outDir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.rfind(kTempPrefix, 0) != 0) continue;
+        const long pid = std::strtol(name.c_str() + std::strlen(kTempPrefix), nullptr, 10);
+        if (pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM)) continue;  // its bake still runs
+        std::error_code removeError;
+        fs::remove_all(it->path(), removeError);
+    }
+}
+
+class OutputSet {
+public:
+    ~OutputSet() {
+        std::error_code ec;
+        for (const fs::path& p : outsideTemporaries_) fs::remove(p, ec);
+        if (!tempDir_.empty()) fs::remove_all(tempDir_, ec);
+    }
+
+    bool begin(const fs::path& outDir, std::string& error) {
+        outDir_ = outDir;
+        removeStaleTemporaries(outDir);
+        std::string pattern = (outDir / (kTempPrefix + std::to_string(::getpid()) + "-XXXXXX")).string();
+        if (!::mkdtemp(pattern.data())) {
+            error = outDir.string() + ": cannot create a temporary folder: " + std::strerror(errno);
+            return false;
+        }
+        tempDir_ = pattern;
+        return true;
+    }
+
+    /// A new empty temporary for `final` (OUTDIR/name, or a file elsewhere such as --stats).
+    bool addFile(const fs::path& final, fs::path& temporary, std::string& error) {
+        const bool inOutDir = final.parent_path() == outDir_;
+        if (inOutDir) {
+            temporary = tempDir_ / final.filename();
+        } else {
+            // Elsewhere: beside its final place (a rename cannot cross file systems).
+            temporary = final;
+            temporary += "." + tempDir_.filename().string();
+        }
+        if (!createExclusive(temporary, error)) return false;
+        if (!inOutDir) outsideTemporaries_.push_back(temporary);
+        entries_.push_back({temporary, final, false});
+        return true;
+    }
+
+    /// A folder (the 3D Tiles tileset), written whole into `temporary` by the caller.
+    fs::path folderTemporary(const fs::path& final) {
+        entries_.push_back({tempDir_ / final.filename(), final, true});
+        return entries_.back().temporary;
+    }
+
+    /// Syncs every temporary, then moves each into place; on a failure the set as it was is
+    /// put back.
+    bool commit(std::string& error) {
+        for (const Entry& e : entries_) {
+            if (e.folder) continue;
+            if (!syncPath(e.temporary, error)) return false;
+        }
+        if (!syncPath(tempDir_, error)) return false;
+        struct Done {
+            fs::path final, backup;
+            bool hadOld;
+        };
+        std::vector<Done> done;
+        const auto rollBack = [&] {
+            std::error_code ec;
+            for (auto d = done.rbegin(); d != done.rend(); ++d) {
+                if (d->hadOld) {
+                    if (fs::is_directory(d->final, ec) && !fs::is_symlink(d->final, ec)) fs::remove_all(d->final, ec);
+                    ::rename(d->backup.c_str(), d->final.c_str());
+                } else {
+                    fs::remove_all(d->final, ec);
+                }
+            }
+        };
+        size_t k = 0;
+        for (const Entry& e : entries_) {
+            std::error_code ec;
+            const fs::path backup = tempDir_ / ("old-" + std::to_string(k++) + "-" + e.final.filename().string());
+            const bool hadOld = fs::exists(fs::symlink_status(e.final, ec));
+            if (!e.folder && fs::is_directory(fs::symlink_status(e.final, ec))) {
+                error = e.final.string() + ": cannot replace: it is a folder";
+                rollBack();
+                return false;
+            }
+            // The old version stays reachable (a second name, or moved aside for a folder).
+            if (hadOld) {
+                const bool ok = e.folder ? ::rename(e.final.c_str(), backup.c_str()) == 0
+                                         : ::link(e.final.c_str(), backup.c_str()) == 0 ||
+                                               ::rename(e.final.c_str(), backup.c_str()) == 0;
+                if (!ok) {
+                    error = e.final.string() + ": cannot replace: " + std::strerror(errno);
+                    rollBack();
+                    return false;
+                }
+            }
+            done.push_back({e.final, backup, hadOld});
+            if (::rename(e.temporary.c_str(), e.final.c_str()) != 0) {
+                error = e.final.string() + ": cannot replace: " + std::strerror(errno);
+                rollBack();
+                return false;
+            }
+        }
+        std::string ignored;
+        syncPath(outDir_, ignored);
+        return true;
+    }
+
+private:
+    struct Entry {
+        fs::path temporary, final;
+        bool folder;
+    };
+    fs::path outDir_, tempDir_;
+    std::vector<Entry> entries_;
+    std::vector<fs::path> outsideTemporaries_;
+};
+
+/// Two paths naming the same file (or the same place, when one does not exist yet).
+bool samePlace(const fs::path& a, const fs::path& b) {
+    std::error_code ec1, ec2;
+    if (fs::exists(a, ec1) && fs::exists(b, ec2)) {
+        std::error_code ec;
+        if (fs::equivalent(a, b, ec)) return true;
+    }
+    std::error_code ec;
+    const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec1);
+    const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec2);
+    return !ec1 && !ec2 && ca == cb;
+}
+
+/// `inner` lies inside the folder `outer`.
+bool inside(const fs::path& inner, const fs::path& outer) {
+    std::error_code ec, ec1, ec2;
+    const std::string ci = fs::weakly_canonical(fs::absolute(inner, ec), ec1).string();
+    const std::string co = (fs::weakly_canonical(fs::absolute(outer, ec), ec2) / "").string();
+    return !ec1 && !ec2 && ci.compare(0, co.size(), co) == 0;
 }
 
 // ---------------------------------------------------------------------------
@@ -86,6 +254,7 @@ struct BakeOptions {
     std::string support = "auto";       ///< auto | none | a regex on object names
     int objectDepth = -1;               ///< >= 0: each node at this depth, with its subtree, is one object
     bool includeAnimated = false;
+    bool allowExternalUris = false;
 };
 
 /// The settings that shape the outputs, as canonical text (hashed into scene.aglod so that an
@@ -151,6 +320,8 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "through: auto (default, documented rule), none, or an ECMAScript regex on object names");
     cmd->add_flag("--include-animated", o.includeAnimated,
                   "Bake animated and skinned nodes at their rest pose (default: left out and listed)");
+    cmd->add_flag("--allow-external-uris", o.allowExternalUris,
+                  "Let buffer uris name files outside the input's folder (refused by default)");
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
     cmd->add_flag("--constant-baseline", o.constantBaseline,
                   "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
@@ -171,44 +342,16 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
     return cmd;
 }
 
-/// Writes the 3D Tiles tileset into a fresh `outDir`/tiles.tmp (removed again on failure).
-bool writeTilesTmp(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, const fs::path& outDir,
-                   io::TilesetSummary& summary, std::string& error) {
-    const fs::path tilesTmp = outDir / "tiles.tmp";
+/// Writes the 3D Tiles tileset into the fresh folder `dir`.
+bool writeTilesInto(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, const fs::path& dir,
+                    io::TilesetSummary& summary, std::string& error) {
     std::error_code ec;
-    fs::remove_all(tilesTmp, ec);
-    fs::create_directories(tilesTmp, ec);
+    fs::create_directory(dir, ec);
     if (ec) {
-        error = tilesTmp.string() + ": cannot create: " + ec.message();
+        error = dir.string() + ": cannot create: " + ec.message();
         return false;
     }
-    if (!io::writeTileset(nodes, objects, tilesTmp.string(), summary, error)) {
-        fs::remove_all(tilesTmp, ec);
-        return false;
-    }
-    return true;
-}
-
-/// Puts `outDir`/tiles.tmp in place of `outDir`/tiles (an older tileset is replaced whole).
-bool renameTilesIntoPlace(const fs::path& outDir, std::string& error) {
-    const fs::path tilesDir = outDir / "tiles", tilesTmp = outDir / "tiles.tmp", tilesOld = outDir / "tiles.old";
-    std::error_code ec;
-    fs::remove_all(tilesOld, ec);
-    if (fs::exists(tilesDir)) {
-        fs::rename(tilesDir, tilesOld, ec);
-        if (ec) {
-            error = tilesDir.string() + ": cannot replace: " + ec.message();
-            fs::remove_all(tilesTmp, ec);
-            return false;
-        }
-    }
-    fs::rename(tilesTmp, tilesDir, ec);
-    if (ec) {
-        error = tilesDir.string() + ": cannot replace: " + ec.message();
-        return false;
-    }
-    fs::remove_all(tilesOld, ec);
-    return true;
+    return io::writeTileset(nodes, objects, dir.string(), summary, error);
 }
 
 int runBake(BakeOptions o) {
@@ -244,12 +387,39 @@ int runBake(BakeOptions o) {
         }
     }
 
+    // No output may overwrite the input or another output: checked before anything is read.
+    {
+        const fs::path outDir(o.outDir);
+        std::vector<std::pair<std::string, fs::path>> outputs = {
+            {"levels.glb", outDir / "levels.glb"}, {"proxies.glb", outDir / "proxies.glb"}, {"scene.aglod", outDir / "scene.aglod"}};
+        if (!o.statsPath.empty()) outputs.emplace_back("--stats", fs::path(o.statsPath));
+        for (size_t i = 0; i < outputs.size(); ++i) {
+            if (samePlace(outputs[i].second, o.scene)) {
+                printError("output " + outputs[i].second.string() + " (" + outputs[i].first + ") is the input " +
+                           o.scene + ": it would be overwritten; choose another output");
+                return kUsage;
+            }
+            for (size_t j = 0; j < i; ++j)
+                if (samePlace(outputs[i].second, outputs[j].second)) {
+                    printError("outputs " + outputs[j].first + " and " + outputs[i].first + " are the same file " +
+                               outputs[i].second.string());
+                    return kUsage;
+                }
+        }
+        if (o.tiles && (inside(o.scene, outDir / "tiles") ||
+                        (!o.statsPath.empty() && inside(fs::path(o.statsPath), outDir / "tiles")))) {
+            printError(outDir.string() + "/tiles is replaced whole by --tiles: the input and --stats must lie outside it");
+            return kUsage;
+        }
+    }
+
     // Read.
     io::SceneReadOptions readOptions;
     readOptions.excludeRegex = o.exclude;
     readOptions.objectUnit = o.objectUnit == "subtree" ? io::ObjectUnit::Subtree : io::ObjectUnit::Node;
     readOptions.objectDepth = o.objectDepth;
     readOptions.includeAnimated = o.includeAnimated;
+    readOptions.allowExternalUris = o.allowExternalUris;
     io::SceneReadResult scene;
     std::string error;
     if (!io::readGltfScene(o.scene, readOptions, scene, error)) {
@@ -318,9 +488,12 @@ int runBake(BakeOptions o) {
         return kInternal;
     }
 
-    // Write: temporary files first, then rename over the old outputs, so that a failure
-    // never leaves a half-written or mixed result behind.
+    // Write: the whole set into a fresh temporary folder, then moved into place (OutputSet).
     const fs::path outDir(o.outDir);
+    const fs::path levelsPath = outDir / "levels.glb";
+    const fs::path proxiesPath = outDir / "proxies.glb";
+    const fs::path runtimePath = outDir / "scene.aglod";
+    const fs::path statsPath = o.statsPath.empty() ? fs::path() : fs::path(o.statsPath);
     std::error_code ec;
     fs::create_directories(outDir, ec);
     if (ec || !fs::is_directory(outDir)) {
@@ -328,42 +501,29 @@ int runBake(BakeOptions o) {
                    (ec ? ": " + ec.message() : std::string()));
         return kFileError;
     }
-    const fs::path levelsPath = outDir / "levels.glb";
-    const fs::path proxiesPath = outDir / "proxies.glb";
-    const fs::path runtimePath = outDir / "scene.aglod";
-    const fs::path statsPath = o.statsPath.empty() ? fs::path() : fs::path(o.statsPath);
-    // Every output as (temporary, final); on any failure all temporaries are removed (a
-    // temporary already renamed into place no longer exists, so removing it is a no-op).
-    std::vector<std::pair<fs::path, fs::path>> outputs = {{outDir / "levels.glb.tmp", levelsPath},
-                                                          {outDir / "proxies.glb.tmp", proxiesPath},
-                                                          {outDir / "scene.aglod.tmp", runtimePath}};
-    if (!statsPath.empty()) outputs.emplace_back(fs::path(o.statsPath + ".tmp"), statsPath);
     const auto fail = [&](const std::string& message) {
-        for (const auto& output : outputs) removeQuietly(output.first);
-        std::error_code removeError;
-        if (o.tiles) fs::remove_all(outDir / "tiles.tmp", removeError);
         printError(message);
         return kFileError;
     };
-    if (!io::writeLevelsGlb(hierarchy, scene.objects, outputs[0].first.string(), error, &nodes)) return fail(error);
-    if (!io::writeProxiesGlb(nodes, scene.objects, outputs[1].first.string(), error)) return fail(error);
+    OutputSet set;
+    if (!set.begin(outDir, error)) return fail(error);
+    if (!statsPath.empty() && statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
+    fs::path levelsTmp, proxiesTmp, runtimeTmp, statsTmp;
+    if (!set.addFile(levelsPath, levelsTmp, error) || !set.addFile(proxiesPath, proxiesTmp, error) ||
+        !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)))
+        return fail(error);
+    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes)) return fail(error);
+    if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) return fail(error);
     if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
-                               outputs[2].first.string(), error))
+                               runtimeTmp.string(), error))
         return fail(error);
     io::TilesetSummary tiles;
-    if (o.tiles && !writeTilesTmp(nodes, scene.objects, outDir, tiles, error)) return fail(error);
-    if (!statsPath.empty()) {
-        if (statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
-        if (!io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, outputs[3].first.string(), error,
-                               &nodes))
-            return fail(error);
-    }
-    for (const auto& [tmp, final] : outputs)
-        if (!renameOver(tmp, final, error)) return fail(error);
-    if (o.tiles && !renameTilesIntoPlace(outDir, error)) {
-        printError(error);
-        return kFileError;
-    }
+    if (o.tiles && !writeTilesInto(nodes, scene.objects, set.folderTemporary(outDir / "tiles"), tiles, error))
+        return fail(error);
+    if (!statsPath.empty() &&
+        !io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, statsTmp.string(), error, &nodes))
+        return fail(error);
+    if (!set.commit(error)) return fail(error);
 
     if (!o.quiet) {
         std::printf("%zu objects, %zu models, %zu triangles; originals: volume %s, sphericity %s\n",
@@ -411,12 +571,15 @@ CLI::App* addInspectCommand(CLI::App& app, InspectOptions& o) {
     return cmd;
 }
 
-/// One node and, indented below it, its children (depth first, children in file order).
-void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int depth, const InspectOptions& o) {
+/// One node's line, indented by its depth (capped, so that a very deep tree cannot print
+/// quadratic output; deeper lines say their depth).
+void printInspectLine(const runtime::RuntimeFile& file, uint32_t index, size_t depth, const InspectOptions& o) {
     const runtime::NodeRecord& n = file.node(index);
     const bool leaf = n.level == runtime::kLeafLevel;
     if (leaf && o.noLeaves) return;
-    const std::string indent(size_t(2 * depth), ' ');
+    constexpr size_t kMaxIndent = 32;
+    std::string indent(2 * std::min(depth, kMaxIndent), ' ');
+    if (depth > kMaxIndent) indent += "(depth " + std::to_string(depth) + ") ";
     const auto sources = file.sources(index);
     if (leaf) {
         std::printf("%sobject %u '%.*s'  triangles %u  sphere r %s\n", indent.c_str(), sources.empty() ? 0u : sources[0],
@@ -449,7 +612,19 @@ void printInspectNode(const runtime::RuntimeFile& file, uint32_t index, int dept
         }
         std::printf("\n");
     }
-    for (uint32_t c : file.children(index)) printInspectNode(file, c, depth + 1, o);
+}
+
+/// Every node below `root`, depth first, children in file order, with an explicit stack (a
+/// valid file may nest hundreds of thousands of levels deep).
+void printInspectTree(const runtime::RuntimeFile& file, uint32_t root, const InspectOptions& o) {
+    std::vector<std::pair<uint32_t, size_t>> stack = {{root, 0}};
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        printInspectLine(file, index, depth, o);
+        const auto children = file.children(index);
+        for (size_t c = children.size; c-- > 0;) stack.emplace_back(children[c], depth + 1);
+    }
 }
 
 int runInspect(const InspectOptions& o) {
@@ -482,7 +657,7 @@ int runInspect(const InspectOptions& o) {
                 file.nodeCount(), aggregates, static_cast<unsigned long long>(proxyTriangles), objectLods,
                 static_cast<unsigned long long>(objectLodTriangles), leaves,
                 static_cast<unsigned long long>(leafTriangles), file.roots().size, file.depth());
-    for (uint32_t r : file.roots()) printInspectNode(file, r, 0, o);
+    for (uint32_t r : file.roots()) printInspectTree(file, r, o);
     std::fflush(stdout);
     return kOk;
 }

@@ -30,6 +30,9 @@ struct SceneReadOptions {
     /// Nodes targeted by an animation channel (with their subtrees) and skinned meshes are
     /// left out with a note listing them, unless this is set (then their rest pose is read).
     bool includeAnimated = false;
+    /// External files (buffer uris) may lie outside the input's folder. Off by default: a
+    /// uri such as "../../etc/passwd" is refused, so a file cannot pull in other data.
+    bool allowExternalUris = false;
 };
 
 struct SceneReadResult {

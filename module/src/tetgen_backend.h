@@ -20,7 +20,21 @@ struct PlcInput {
     /// (tetgenBudget). A child over budget is stopped and reported, never waited for.
     double cpuSeconds = 0;
     uint64_t memoryBytes = 0;
+    /// Watchdog: a child that gains no CPU time for this many seconds is hung (e.g. on a lock
+    /// another thread held at fork time, which no CPU limit catches): it is killed and started
+    /// once more, then reported as TetgenStatus::Hung. 0 = kDefaultHangSeconds.
+    double hangSeconds = 0;
 };
+
+/// Seconds without CPU progress after which a TetGen child counts as hung.
+constexpr double kDefaultHangSeconds = 60.0;
+
+/// main() of the helper executable aggrelod-tetgen, which runs TetGen for
+/// tetrahedralizePlc / findIntersectingFacets: started with posix_spawn, a fresh process
+/// holds no lock of the bake (a forked child can inherit one, held by another thread, and
+/// deadlock). It is looked up as AGGRELOD_TETGEN_HELPER (set but empty: none), beside the
+/// running executable, then in the build tree; without one a forked child does the work.
+int tetgenHelperMain(int argc, char** argv);
 
 /// The budget a PLC gets when it names none: 120 s + 0.5 ms per input triangle of CPU (about
 /// 20x what TetGen needs on well-spaced input), and half the machine's physical memory.
@@ -46,7 +60,8 @@ enum class TetgenStatus {
     OutOfMemory,       ///< code 1
     InternalError,     ///< code 2, or anything else TetGen reported
     Crashed,           ///< the child process died (assert, signal)
-    OverBudget         ///< the child used up its CPU time budget and was stopped
+    OverBudget,        ///< the child used up its CPU time budget and was stopped
+    Hung               ///< the child made no progress (twice) and was stopped
 };
 
 struct TetgenOutcome {

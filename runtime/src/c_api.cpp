@@ -31,6 +31,7 @@ aglod_status failWith(aglod_status status, const std::string& message) {
 }  // namespace aggrelod::runtime::capi
 
 using aggrelod::runtime::capi::failWith;
+using aggrelod::runtime::capi::inRange;
 
 namespace {
 // A per-vertex attribute of a node (`components` values per vertex) as a view into the file.
@@ -192,14 +193,18 @@ aglod_selector* aglod_selector_create(const aglod_file* file) {
 
 void aglod_selector_destroy(aglod_selector* selector) { delete selector; }
 
-static bool validSelection(const char* function, float pixel_tolerance, float coarsen_ratio, float fov_y,
-                           float viewport_height) {
-    if (pixel_tolerance > 0 && coarsen_ratio > 0 && coarsen_ratio <= 1 && fov_y > 0 && fov_y < 3.14159f &&
-        viewport_height > 0)
+static bool validSelection(const char* function, const float position[3], float pixel_tolerance,
+                           float coarsen_ratio, float fov_y, float viewport_height) {
+    if (!inRange(position, 3)) {
+        failWith(AGLOD_INVALID_ARGUMENT, std::string(function) + ": camera position must be finite, within 1e18");
+        return false;
+    }
+    if (pixel_tolerance > 0 && std::isfinite(pixel_tolerance) && coarsen_ratio > 0 && coarsen_ratio <= 1 &&
+        fov_y > 0 && fov_y < 3.14159f && viewport_height > 0 && std::isfinite(viewport_height))
         return true;
     failWith(AGLOD_INVALID_ARGUMENT, std::string(function) +
-                                         ": need pixel_tolerance > 0, coarsen_ratio in (0,1], fov_y in (0,pi), "
-                                         "viewport_height > 0");
+                                         ": need finite pixel_tolerance > 0, coarsen_ratio in (0,1], fov_y in (0,pi), "
+                                         "finite viewport_height > 0");
     return false;
 }
 
@@ -211,7 +216,8 @@ static void fillCut(const Selector& s, aglod_cut* out) {
 aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera, float pixel_tolerance,
                           float coarsen_ratio, aglod_cut* out) {
     if (!selector || !camera || !out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_select: NULL argument");
-    if (!validSelection("aglod_select", pixel_tolerance, coarsen_ratio, camera->fov_y, camera->viewport_height))
+    if (!validSelection("aglod_select", camera->position, pixel_tolerance, coarsen_ratio, camera->fov_y,
+                        camera->viewport_height))
         return AGLOD_INVALID_ARGUMENT;
     Camera c;
     std::memcpy(c.position, camera->position, sizeof(c.position));
@@ -225,7 +231,8 @@ aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera, 
 aglod_status aglod_select_view(aglod_selector* selector, const aglod_view_camera* camera, float pixel_tolerance,
                                float coarsen_ratio, aglod_cut* out) {
     if (!selector || !camera || !out) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_select_view: NULL argument");
-    if (!validSelection("aglod_select_view", pixel_tolerance, coarsen_ratio, camera->fov_y, camera->viewport_height))
+    if (!validSelection("aglod_select_view", camera->position, pixel_tolerance, coarsen_ratio, camera->fov_y,
+                        camera->viewport_height))
         return AGLOD_INVALID_ARGUMENT;
     const float* f = camera->forward;
     const float* u = camera->up;
@@ -235,9 +242,9 @@ aglod_status aglod_select_view(aglod_selector* selector, const aglod_view_camera
                  cz = double(f[0]) * u[1] - double(f[1]) * u[0];
     const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (fl * ul);
     const float far = camera->far_distance == 0.0f ? INFINITY : camera->far_distance;
-    if (!(fl > 0) || !std::isfinite(fl) || !(ul > 0) || !std::isfinite(ul) || !(sine > 1e-6) ||
-        !(camera->aspect > 0) || !std::isfinite(camera->aspect) || !(camera->near_distance >= 0) ||
-        !(far > camera->near_distance))
+    if (!inRange(f, 3) || !inRange(u, 3) || !(fl > 0) || !std::isfinite(fl) || !(ul > 0) || !std::isfinite(ul) ||
+        !(sine > 1e-6) || !(camera->aspect > 0) || !std::isfinite(camera->aspect) ||
+        !(camera->near_distance >= 0) || !std::isfinite(camera->near_distance) || !(far > camera->near_distance))
         return failWith(AGLOD_INVALID_ARGUMENT,
                         "aglod_select_view: need a finite non-zero forward, up not parallel to it, aspect > 0, "
                         "near_distance >= 0 and far_distance > near_distance (0 = none)");

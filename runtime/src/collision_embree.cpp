@@ -18,6 +18,17 @@
 
 namespace aggrelod::runtime {
 
+namespace {
+/// Embree asserts (and aborts the process) on ray coordinates beyond about 1.8e18 and on
+/// non-finite ones: such rays are refused here (no hit).
+bool rayInRange(const float o[3], const float d[3], float maxDistance) {
+    constexpr float kLimit = 1e18f;
+    for (int k = 0; k < 3; ++k)
+        if (!(std::fabs(o[k]) <= kLimit) || !(std::fabs(d[k]) <= kLimit)) return false;
+    return maxDistance >= 0;  // +inf allowed, NaN not
+}
+}  // namespace
+
 void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out) {
     out.clear();
     // Leaves are finest, then the per-object LODs, then level 0: rank(leaf) = -2,
@@ -166,6 +177,7 @@ struct CollisionWorld::Impl {
 
     bool intersect(const float o[3], const float d[3], float maxDistance, CollisionHit& hit) const {
         if (!scene || failed || !committed) return false;
+        if (!rayInRange(o, d, maxDistance)) return false;
         const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         if (!(len > 0) || !(maxDistance >= 0)) return false;
         RTCRayHit rh;
@@ -244,6 +256,7 @@ struct CollisionWorld::Impl {
 
     bool occluded(const float o[3], const float d[3], float maxDistance) const {
         if (!scene || failed || !committed) return false;
+        if (!rayInRange(o, d, maxDistance)) return false;
         const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         if (!(len > 0) || !(maxDistance >= 0)) return false;
         RTCRay ray;

@@ -7,7 +7,11 @@
 #include "aglod_layout.h"
 #include "mapped_file.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
 #include <vector>
 
 namespace aggrelod::runtime {
@@ -94,6 +98,9 @@ struct FileValidator {
         if (total > size)
             return fail(FileStatus::Truncated, "header says " + std::to_string(total) +
                                                    " bytes, only " + std::to_string(size) + " present");
+        if (total < size)
+            return fail(FileStatus::BadSection, std::to_string(size - total) + " bytes after the declared end (" +
+                                                    std::to_string(total) + " bytes)");
         if (total < kHeaderSize || total % kTotalSizeMultiple != 0)
             return fail(FileStatus::BadSection, "total size " + std::to_string(total) +
                                                     " is not a multiple of 32 of at least 64");
@@ -177,6 +184,27 @@ struct FileValidator {
         return first <= size && count <= size - first;
     }
 
+    /// The non-empty ranges [first, first + count) of the nodes in one array must not overlap:
+    /// shared ranges would let a small file cost time and memory quadratic in its size.
+    FileStatus checkDisjoint(const char* what, uint32_t NodeRecord::*first, uint32_t NodeRecord::*count) {
+        const Span<NodeRecord> nodes = out.nodes_;
+        std::vector<std::pair<uint32_t, uint32_t>> ranges;  // (first, node)
+        for (uint64_t i = 0; i < nodes.size; ++i)
+            if (nodes[i].*count != 0) ranges.emplace_back(nodes[i].*first, uint32_t(i));
+        std::sort(ranges.begin(), ranges.end());
+        for (size_t k = 1; k < ranges.size(); ++k) {
+            const NodeRecord& previous = nodes[ranges[k - 1].second];
+            if (uint64_t(previous.*first) + (previous.*count) > ranges[k].first)
+                return fail(FileStatus::BadValue, "nodes " + std::to_string(ranges[k - 1].second) + " and " +
+                                                      std::to_string(ranges[k].second) + " share " + what);
+        }
+        return FileStatus::Ok;
+    }
+
+    /// Largest magnitude of a stored coordinate, box, sphere, error or delta: inside what ray
+    /// tracing (Embree) accepts, far above what a bake writes.
+    static constexpr float kMaxMagnitude = 1e18f;
+
     FileStatus checkRanges() {
         const Span<NodeRecord> nodes = out.nodes_;
         const uint64_t n = nodes.size;
@@ -199,17 +227,15 @@ struct FileValidator {
             if (r.indexCount % 3 != 0)
                 return fail(FileStatus::BadValue, where() + ": index count " + std::to_string(r.indexCount) +
                                                       " is not a multiple of 3");
-            for (uint32_t k = 0; k < r.indexCount; ++k)
-                if (out.indices_[r.firstIndex + k] >= r.vertexCount)
-                    return fail(FileStatus::IndexOutOfRange,
-                                where() + ": triangle index " + std::to_string(out.indices_[r.firstIndex + k]) +
-                                    " >= its vertex count " + std::to_string(r.vertexCount));
             const float values[] = {r.delta, r.geometricError, r.boundsMin[0], r.boundsMin[1],
                                     r.boundsMin[2], r.boundsMax[0], r.boundsMax[1], r.boundsMax[2],
                                     r.sphereCenter[0], r.sphereCenter[1], r.sphereCenter[2],
                                     r.sphereRadius};
-            for (float v : values)
+            for (float v : values) {
                 if (!std::isfinite(v)) return fail(FileStatus::BadValue, where() + ": NaN or infinite value");
+                if (std::fabs(v) > kMaxMagnitude)
+                    return fail(FileStatus::BadValue, where() + ": value " + std::to_string(v) + " beyond 1e18");
+            }
             if (r.geometricError < 0 || r.sphereRadius < 0 || r.delta < 0)
                 return fail(FileStatus::BadValue, where() + ": negative error, radius or delta");
             for (int k = 0; k < 3; ++k)
@@ -228,9 +254,29 @@ struct FileValidator {
             if (!leaf && r.level != kObjectLodLevel && r.level != kCoarserLevel && r.level >= kMaxAggregateLevel)
                 return fail(FileStatus::BadValue, where() + ": level " + std::to_string(r.level));
         }
+        if (FileStatus s = checkDisjoint("vertices", &NodeRecord::firstVertex, &NodeRecord::vertexCount);
+            s != FileStatus::Ok)
+            return s;
+        if (FileStatus s = checkDisjoint("triangles", &NodeRecord::firstIndex, &NodeRecord::indexCount);
+            s != FileStatus::Ok)
+            return s;
+        if (FileStatus s = checkDisjoint("source objects", &NodeRecord::firstSource, &NodeRecord::sourceCount);
+            s != FileStatus::Ok)
+            return s;
+        // Disjoint ranges: this pass reads each index at most once.
+        for (uint64_t i = 0; i < n; ++i) {
+            const NodeRecord& r = nodes[i];
+            for (uint32_t k = 0; k < r.indexCount; ++k)
+                if (out.indices_[r.firstIndex + k] >= r.vertexCount)
+                    return fail(FileStatus::IndexOutOfRange,
+                                "node " + std::to_string(i) + ": triangle index " +
+                                    std::to_string(out.indices_[r.firstIndex + k]) + " >= its vertex count " +
+                                    std::to_string(r.vertexCount));
+        }
         for (size_t i = 0; i < out.positions_.size; ++i)
-            if (!std::isfinite(out.positions_[i]))
-                return fail(FileStatus::BadValue, "vertex " + std::to_string(i / 3) + ": NaN or infinite coordinate");
+            if (!(std::fabs(out.positions_[i]) <= kMaxMagnitude))
+                return fail(FileStatus::BadValue, "vertex " + std::to_string(i / 3) +
+                                                      ": NaN, infinite or beyond 1e18 coordinate");
         for (size_t v = 0; v < out.normals_.size / 3; ++v) {
             const float* nv = out.normals_.data + 3 * v;
             const float length2 = nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2];
@@ -285,6 +331,15 @@ struct FileValidator {
         return true;
     }
 
+    /// Order of levels from fine to coarse: leaves, per-object LODs, aggregate levels 0, 1, ...
+    /// A child's level must be below its parent's (per-object LODs may also chain; a coarser
+    /// version ranks as the aggregate it simplifies).
+    static int64_t levelRank(uint32_t level) {
+        if (level == kLeafLevel) return -2;
+        if (level == kObjectLodLevel) return -1;
+        return level;
+    }
+
     FileStatus checkTree() {
         const Span<NodeRecord> nodes = out.nodes_;
         const uint32_t n = static_cast<uint32_t>(nodes.size);
@@ -292,16 +347,48 @@ struct FileValidator {
         if (n == 0) return fail(FileStatus::BadTree, "no nodes");
         // Parent/child consistency: each non-root is listed exactly once, by its parent.
         std::vector<uint32_t> references(n, 0);
+        // A coarser version ranks as the aggregate it simplifies: the end of its chain of
+        // single children (memoised, so the walk is linear in the node count).
+        constexpr int64_t kUnknown = std::numeric_limits<int64_t>::min();
+        std::vector<int64_t> rank(n, kUnknown);
+        std::vector<uint32_t> path;
+        for (uint32_t i = 0; i < n; ++i) {
+            path.clear();
+            uint32_t at = i;
+            int64_t found = kUnknown;
+            while (found == kUnknown) {
+                if (rank[at] != kUnknown) found = rank[at];
+                else if (nodes[at].level != kCoarserLevel) found = levelRank(nodes[at].level);
+                else if (path.size() > n || out.children(at).size != 1)
+                    return fail(FileStatus::BadTree, "node " + std::to_string(i) + ": a coarser version that is not "
+                                                     "above exactly one chain of single children");
+                else {
+                    path.push_back(at);
+                    at = out.children(at)[0];
+                }
+            }
+            for (uint32_t p : path) rank[p] = found;
+            rank[i] = found;
+        }
         uint64_t parentless = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const NodeRecord& r = nodes[i];
             if (r.parent == kNoIndex) ++parentless;
             for (uint32_t c : out.children(i)) {
+                if (r.level == kCoarserLevel && (nodes[c].level == kLeafLevel || nodes[c].level == kObjectLodLevel))
+                    return fail(FileStatus::BadTree, "node " + std::to_string(i) + ": a coarser version above a " +
+                                                         (nodes[c].level == kLeafLevel ? "leaf" : "per-object LOD"));
                 if (nodes[c].parent != i)
                     return fail(FileStatus::BadTree, "node " + std::to_string(i) + ": child " + std::to_string(c) +
                                                          " has parent " + std::to_string(nodes[c].parent));
                 if (++references[c] > 1)
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + " is listed twice as a child");
+                // Per-object LODs form chains: one may stand under another.
+                if (rank[c] >= rank[i] && r.level != kCoarserLevel &&
+                    !(r.level == kObjectLodLevel && nodes[c].level == kObjectLodLevel))
+                    return fail(FileStatus::BadTree, "node " + std::to_string(c) + ": level " +
+                                                         std::to_string(nodes[c].level) + " is not below its parent's (" +
+                                                         std::to_string(r.level) + ")");
                 if (nodes[c].geometricError > r.geometricError)
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + ": error " +
                                                          std::to_string(nodes[c].geometricError) +

@@ -1,0 +1,167 @@
+// The output set of `aggrelod bake`: outputs never overwrite the input or each other, nothing
+// planted in OUTDIR is followed, a failing move puts the old set back, stale temporaries are
+// removed, and a bake killed at any moment leaves the complete old or the complete new set
+// with no process of it left running.
+#include "test_support.h"
+
+#include <aggrelod/samples.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <random>
+#include <spawn.h>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace aggrelod;
+using namespace aggrelod::testing;
+
+namespace {
+
+RawMesh cube(const std::string& name, double x0) {
+    return rawMeshOf(samples::makeBox(name, {x0, 0, 0}, {x0 + 1, 1, 1}));
+}
+
+std::string threeCubes() { return makeGlb({cube("a", 0), cube("b", 1.5), cube("c", 5)}); }
+
+RunResult bake(const fs::path& scene, const fs::path& out, const fs::path& dir, std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv = {AGGRELOD_CLI, "bake", scene.string(), "-o", out.string(), "-q"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return runProgram(argv, dir);
+}
+
+const std::vector<std::string> kSet = {"levels.glb", "proxies.glb", "scene.aglod"};
+
+std::vector<std::string> readSet(const fs::path& out) {
+    std::vector<std::string> files;
+    for (const auto& name : kSet) files.push_back(fs::exists(out / name) ? readFile(out / name) : std::string("<missing>"));
+    return files;
+}
+
+}  // namespace
+
+TEST(OutputSet, AnInputNamedLikeAnOutputIsNotOverwritten) {
+    const fs::path dir = freshTestDir(currentTestName());
+    fs::create_directories(dir / "out");
+    const std::string input = threeCubes();
+    writeFile(dir / "out" / "levels.glb", input);
+    const RunResult r = bake(dir / "out" / "levels.glb", dir / "out", dir);
+    EXPECT_EQ(r.exitCode, 1) << r.describe();
+    EXPECT_NE(r.err.find("would be overwritten"), std::string::npos) << r.describe();
+    EXPECT_EQ(readFile(dir / "out" / "levels.glb"), input);
+
+    writeFile(dir / "in.glb", input);
+    const RunResult stats = bake(dir / "in.glb", dir / "out2", dir, {"--stats", (dir / "in.glb").string()});
+    EXPECT_EQ(stats.exitCode, 1) << stats.describe();
+    EXPECT_EQ(readFile(dir / "in.glb"), input);
+    const RunResult same = bake(dir / "in.glb", dir / "out2", dir, {"--stats", (dir / "out2" / "scene.aglod").string()});
+    EXPECT_EQ(same.exitCode, 1) << same.describe();
+    EXPECT_NE(same.err.find("are the same file"), std::string::npos) << same.describe();
+}
+
+TEST(OutputSet, APlantedSymlinkIsNotFollowed) {
+    const fs::path dir = freshTestDir(currentTestName());
+    fs::create_directories(dir / "out");
+    writeFile(dir / "victim.txt", "precious");
+    for (const char* name : {"levels.glb.tmp", "proxies.glb.tmp", "scene.aglod.tmp"})
+        fs::create_symlink(dir / "victim.txt", dir / "out" / name);
+    writeFile(dir / "in.glb", threeCubes());
+    const RunResult r = bake(dir / "in.glb", dir / "out", dir);
+    EXPECT_EQ(r.exitCode, 0) << r.describe();
+    EXPECT_EQ(readFile(dir / "victim.txt"), "precious");
+    EXPECT_FALSE(fs::is_symlink(dir / "out" / "levels.glb"));
+    EXPECT_TRUE(fs::is_regular_file(dir / "out" / "levels.glb"));
+}
+
+TEST(OutputSet, AFailingMovePutsTheOldSetBack) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "in.glb", threeCubes());
+    ASSERT_EQ(bake(dir / "in.glb", dir / "out", dir, {"--levels", "2"}).exitCode, 0);
+    const std::vector<std::string> old = readSet(dir / "out");
+    // scene.aglod, moved last, cannot be replaced: a non-empty folder took its place.
+    fs::remove(dir / "out" / "scene.aglod");
+    fs::create_directories(dir / "out" / "scene.aglod" / "x");
+    const RunResult r = bake(dir / "in.glb", dir / "out", dir, {"--levels", "3"});
+    EXPECT_EQ(r.exitCode, 2) << r.describe();
+    EXPECT_NE(r.err.find("cannot replace"), std::string::npos) << r.describe();
+    EXPECT_TRUE(readFile(dir / "out" / "levels.glb") == old[0]) << "levels.glb is not the old one";
+    EXPECT_TRUE(readFile(dir / "out" / "proxies.glb") == old[1]) << "proxies.glb is not the old one";
+    EXPECT_TRUE(fs::is_directory(dir / "out" / "scene.aglod" / "x"));
+    for (const auto& e : fs::directory_iterator(dir / "out"))
+        EXPECT_EQ(e.path().filename().string().rfind(".aggrelod-tmp-", 0), std::string::npos) << e.path();
+}
+
+TEST(OutputSet, StaleTemporariesAreRemoved) {
+    const fs::path dir = freshTestDir(currentTestName());
+    fs::create_directories(dir / "out" / ".aggrelod-tmp-999999999-dead01");  // no such process
+    writeFile(dir / "out" / ".aggrelod-tmp-999999999-dead01" / "levels.glb", "half written");
+    writeFile(dir / "out" / "tiles.tmp", "old temporary");
+    const fs::path live = dir / "out" / (".aggrelod-tmp-" + std::to_string(::getpid()) + "-alive1");
+    fs::create_directories(live);  // a bake that still runs (this process): left alone
+    writeFile(dir / "in.glb", threeCubes());
+    const RunResult r = bake(dir / "in.glb", dir / "out", dir);
+    EXPECT_EQ(r.exitCode, 0) << r.describe();
+    EXPECT_FALSE(fs::exists(dir / "out" / ".aggrelod-tmp-999999999-dead01"));
+    EXPECT_FALSE(fs::exists(dir / "out" / "tiles.tmp"));
+    EXPECT_TRUE(fs::exists(live));
+}
+
+TEST(OutputSet, ABakeKilledAtAnyMomentLeavesTheOldOrTheNewSet) {
+    const fs::path dir = freshTestDir(currentTestName());
+    // Enough objects for the bake to take a while (kill times spread over all its stages).
+    std::vector<RawMesh> cubes;
+    for (int i = 0; i < 30; ++i) cubes.push_back(cube("c" + std::to_string(i), 1.7 * i + 0.1 * (i % 3)));
+    writeFile(dir / "in.glb", makeGlb(cubes));
+    // The two sets: --levels 2 (old) and --levels 3 (new), each baked once to compare with.
+    ASSERT_EQ(bake(dir / "in.glb", dir / "old", dir, {"--levels", "2"}).exitCode, 0);
+    const auto start = std::chrono::steady_clock::now();
+    ASSERT_EQ(bake(dir / "in.glb", dir / "new", dir, {"--levels", "3"}).exitCode, 0);
+    const double duration = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::vector<std::string> oldSet = readSet(dir / "old"), newSet = readSet(dir / "new");
+    ASSERT_FALSE(oldSet[0] == newSet[0]);
+
+    ASSERT_EQ(::prctl(PR_SET_CHILD_SUBREAPER, 1), 0);  // orphans of the bake become ours
+    std::mt19937 random(18);
+    std::uniform_real_distribution<double> at(0.0, 1.3 * duration);
+    int oldSeen = 0, newSeen = 0;
+    for (int run = 0; run < 10; ++run) {
+        fs::remove_all(dir / "out");
+        fs::create_directories(dir / "out");
+        for (const auto& name : kSet) fs::copy_file(dir / "old" / name, dir / "out" / name);
+        const std::string in = (dir / "in.glb").string(), out = (dir / "out").string();
+        std::vector<std::string> argv = {AGGRELOD_CLI, "bake", in, "-o", out, "-q", "--levels", "3"};
+        std::vector<char*> args;
+        for (auto& a : argv) args.push_back(a.data());
+        args.push_back(nullptr);
+        pid_t pid = 0;
+        ASSERT_EQ(posix_spawn(&pid, args[0], nullptr, nullptr, args.data(), environ), 0);
+        const double killAt = at(random);
+        std::this_thread::sleep_for(std::chrono::duration<double>(killAt));
+        ::kill(pid, SIGKILL);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        // One second later no process of the bake is left (a TetGen child dies with it).
+        std::this_thread::sleep_for(std::chrono::seconds(1));
+        int leftovers = 0;  // still running (dead ones, reaped here, are fine)
+        for (pid_t p;;) {
+            p = ::waitpid(-1, &status, WNOHANG);
+            if (p > 0) continue;
+            if (p == 0) ++leftovers;
+            break;
+        }
+        EXPECT_EQ(leftovers, 0) << "run " << run << ": a process of the bake outlived it (killed at " << killAt << " s)";
+        const std::vector<std::string> now = readSet(dir / "out");
+        if (now == oldSet) ++oldSeen;
+        else if (now == newSet) ++newSeen;
+        else ADD_FAILURE() << "run " << run << ", killed at " << killAt << " s: a mixed or damaged output set";
+    }
+    ::prctl(PR_SET_CHILD_SUBREAPER, 0);
+    std::printf("bake %.2f s; killed 10 times: old set %d, new set %d\n", duration, oldSeen, newSeen);
+}
