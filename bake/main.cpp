@@ -711,8 +711,9 @@ CLI::App* addRenderCommand(CLI::App& app, cli::RenderOptions& o) {
     cmd->add_option("file", o.input, "OUTDIR/scene.aglod or OUTDIR/levels.glb written by `aggrelod bake`")->required();
     cmd->add_option("-o,--output", o.output, "Output PNG")->required();
     CLI::Option* level = cmd->add_option(
-        "--level", o.level, "Level to draw: a level number or 'originals' (default: originals for .aglod, the first "
-                            "level for levels.glb)");
+        "--level", o.level, "Level to draw: a level number, 'originals', 'object-lods' or 'drawn-at-N' (.aglod: what "
+                            "the runtime draws from N = 4 or 16 scene diameters; default: originals for .aglod, the "
+                            "first level for levels.glb)");
     CLI::Option* sheet = cmd->add_flag("--sheet", o.sheet, "Draw every level (and the originals) side by side, labelled");
     level->excludes(sheet);
     cmd->add_option("--camera", o.camera,

@@ -8,6 +8,7 @@
 #include "scene_io.h"
 
 #include <aggrelod/collision.h>
+#include <aggrelod/selection.h>
 
 #include <algorithm>
 #include <cctype>
@@ -200,6 +201,33 @@ bool RenderScene::open(const std::string& path, std::string& error) {
         panel.label = "LEVEL " + std::to_string(level) + "  DELTA " + formatDelta(delta);
         panels_.push_back(std::move(panel));
     }
+    // What the runtime draws from far away, seen up close: a camera on the diagonal at N
+    // scene diameters from the centre of the originals' box.
+    float lo[3], hi[3];
+    bounds(lo, hi);
+    const float diameter = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    runtime::Selector selector(file_);
+    runtime::SelectionSettings settings;
+    settings.pixelTolerance = 1.0f;
+    settings.coarsenRatio = 1.0f;
+    for (uint32_t distance : kDrawnAtDistances) {
+        runtime::Camera camera;
+        for (int k = 0; k < 3; ++k)
+            camera.position[k] = 0.5f * (lo[k] + hi[k]) + float(distance) * diameter / std::sqrt(3.0f);
+        camera.fovY = float(3.14159265358979323846 / 3);
+        camera.viewportHeight = 1080.0f;
+        selector.reset();
+        selector.selectFull(camera, settings);
+        Panel panel;
+        panel.level = kDrawnAtLevel + distance;
+        panel.nodes.assign(selector.cut().begin(), selector.cut().end());
+        std::sort(panel.nodes.begin(), panel.nodes.end());
+        size_t triangles = 0;
+        for (uint32_t n : panel.nodes) triangles += file_.node(n).indexCount / 3;
+        panel.label = "FROM " + std::to_string(distance) + " DIAM  " + std::to_string(triangles) + " TRI";
+        panels_.push_back(std::move(panel));
+    }
     colours_.resize(size_t(file_.nodeCount()) * 3);
     for (uint32_t i = 0; i < file_.nodeCount(); ++i) {
         const unsigned char* c = file_.isLeaf(i) ? kOriginalGrey : kPalette[i % kPaletteSize];
@@ -220,6 +248,7 @@ std::string RenderScene::levelList() const {
         if (!s.empty()) s += ", ";
         s += p.level == kLeafLevel                ? std::string("originals")
              : p.level == runtime::kObjectLodLevel ? std::string("object-lods")
+             : p.level > kDrawnAtLevel             ? "drawn-at-" + std::to_string(p.level - kDrawnAtLevel)
                                                    : std::to_string(p.level);
     }
     return s;

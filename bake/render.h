@@ -32,9 +32,16 @@ struct RgbImage {
 };
 
 /// One picture the scene offers: the originals or one level.
+/// Panel level of "what the runtime draws from N scene diameters away": kDrawnAtLevel + N.
+constexpr uint32_t kDrawnAtLevel = 0xFF80u;
+/// The distances (scene diameters from the centre) of the drawn-cut panels of a .aglod.
+constexpr uint32_t kDrawnAtDistances[] = {4, 16};
+
 struct Panel {
     std::string label;            ///< e.g. "LEVEL 2  DELTA 0.5" or "ORIGINALS"
-    uint32_t level = 0;           ///< runtime::kLeafLevel for the originals, kObjectLodLevel for the per-object LODs
+    /// runtime::kLeafLevel for the originals, kObjectLodLevel for the per-object LODs,
+    /// kDrawnAtLevel + N for the cut drawn from N scene diameters
+    uint32_t level = 0;
     std::vector<uint32_t> nodes;  ///< the cut: runtime-file nodes drawn
 };
 
@@ -48,7 +55,9 @@ public:
     RenderScene& operator=(const RenderScene&) = delete;
 
     /// Opens a .aglod (panels: the originals, the coarsest per-object LODs when the file has
-    /// any, then every aggregate level) or a levels.glb (panels:
+    /// any, every aggregate level, then the cut the runtime's selection draws for a camera at
+    /// kDrawnAtDistances scene diameters from the centre, 1080 px high, 60 degree field of
+    /// view, tau 1 px: proxies of any kind, coarser versions included) or a levels.glb (panels:
     /// every level). False with a message naming the file and the problem.
     bool open(const std::string& path, std::string& error);
 

@@ -63,11 +63,16 @@ int runRender(const RenderOptions& o) {
         uint32_t level = runtime::kLeafLevel;
         if (o.level == "object-lods") {
             level = runtime::kObjectLodLevel;
+        } else if (o.level.rfind("drawn-at-", 0) == 0) {
+            char* end = nullptr;
+            const long n = std::strtol(o.level.c_str() + 9, &end, 10);
+            level = *end == '\0' && n > 0 && n < 64 ? render::kDrawnAtLevel + uint32_t(n) : runtime::kLeafLevel - 1;
         } else if (o.level != "originals") {
             char* end = nullptr;
             const long k = std::strtol(o.level.c_str(), &end, 10);
             if (o.level.empty() || *end != '\0' || k < 0 || k >= long(runtime::kMaxAggregateLevel)) {
-                printError("--level '" + o.level + "': expected 'originals', 'object-lods' or a level number");
+                printError("--level '" + o.level +
+                           "': expected 'originals', 'object-lods', 'drawn-at-N' or a level number");
                 return kUsage;
             }
             level = uint32_t(k);

@@ -7,6 +7,7 @@
 // (surface_colors.cpp), and makes bounds nested and errors monotone so that
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
 #include "conservative_simplify.h"
+#include "convex_hull.h"
 #include "mesh_optimize.h"
 #include "mesh_preparation.h"
 #include "parallel_for.h"
@@ -19,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace aggrelod {
 
@@ -286,11 +288,13 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
 /// (its parent's certified error; infinity for a root, then up to the aggregate's diagonal).
 /// A level's proxy fits a budget near the fill's own error, the next level's error is that
 /// of a wider fill; these versions fill the gap, so that at any distance the cut can draw a
-/// version of the group whose error is near what the pixel tolerance allows. A version is
-/// kept as a per-object LOD level is: it does not intersect itself, its certified error fits
-/// its budget (the node's error plus twice its push-out allowance) and stays below the
-/// ceiling, and it has at most 80 % of the triangles of the finer one kept. Finest first.
-std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactProxy& proxy,
+/// version of the group whose error is near what the pixel tolerance allows. Each target is
+/// tried on the proxy and, for a proxy of one shell, on its convex hull (both simplified in
+/// one pass each); of the two that fit, the one with the smaller error. A version is kept as a per-object LOD
+/// level is: it does not intersect itself, its certified error fits its budget (the node's
+/// error plus twice its push-out allowance) and stays below the ceiling, and it has at most
+/// 80 % of the triangles of the finer one kept. Finest first.
+std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactProxy& proxy, bool oneShell,
                                         const std::vector<const detail::PreparedOriginal*>& originals, double ceiling,
                                         const ProxySettings& settings) {
     std::vector<HierarchyNode> chain;
@@ -304,27 +308,44 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
     std::vector<double> allowances;  // ascending push-outs above the proxy
     for (double t = base * kChainRatio; t < top; t *= kChainRatio) allowances.push_back(t - own);
     if (allowances.empty()) return chain;
-    EnclosureSeries series(proxy.positions, proxy.indices, allowances);
+    // Two sources of versions: the proxy simplified further, and (for a proxy of one shell)
+    // its convex hull simplified. The hull starts coarser, but where edge collapses of the
+    // proxy get stuck among concave edges, the hull's go on down to a tetrahedron.
+    std::vector<std::unique_ptr<EnclosureSeries>> sources;
+    sources.push_back(std::make_unique<EnclosureSeries>(proxy.positions, proxy.indices, allowances));
+    ExactProxy hull;
+    if (oneShell && detail::convexHull3(proxy.positions, hull.positions, hull.indices) &&
+        hull.indices.size() < proxy.indices.size())
+        sources.push_back(std::make_unique<EnclosureSeries>(hull.positions, hull.indices, allowances));
     size_t finerTriangles = proxy.indices.size() / 3;
-    for (size_t i = 0; i < series.size() && int(chain.size()) < settings.coarserCount; ++i) {
-        const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, finerTriangles);
-        if (!clean) continue;
-        const detail::ConservativeSnapshot& s = *clean;
-        const size_t triangles = s.indices.size() / 3;
-        HierarchyNode n;
-        n.coarserStep = static_cast<int>(chain.size()) + 1;
-        n.sources = node.sources;
-        n.delta = node.delta;
-        n.budget = own + 2 * allowances[i];
-        n.positions = toFloats(s.positions);
-        n.indices = s.indices;
-        n.exactTriangleCount = node.exactTriangleCount;
-        n.error = measureEnclosure(s.positions, n.positions, n.indices, originals,
-                                   settings.toleranceFraction * (own + allowances[i]), settings,
-                                   std::min(n.budget, ceiling));
-        if (!(n.error.bound() <= n.budget) || !(n.error.bound() < ceiling)) continue;
-        finerTriangles = triangles;
-        chain.push_back(std::move(n));
+    for (size_t i = 0; i < allowances.size() && int(chain.size()) < settings.coarserCount; ++i) {
+        const double budget = own + 2 * allowances[i];
+        HierarchyNode best;
+        for (const auto& series : sources) {
+            const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(*series, i, finerTriangles);
+            if (!clean) continue;
+            HierarchyNode n;
+            n.positions = toFloats(clean->positions);
+            n.indices = clean->indices;
+            n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals,
+                                       settings.toleranceFraction * (own + allowances[i]), settings,
+                                       std::min(budget, ceiling));
+            if (!(n.error.bound() <= budget && n.error.bound() < ceiling)) continue;
+            // Of two that fit, the one with the smaller error, unless the other is also
+            // lighter: the coarser one is reached at a later target, while a version that
+            // takes the whole budget at once is selectable only from farther away.
+            const bool better = best.indices.empty() || n.error.bound() < best.error.bound() ||
+                                (n.error.bound() <= best.error.bound() && n.indices.size() < best.indices.size());
+            if (better) best = std::move(n);
+        }
+        if (best.indices.empty()) continue;
+        best.coarserStep = static_cast<int>(chain.size()) + 1;
+        best.sources = node.sources;
+        best.delta = node.delta;
+        best.budget = budget;
+        best.exactTriangleCount = node.exactTriangleCount;
+        finerTriangles = best.indices.size() / 3;
+        chain.push_back(std::move(best));
     }
     return chain;
 }
@@ -541,7 +562,8 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
             originals.push_back(&prepared[o]);
             sourceObjects.push_back(&objects[o]);
         }
-        coarser[i] = coarserChain(n, exactProxies[i], originals, ceiling, settings);
+        const bool oneShell = n.firstLevel >= 0 && aggregateOf(n).componentCount == 1;
+        coarser[i] = coarserChain(n, exactProxies[i], oneShell, originals, ceiling, settings);
         exactProxies[i] = ExactProxy{};
         for (HierarchyNode& c : coarser[i]) {
             detail::nearestSurfaceColors(c.positions, c.indices, sourceObjects, c.faceColors);

@@ -196,9 +196,11 @@ TEST(Render, SheetHasOnePanelPerLevel) {
     std::set<std::string> glbLevels;
     for (const aggrelod::InputObject& o : glb.objects) glbLevels.insert(o.name.substr(0, o.name.find('_')));
 
-    // .aglod: the originals, the per-object LODs and every level; levels.glb: every level.
+    // .aglod: the originals, the per-object LODs, every level and the cuts drawn from far
+    // away; levels.glb: every level.
     struct Case { fs::path input; size_t panels; };
-    for (const Case& c : {Case{aglodPath(), levels + 1 + (objectLods ? 1 : 0)}, Case{levelsPath(), glbLevels.size()}}) {
+    const size_t drawnAt = std::size(render::kDrawnAtDistances);
+    for (const Case& c : {Case{aglodPath(), levels + 1 + (objectLods ? 1 : 0) + drawnAt}, Case{levelsPath(), glbLevels.size()}}) {
         render::RenderScene scene;
         ASSERT_TRUE(scene.open(c.input.string(), message)) << message;
         EXPECT_EQ(scene.panels().size(), c.panels) << c.input;
@@ -211,6 +213,24 @@ TEST(Render, SheetHasOnePanelPerLevel) {
         const int rows = int((c.panels + 2) / 3);
         EXPECT_EQ(pngSize(readFile(out)), std::make_pair(3 * 64 + 4 * 4, rows * (48 + 24) + (rows + 1) * 4)) << c.input;
         EXPECT_NE(r.out.find(std::to_string(c.panels) + " panels"), std::string::npos) << r.out;
+    }
+    // The drawn-cut panels are the runtime's selection: they cover every object once, and the
+    // farther one draws no more triangles than the nearer one.
+    render::RenderScene scene;
+    ASSERT_TRUE(scene.open(aglodPath().string(), message)) << message;
+    size_t previous = SIZE_MAX;
+    for (uint32_t distance : render::kDrawnAtDistances) {
+        const int panel = scene.panelOfLevel(render::kDrawnAtLevel + distance);
+        ASSERT_GE(panel, 0) << distance;
+        std::vector<int> covered(file.objectCount(), 0);
+        size_t triangles = 0;
+        for (uint32_t n : scene.panels()[size_t(panel)].nodes) {
+            for (uint32_t o : file.sources(n)) ++covered[o];
+            triangles += file.node(n).indexCount / 3;
+        }
+        for (uint32_t o = 0; o < file.objectCount(); ++o) EXPECT_EQ(covered[o], 1) << "object " << o;
+        EXPECT_LE(triangles, previous) << distance << " diameters";
+        previous = triangles;
     }
 
     // composeSheet puts each panel's pixels at its cell.
