@@ -18,8 +18,10 @@ packages=(
   libglm-dev libtinygltf-dev libembree-dev libtet1.5-dev
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev
   libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
+  libompl-dev
   chromium clang libclang-rt-14-dev python3
 )
+# libompl-dev: motion planning on the hierarchy (planning/, `aggrelod plan`).
 # clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz; python3: their
 # mutation corpora (tests/fuzz/mutate.py).
 # chromium: the web viewer test (tests/web) loads samples/web in headless Chromium.

@@ -1890,11 +1890,25 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 extras["leaf"] = tinygltf::Value(true);
             } else {
                 // A per-object LOD node has no level: it is named and tinted as below level 0.
-                const bool objectLod = n.objectLod >= 1;
+                // A coarser version of an aggregate neither: it is named after its step and
+                // tinted as the level of the aggregate it simplifies.
+                const bool objectLod = n.objectLod >= 1, coarser = n.coarserStep >= 1;
+                int tintLevel = objectLod ? 0 : n.firstLevel;
+                if (coarser) {
+                    size_t below = i;
+                    while (nodes.nodes[below].coarserStep >= 1) below = nodes.nodes[below].children.front();
+                    tintLevel = std::max(nodes.nodes[below].firstLevel, 0);
+                }
                 node.name = "node" + std::to_string(i) +
-                            (objectLod ? "_object_lod" + std::to_string(n.objectLod) : "_level" + std::to_string(n.firstLevel));
+                            (objectLod ? "_object_lod" + std::to_string(n.objectLod)
+                             : coarser ? "_coarser" + std::to_string(n.coarserStep)
+                                       : "_level" + std::to_string(n.firstLevel));
                 if (objectLod) {
                     extras["object_lod"] = intValue(size_t(n.objectLod));
+                } else if (coarser) {
+                    extras["coarser_step"] = intValue(size_t(n.coarserStep));
+                    extras["aggregate_level"] = tinygltf::Value(tintLevel);
+                    extras["delta"] = tinygltf::Value(n.delta);
                 } else {
                     extras["level"] = tinygltf::Value(n.firstLevel);
                     extras["last_level"] = tinygltf::Value(n.lastLevel);
@@ -1904,7 +1918,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 extras["proxy_error_budget"] = tinygltf::Value(n.budget);
                 extras["exact_triangles"] = intValue(n.exactTriangleCount);
                 const std::vector<double> positions(n.positions.begin(), n.positions.end());
-                node.mesh = glb.addMesh(node.name, positions, n.indices, objectLod ? 0 : n.firstLevel, &n.faceColors);
+                node.mesh = glb.addMesh(node.name, positions, n.indices, tintLevel, &n.faceColors);
             }
             for (uint32_t c : n.children) node.children.push_back(int(c));
             node.extras = tinygltf::Value(std::move(extras));

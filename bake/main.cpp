@@ -8,6 +8,9 @@
 #include "runtime_export.h"
 #include "commands_2d.h"
 #include "commands_render.h"
+#ifdef AGGRELOD_HAVE_PLANNING
+#include "commands_plan.h"
+#endif
 #include "scene_io.h"
 #include "terminal.h"
 #include "tiles_export.h"
@@ -647,8 +650,9 @@ void printInspectLine(const runtime::RuntimeFile& file, uint32_t index, size_t d
                     cli::formatNumber(n.sphereRadius).c_str());
     } else {
         // A per-object LOD (a simplified version of one object) has no level of its own.
-        const std::string level = n.level == runtime::kObjectLodLevel
-                                      ? std::string("object LOD")
+        const std::string level = n.level == runtime::kObjectLodLevel ? std::string("object LOD")
+                                  : n.level == runtime::kCoarserLevel
+                                      ? "coarser version  delta " + cli::formatNumber(n.delta)
                                       : "level " + std::to_string(n.level) + "  delta " + cli::formatNumber(n.delta);
         std::printf("%snode %u  %s  error %s  triangles %u  box [%s %s %s]..[%s %s %s]  sphere r %s  "
                     "%u objects:",
@@ -789,6 +793,58 @@ CLI::App* addRenderCommand(CLI::App& app, cli::RenderOptions& o) {
 }
 
 // ---------------------------------------------------------------------------
+// plan, reproduce-planning (work in plan_command.cpp / reproduce_planning_command.cpp)
+
+#ifdef AGGRELOD_HAVE_PLANNING
+CLI::App* addPlanCommand(CLI::App& app, cli::PlanOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "plan", "Plan a collision-free path for a round agent with the aggregation hierarchy (OMPL LazyPRM, coarse to "
+                "fine); exit 0 solved, 3 no path within the time limit");
+    cmd->add_option("baked", o.input,
+                    "OUTDIR/scene.aglod (3D) or 2D polygons (.wkt, .geojson, .json; aggregated here, see --levels)")
+        ->required();
+    cmd->add_option("--from", o.from, "Start x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
+    cmd->add_option("--to", o.to, "Goal x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
+    cmd->add_option("--radius", o.radius, "Agent radius (disc in 2D, ball in 3D), scene units, > 0")->required();
+    cmd->add_option("--strategy", o.strategy,
+                    "hierarchy (default: coarsest level first, then finer), originals, or level:K (one level only)");
+    cmd->add_option("--time-limit", o.timeLimit, "Seconds for the query (default 10)");
+    cmd->add_option("--seed", o.seed, "Seed of OMPL's random numbers (default 1); same seed, same roadmap and path");
+    cmd->add_option("--level-samples", o.levelSamples,
+                    "Hierarchy: new roadmap vertices per level before descending (default 500)")
+        ->check(CLI::Range(1, 100000000));
+    CLI::Option* delta = cmd->add_option("--delta", o.deltas, "2D polygons: explicit thresholds, comma-separated")
+                             ->delimiter(',')
+                             ->allow_extra_args(false);
+    CLI::Option* levels =
+        cmd->add_option("--levels", o.levels, "2D polygons: number of automatic levels (default 6)")->check(CLI::Range(1, 1000));
+    delta->excludes(levels);
+    CLI::Option* png = cmd->add_option("--png", o.pngPath, "Write a Fig. 7-style picture (roadmap per level, path) as PNG");
+    CLI::Option* svg = cmd->add_option("--svg", o.svgPath, "Write the picture as SVG");
+    png->excludes(svg);
+    cmd->add_option("--stats", o.statsPath, "Write {solved, path, levels_used, seconds, collision_checks, ...} as JSON");
+    cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors");
+    return cmd;
+}
+
+CLI::App* addReproducePlanningCommand(CLI::App& app, cli::ReproducePlanningOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "reproduce-planning", "Rerun the paper's motion-planning experiment (Section 4.3) on the five 2D environments and "
+                              "three 3D scenes: planning.md, planning.csv, fig7-<env>.png");
+    cmd->add_option("-o,--output", o.outDir, "Output directory (created if missing; 3D bakes are kept in scenes/)")
+        ->required();
+    cmd->add_option("--queries", o.queries, "Random start / goal pairs per environment (default 100)")
+        ->check(CLI::Range(1, 100000));
+    cmd->add_option("--time-limit", o.timeLimit, "Seconds per query and strategy (default 2)");
+    cmd->add_option("--seed", o.seed, "Seed of the scenes, queries and planners (default 1)");
+    cmd->add_option("--only", o.only,
+                    "Comma-separated environments (tree, scatter, room, colony, forest, forest3d, village3d, random1000)");
+    cmd->add_flag("-q,--quiet", o.quiet, "No progress or table (errors only)");
+    return cmd;
+}
+#endif
+
+// ---------------------------------------------------------------------------
 
 int run(int argc, char** argv) {
     CLI::App app{"aggrelod: aggregate separate objects into a level-of-detail hierarchy"};
@@ -805,6 +861,12 @@ int run(int argc, char** argv) {
     CLI::App* reproduce2dCommand = addReproduce2DCommand(app, reproduce2d);
     cli::RenderOptions render;
     CLI::App* renderCommand = addRenderCommand(app, render);
+#ifdef AGGRELOD_HAVE_PLANNING
+    cli::PlanOptions plan;
+    CLI::App* planCommand = addPlanCommand(app, plan);
+    cli::ReproducePlanningOptions reproducePlanning;
+    CLI::App* reproducePlanningCommand = addReproducePlanningCommand(app, reproducePlanning);
+#endif
 
     if (argc <= 1) {
         std::fputs(app.help().c_str(), stderr);
@@ -821,6 +883,10 @@ int run(int argc, char** argv) {
     if (aggregate2dCommand->parsed()) return cli::runAggregate2D(aggregate2d);
     if (reproduce2dCommand->parsed()) return cli::runReproduce2D(reproduce2d);
     if (renderCommand->parsed()) return cli::runRender(render);
+#ifdef AGGRELOD_HAVE_PLANNING
+    if (planCommand->parsed()) return cli::runPlan(plan);
+    if (reproducePlanningCommand->parsed()) return cli::runReproducePlanning(reproducePlanning);
+#endif
     return kUsage;
 }
 

@@ -192,6 +192,7 @@ bool fillBuildParams(const HierarchyNodes& nodes, const std::vector<InputObject>
         mesh = RenderMesh{};  // keep the peak memory near one copy of the arrays
         b.level = n.leaf ? runtime::kLeafLevel
                   : n.objectLod >= 1 ? runtime::kObjectLodLevel
+                  : n.coarserStep >= 1 ? runtime::kCoarserLevel
                                      : static_cast<uint32_t>(n.firstLevel);
         b.delta = static_cast<float>(n.delta);
         // Float-representable by construction (hierarchy_nodes.h): the casts are exact.

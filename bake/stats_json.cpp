@@ -173,14 +173,19 @@ std::pair<double, double> maxAndMedian(std::vector<double> values) {
     return {values.back(), values[values.size() / 2]};
 }
 
-/// The proxies of the nodes a cut of `nodes` would draw at one level (or the per-object LOD
-/// nodes): their budgets, certified errors and triangles.
+/// The proxies of the nodes a cut of `nodes` would draw at one level (level -1: the
+/// per-object LOD nodes, -2: the coarser versions of aggregates): their budgets, certified
+/// errors and triangles.
 void writeProxyFigures(JsonWriter& w, const HierarchyNodes& nodes, int level) {
     std::vector<double> budgets, errors;
     size_t triangles = 0, count = 0;
     for (const HierarchyNode& n : nodes.nodes) {
         if (n.leaf) continue;
-        if (level >= 0 ? !(n.objectLod == 0 && n.firstLevel <= level && level <= n.lastLevel) : n.objectLod == 0) continue;
+        const bool wanted = level >= 0   ? n.objectLod == 0 && n.coarserStep == 0 && n.firstLevel <= level &&
+                                               level <= n.lastLevel
+                            : level == -1 ? n.objectLod >= 1
+                                          : n.coarserStep >= 1;
+        if (!wanted) continue;
         ++count;
         budgets.push_back(n.budget);
         errors.push_back(n.error.bound());
@@ -241,6 +246,8 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
     if (nodes) {  // the per-object LOD nodes below the levels
         w.key("object_lods");
         writeProxyFigures(w, *nodes, -1);
+        w.key("coarser_versions");  // between each aggregate and its parent
+        writeProxyFigures(w, *nodes, -2);
     }
 
     // Solidified models (DESIGN 2.0): distances sampled, not certified.

@@ -179,6 +179,10 @@ private:
         } else if (node.objectLod >= 1) {
             // A simplified version of one object: no aggregate level of its own.
             out_ += ", \"objectLod\": " + std::to_string(node.objectLod) + ", \"objects\": 1";
+        } else if (node.coarserStep >= 1) {
+            // A coarser version of the aggregate below it: no level of its own either.
+            out_ += ", \"coarserStep\": " + std::to_string(node.coarserStep) + ", \"delta\": " + number(node.delta) +
+                    ", \"objects\": " + std::to_string(node.sources.size());
         } else {
             out_ += ", \"level\": " + std::to_string(node.firstLevel) + ", \"lastLevel\": " +
                     std::to_string(node.lastLevel) + ", \"delta\": " + number(node.delta) +
@@ -231,15 +235,20 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
         const HierarchyNode& node = nodes.nodes[n];
         TileMesh tile;
         const bool objectLod = node.objectLod >= 1;
-        tile.name = node.leaf    ? "object_" + objects[n].name
-                    : objectLod ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
-                                : "node" + std::to_string(n) + "_level" + std::to_string(node.firstLevel);
+        // A coarser version takes the level (and tint) of the aggregate it simplifies.
+        uint32_t below = n;
+        while (nodes.nodes[below].coarserStep >= 1) below = nodes.nodes[below].children.front();
+        const int level = std::max(nodes.nodes[below].firstLevel, 0);
+        tile.name = node.leaf                ? "object_" + objects[n].name
+                    : objectLod             ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
+                    : node.coarserStep >= 1 ? "node" + std::to_string(n) + "_coarser" + std::to_string(node.coarserStep)
+                                            : "node" + std::to_string(n) + "_level" + std::to_string(node.firstLevel);
         tile.positions = node.positions;
         tile.indices = node.indices;
         if (!node.leaf) {
             // Per-object LODs are finer than level 0: they take its tint.
             const std::vector<double> colour =
-                levelBaseColour(objectLod ? 0 : size_t(node.firstLevel), size_t(std::max(levelCount, 1)));
+                levelBaseColour(objectLod ? 0 : size_t(level), size_t(std::max(levelCount, 1)));
             std::copy(colour.begin(), colour.begin() + 4, tile.baseColor);
         }
         tile.node = n;

@@ -6,7 +6,9 @@
 // one before it, so the whole sequence encloses the input. The feasible positions form a
 // convex polyhedron; candidates (the quadric optimum of Garland and Heckbert, SIGGRAPH 1997,
 // the midpoint and both end points) are pushed along the mean normal of the edge's faces
-// into it, and the one with the smallest error estimate wins.
+// into it, or projected onto the planes they lie inside of in turn (alternating projections,
+// which reach it where the mean normal does not), and the one with the smallest error
+// estimate wins.
 //
 // Error estimate: a vertex carries the largest distance by which the surface around it has
 // been pushed out; a collapse adds the largest distance of its new vertex to the planes of
@@ -439,9 +441,13 @@ private:
         candidates[candidateCount++] = p_[b];
         const double inherited = std::max(error_[a], error_[b]);
         bool found = false;
-        for (int i = 0; i < candidateCount; ++i) {
+        for (int j = 0; j < 2 * candidateCount; ++j) {
+            const int i = j / 2;
             V3 position;
-            if (!pushInside(candidates[i], direction, position)) continue;
+            // Two ways into the feasible region: along the mean normal, and by projecting
+            // onto the violated planes in turn (reaches it where the mean normal cannot).
+            if (j % 2 == 0 ? !pushInside(candidates[i], direction, position)
+                           : !projectInside(candidates[i], direction, position)) continue;
             double pushed = 0;
             for (const Plane& pl : planes_) pushed = std::max(pushed, dot(pl.normal, position) - pl.offset);
             const double cost = inherited + pushed;
@@ -475,6 +481,32 @@ private:
             out = out + (-worst + epsilon_) * direction;
         }
         return false;
+    }
+
+    /// Moves c into the region on or outside every constraint plane by projecting it onto
+    /// the planes it lies inside of, in turn (alternating projections), then steps out
+    /// along `direction` by what rounding left; false when that does not converge.
+    bool projectInside(V3 c, V3 direction, V3& out) const {
+        out = c;
+        for (int pass = 0; pass < 48; ++pass) {
+            bool inside = false;
+            for (const Plane& pl : planes_) {
+                const double g = dot(pl.normal, out) - pl.offset;
+                if (g < 0) {
+                    out = out + (-g + epsilon_) * pl.normal;
+                    inside = true;
+                }
+            }
+            if (!inside) return true;
+        }
+        double worst = 0;
+        for (const Plane& pl : planes_) worst = std::min(worst, dot(pl.normal, out) - pl.offset);
+        if (worst >= 0) return true;
+        // Close: finish along the mean normal.
+        V3 pushed;
+        if (!pushInside(out, direction, pushed)) return false;
+        out = pushed;
+        return true;
     }
 
     /// Every face kept by collapsing (a, b) into `position` keeps an area and turns its

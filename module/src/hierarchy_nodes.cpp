@@ -172,6 +172,13 @@ private:
     std::vector<char> pinned_;
 };
 
+/// A proxy as built, in doubles, before vertex-cache ordering: what its coarser versions
+/// are simplified from.
+struct ExactProxy {
+    std::vector<double> positions;
+    std::vector<uint32_t> indices;
+};
+
 /// Push-out allowances tried for a proxy, as fractions of the room its budget leaves above
 /// the exact aggregate's own error, coarsest first (the simplification's estimate is a
 /// vertex-to-plane distance, not the certified one, so the largest can still miss).
@@ -183,10 +190,11 @@ constexpr double kRoomFractions[] = {1.0 / 4, 1.0 / 2, 1.0, 2.0, 4.0};
 /// conservative simplification of the aggregate that does not intersect itself and whose
 /// certified error fits the budget, else the exact aggregate.
 void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::PreparedOriginal*>& originals,
-                        const ProxySettings& settings, HierarchyNode& n) {
+                        const ProxySettings& settings, HierarchyNode& n, ExactProxy& exactProxy) {
     const double tolerance = settings.toleranceFraction * n.delta;
     n.positions = toFloats(agg.positions);
     n.indices = agg.indices;
+    exactProxy = {agg.positions, agg.indices};
     n.error = measureEnclosure(agg.positions, n.positions, n.indices, originals, tolerance, settings, INFINITY);
     const double room = settings.simplifyFraction * n.delta;
     n.budget = n.error.bound() + room;
@@ -205,9 +213,19 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
             n.positions = std::move(positions);
             n.indices = s.indices;
             n.error = e;
+            exactProxy = {s.positions, s.indices};
             return;
         }
     }
+}
+
+/// Snapshot i of a chain's series when it is clean and at most 80 % of finerTriangles (else
+/// not worth a node), else null.
+const detail::ConservativeSnapshot* lighterCleanSnapshot(EnclosureSeries& series, size_t i, size_t finerTriangles) {
+    if (5 * series.triangleCount(i) > 4 * finerTriangles) return nullptr;
+    const detail::ConservativeSnapshot* clean = series.clean(i);
+    if (!clean || 5 * (clean->indices.size() / 3) > 4 * finerTriangles) return nullptr;
+    return clean;
 }
 
 /// Error targets of per-object LOD chains: a geometric series sqrt(2) apart, from this
@@ -243,12 +261,10 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
     size_t finerTriangles = object.indices.size() / 3;
     const std::vector<const detail::PreparedOriginal*> originals{&original};
     for (size_t i = 0; i < series.size() && int(chain.size()) < settings.objectLodCount; ++i) {
-        if (5 * (series.triangleCount(i)) > 4 * finerTriangles) continue;  // not worth a node
-        const detail::ConservativeSnapshot* clean = series.clean(i);
+        const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, finerTriangles);
         if (!clean) continue;
         const detail::ConservativeSnapshot& s = *clean;
         const size_t triangles = s.indices.size() / 3;
-        if (5 * triangles > 4 * finerTriangles) continue;
         HierarchyNode n;
         n.objectLod = static_cast<int>(chain.size()) + 1;
         n.sources = {objectIndex};
@@ -258,6 +274,54 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
         n.exactTriangleCount = object.indices.size() / 3;
         n.error = measureEnclosure(s.positions, n.positions, n.indices, originals, settings.toleranceFraction * targets[i],
                                    settings, std::min(n.budget, ceiling));
+        if (!(n.error.bound() <= n.budget) || !(n.error.bound() < ceiling)) continue;
+        finerTriangles = triangles;
+        chain.push_back(std::move(n));
+    }
+    return chain;
+}
+
+/// Coarser versions of an aggregate node (DESIGN section 2.6): enclosing simplifications of
+/// its proxy at error targets sqrt(2) apart above the node's budget, up to below `ceiling`
+/// (its parent's certified error; infinity for a root, then up to the aggregate's diagonal).
+/// A level's proxy fits a budget near the fill's own error, the next level's error is that
+/// of a wider fill; these versions fill the gap, so that at any distance the cut can draw a
+/// version of the group whose error is near what the pixel tolerance allows. A version is
+/// kept as a per-object LOD level is: it does not intersect itself, its certified error fits
+/// its budget (the node's error plus twice its push-out allowance) and stays below the
+/// ceiling, and it has at most 80 % of the triangles of the finer one kept. Finest first.
+std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactProxy& proxy,
+                                        const std::vector<const detail::PreparedOriginal*>& originals, double ceiling,
+                                        const ProxySettings& settings) {
+    std::vector<HierarchyNode> chain;
+    if (settings.coarserCount <= 0 || proxy.indices.empty()) return chain;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i + 2 < proxy.positions.size(); i += 3) growBox(lo, hi, &proxy.positions[i]);
+    const double diagonal = distance(lo, hi);
+    const double own = node.error.bound(), base = std::max(own, node.budget);
+    if (!(diagonal > 0) || !(base > 0)) return chain;
+    const double top = std::min(ceiling, diagonal);
+    std::vector<double> allowances;  // ascending push-outs above the proxy
+    for (double t = base * kChainRatio; t < top; t *= kChainRatio) allowances.push_back(t - own);
+    if (allowances.empty()) return chain;
+    EnclosureSeries series(proxy.positions, proxy.indices, allowances);
+    size_t finerTriangles = proxy.indices.size() / 3;
+    for (size_t i = 0; i < series.size() && int(chain.size()) < settings.coarserCount; ++i) {
+        const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, finerTriangles);
+        if (!clean) continue;
+        const detail::ConservativeSnapshot& s = *clean;
+        const size_t triangles = s.indices.size() / 3;
+        HierarchyNode n;
+        n.coarserStep = static_cast<int>(chain.size()) + 1;
+        n.sources = node.sources;
+        n.delta = node.delta;
+        n.budget = own + 2 * allowances[i];
+        n.positions = toFloats(s.positions);
+        n.indices = s.indices;
+        n.exactTriangleCount = node.exactTriangleCount;
+        n.error = measureEnclosure(s.positions, n.positions, n.indices, originals,
+                                   settings.toleranceFraction * (own + allowances[i]), settings,
+                                   std::min(n.budget, ceiling));
         if (!(n.error.bound() <= n.budget) || !(n.error.bound() < ceiling)) continue;
         finerTriangles = triangles;
         chain.push_back(std::move(n));
@@ -409,12 +473,13 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     });
     // Proxies of the aggregates that hold several objects first: their errors cap the
     // per-object LOD chains below them.
+    std::vector<ExactProxy> exactProxies(nodes.size());
     const auto makeProxies = [&](const std::vector<uint32_t>& which, double progressFrom, double progressTo) {
         detail::parallelFor(which.size(), settings.threadCount, [&](size_t j) {
             HierarchyNode& n = nodes[which[j]];
             std::vector<const detail::PreparedOriginal*> originals;
             for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
-            makeAggregateProxy(aggregateOf(n), originals, settings, n);
+            makeAggregateProxy(aggregateOf(n), originals, settings, n, exactProxies[which[j]]);
             std::vector<const InputObject*> sourceObjects;
             for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
             detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
@@ -427,7 +492,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     std::vector<uint32_t> groupNodes, singleNodes;
     for (uint32_t i = static_cast<uint32_t>(objectCount); i < nodes.size(); ++i)
         (nodes[i].sources.size() > 1 ? groupNodes : singleNodes).push_back(i);
-    makeProxies(groupNodes, 0.0, 0.6);
+    makeProxies(groupNodes, 0.0, 0.5);
 
     // Per-object LOD chains. An object's chain stands in for the aggregates of that object
     // alone (the object with its concavities filled), up to its first aggregate with other
@@ -449,7 +514,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
             detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
         }
     }, [&](size_t done) {
-        if (settings.progress) settings.progress("proxies", 0.6 + 0.3 * double(done) / double(objectCount));
+        if (settings.progress) settings.progress("proxies", 0.5 + 0.25 * double(done) / double(objectCount));
     });
     std::vector<char> dropped(nodes.size(), 0);
     std::vector<uint32_t> keptSingles;
@@ -457,9 +522,38 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         if (!chains[nodes[i].sources.front()].empty()) dropped[i] = 1;
         else keptSingles.push_back(i);
     }
-    makeProxies(keptSingles, 0.9, 1.0);
+    makeProxies(keptSingles, 0.75, 0.85);
 
-    // The tree again: leaves, chains (object by object, finest first), the aggregates kept.
+    // Coarser versions of every aggregate kept, capped by its parent's error. The parent of
+    // a kept aggregate is kept: it holds more objects, or the same object, which then has no
+    // chain either.
+    std::vector<std::vector<HierarchyNode>> coarser(nodes.size());
+    std::vector<uint32_t> keptAggregates;
+    for (uint32_t i = static_cast<uint32_t>(objectCount); i < nodes.size(); ++i)
+        if (!dropped[i]) keptAggregates.push_back(i);
+    detail::parallelFor(keptAggregates.size(), settings.threadCount, [&](size_t j) {
+        const uint32_t i = keptAggregates[j];
+        const HierarchyNode& n = nodes[i];
+        const double ceiling = n.parent == kNoNode ? INFINITY : nodes[n.parent].error.bound();
+        std::vector<const detail::PreparedOriginal*> originals;
+        std::vector<const InputObject*> sourceObjects;
+        for (uint32_t o : n.sources) {
+            originals.push_back(&prepared[o]);
+            sourceObjects.push_back(&objects[o]);
+        }
+        coarser[i] = coarserChain(n, exactProxies[i], originals, ceiling, settings);
+        exactProxies[i] = ExactProxy{};
+        for (HierarchyNode& c : coarser[i]) {
+            detail::nearestSurfaceColors(c.positions, c.indices, sourceObjects, c.faceColors);
+            detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
+        }
+    }, [&](size_t done) {
+        if (settings.progress)
+            settings.progress("proxies", 0.85 + 0.15 * double(done) / double(std::max<size_t>(keptAggregates.size(), 1)));
+    });
+
+    // The tree again: leaves, per-object chains (object by object, finest first), then each
+    // aggregate kept followed by its coarser versions (finest first).
     {
         std::vector<uint32_t> newIndex(nodes.size(), kNoNode);
         uint32_t next = static_cast<uint32_t>(objectCount);
@@ -469,8 +563,14 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
             next += static_cast<uint32_t>(chains[o].size());
             chainTop[o] = chains[o].empty() ? static_cast<uint32_t>(o) : next - 1;
         }
-        for (size_t i = objectCount; i < nodes.size(); ++i)
-            newIndex[i] = dropped[i] ? chainTop[nodes[i].sources.front()] : next++;
+        for (size_t i = objectCount; i < nodes.size(); ++i) {
+            if (dropped[i]) {
+                newIndex[i] = chainTop[nodes[i].sources.front()];
+            } else {
+                newIndex[i] = next++;
+                next += static_cast<uint32_t>(coarser[i].size());
+            }
+        }
         // Nearest kept ancestor of old node i (kNoNode at the top).
         const auto keptParent = [&](uint32_t i) {
             uint32_t up = nodes[i].parent;
@@ -479,19 +579,23 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         };
         std::vector<HierarchyNode> renumbered(next);
         std::vector<uint32_t> parentOf(next, kNoNode);
-        for (size_t o = 0; o < objectCount; ++o) {
-            const uint32_t above = keptParent(static_cast<uint32_t>(o));
-            uint32_t below = static_cast<uint32_t>(o);
-            for (size_t j = 0; j < chains[o].size(); ++j) {
-                const uint32_t at = chainTop[o] - uint32_t(chains[o].size() - 1 - j);
+        // Hangs `chain` above new node `bottom` (its nodes numbered first..) and the chain's
+        // top below `above`.
+        const auto hang = [&](std::vector<HierarchyNode>& chain, uint32_t bottom, uint32_t first, uint32_t above) {
+            uint32_t below = bottom;
+            for (size_t j = 0; j < chain.size(); ++j) {
+                const uint32_t at = first + static_cast<uint32_t>(j);
                 parentOf[below] = at;
-                renumbered[at] = std::move(chains[o][j]);
+                renumbered[at] = std::move(chain[j]);
                 below = at;
             }
             parentOf[below] = above;
-        }
+        };
+        for (size_t o = 0; o < objectCount; ++o)
+            hang(chains[o], static_cast<uint32_t>(o), chainTop[o] + 1 - static_cast<uint32_t>(chains[o].size()),
+                 keptParent(static_cast<uint32_t>(o)));
         for (size_t i = objectCount; i < nodes.size(); ++i)
-            if (!dropped[i]) parentOf[newIndex[i]] = keptParent(static_cast<uint32_t>(i));
+            if (!dropped[i]) hang(coarser[i], newIndex[i], newIndex[i] + 1, keptParent(static_cast<uint32_t>(i)));
         for (size_t i = 0; i < nodes.size(); ++i)
             if (i < objectCount || !dropped[i]) renumbered[newIndex[i]] = std::move(nodes[i]);
         out.roots.clear();
@@ -516,7 +620,8 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         for (uint32_t c : n.children) e = std::max(e, nodes[c].geometricError);
         n.geometricError = floatUp(e);
         const std::vector<double>& exact = n.leaf ? (n.positions.empty() ? none : objects[i].positions)
-                                           : n.objectLod > 0 ? none : aggregateOf(n).positions;
+                                           : n.objectLod > 0 || n.coarserStep > 0 ? none
+                                                                         : aggregateOf(n).positions;
         computeBounds(n, exact, nodes);
     }
     return true;

@@ -47,6 +47,8 @@ typedef struct aglod_collision aglod_collision;
  * first aggregate) in aglod_node_level; in aglod_collision_use_level: the coarsest per-object
  * LOD of every object. */
 #define AGLOD_OBJECT_LOD_LEVEL 0xFFFEu
+/** Level of a coarser version of an aggregate (one child: that aggregate or a finer version). */
+#define AGLOD_COARSER_LEVEL 0xFFFDu
 #define AGLOD_NO_INDEX 0xFFFFFFFFu
 
 /* Short name of a status, e.g. "checksum mismatch". Never NULL. */
@@ -65,7 +67,8 @@ void aglod_close(aglod_file* file);
 uint32_t aglod_node_count(const aglod_file* file);
 uint32_t aglod_object_count(const aglod_file* file);
 /* Level of a node: 0, 1, ... for aggregates, AGLOD_LEAF_LEVEL for originals,
- * AGLOD_OBJECT_LOD_LEVEL for per-object LODs; AGLOD_NO_INDEX when out of range. */
+ * AGLOD_OBJECT_LOD_LEVEL for per-object LODs, AGLOD_COARSER_LEVEL for coarser versions of an
+ * aggregate; AGLOD_NO_INDEX when out of range. */
 uint32_t aglod_node_level(const aglod_file* file, uint32_t node);
 /* Geometric error of a node, world units (-1 when out of range). */
 float aglod_node_error(const aglod_file* file, uint32_t node);

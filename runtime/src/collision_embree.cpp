@@ -6,6 +6,8 @@
 #include <aggrelod/collision.h>
 #include <aggrelod/selection.h>
 
+#include "triangle_distance.h"
+
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -40,6 +42,7 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
     auto rank = [&](uint32_t node) -> int64_t {
         if (file.isLeaf(node)) return -2;
         if (file.isObjectLod(node)) return wanted == -1 ? -1 : std::numeric_limits<int64_t>::max();
+        if (file.isCoarser(node)) return std::numeric_limits<int64_t>::max();  // passed through
         return rankOf(file.node(node).level);
     };
     std::vector<uint32_t> stack(file.roots().begin(), file.roots().end());
@@ -58,7 +61,7 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
 std::vector<uint32_t> levelsOf(const RuntimeFile& file) {
     std::vector<uint32_t> levels;
     for (uint32_t i = 0; i < file.nodeCount(); ++i)
-        if (!file.isLeaf(i) && !file.isObjectLod(i)) levels.push_back(file.node(i).level);
+        if (!file.isLeaf(i) && !file.isObjectLod(i) && !file.isCoarser(i)) levels.push_back(file.node(i).level);
     std::sort(levels.begin(), levels.end());
     levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
     return levels;
@@ -87,6 +90,8 @@ struct CollisionWorld::Impl {
     std::string lastError;
     bool failed = false;
     bool committed = false;  // queries before the first cut find nothing
+    const float* vertexData = nullptr;    // merged mesh (Embree's buffers), for distance queries
+    const uint32_t* indexData = nullptr;
 
     static void onError(void* user, RTCError code, const char* text) {
         auto* self = static_cast<Impl*>(user);
@@ -127,6 +132,8 @@ struct CollisionWorld::Impl {
         cut = std::move(nodes);
         triangleRefs.clear();
         slots.clear();
+        vertexData = nullptr;
+        indexData = nullptr;
         size_t vertexTotal = 0;
         for (uint32_t slot = 0; slot < cut.size(); ++slot) {
             const uint32_t n = cut[slot];
@@ -160,6 +167,8 @@ struct CollisionWorld::Impl {
                 }
                 rtcCommitGeometry(geometry);
                 rtcAttachGeometryByID(scene, geometry, 0);
+                vertexData = vb;
+                indexData = ib;
             }
         }
         rtcCommitScene(scene);
@@ -199,6 +208,50 @@ struct CollisionWorld::Impl {
         const float nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         for (int k = 0; k < 3; ++k) hit.normal[k] = nl > 0 ? n[k] / nl : 0.0f;
         return true;
+    }
+
+    // Sphere / capsule overlap: an Embree point query around the shape's bounding sphere visits
+    // every triangle whose box meets it; the callback measures the exact distance and, on the
+    // first triangle within reach, shrinks the query to nothing so the traversal ends.
+    struct TouchQuery {
+        const Impl* self;
+        distance::V3 a, b;  // segment (a == b for a sphere)
+        double radius2;
+        bool found;
+    };
+    static bool touchCallback(RTCPointQueryFunctionArguments* args) {
+        auto* q = static_cast<TouchQuery*>(args->userPtr);
+        if (q->found) return false;
+        const uint32_t* t = q->self->indexData + 3 * size_t(args->primID);
+        auto vertex = [&](uint32_t i) {
+            const float* v = q->self->vertexData + 3 * size_t(i);
+            return distance::V3{v[0], v[1], v[2]};
+        };
+        const distance::V3 a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
+        const double d2 = distance::segmentTriangleDistance2(q->a, q->b, a, b, c);
+        if (d2 <= q->radius2) {
+            q->found = true;
+            args->query->radius = 0.0f;
+            return true;
+        }
+        return false;
+    }
+    bool touches(const float a[3], const float b[3], float radius) const {
+        if (!scene || failed || !committed || !vertexData || !(radius >= 0)) return false;
+        TouchQuery q{this, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, double(radius) * double(radius), false};
+        const double half = 0.5 * std::sqrt(distance::length2(q.b - q.a));
+        RTCPointQuery query;
+        query.x = float(0.5 * (q.a.x + q.b.x));
+        query.y = float(0.5 * (q.a.y + q.b.y));
+        query.z = float(0.5 * (q.a.z + q.b.z));
+        query.time = 0.0f;
+        // Float rounding of the centre is covered by a relative margin on the reach.
+        const double reach = half + radius;
+        query.radius = float(reach * (1.0 + 1e-5) + 1e-6);
+        RTCPointQueryContext context;
+        rtcInitPointQueryContext(&context);
+        rtcPointQuery(scene, &query, &context, &Impl::touchCallback, &q);
+        return q.found;
     }
 
     bool occluded(const float o[3], const float d[3], float maxDistance) const {
@@ -258,6 +311,12 @@ bool CollisionWorld::segment(const float a[3], const float b[3], CollisionHit& h
 }
 bool CollisionWorld::occluded(const float origin[3], const float direction[3], float maxDistance) const {
     return impl_->occluded(origin, direction, maxDistance);
+}
+bool CollisionWorld::sphereTouches(const float center[3], float radius) const {
+    return impl_->touches(center, center, radius);
+}
+bool CollisionWorld::capsuleTouches(const float a[3], const float b[3], float radius) const {
+    return impl_->touches(a, b, radius);
 }
 
 }  // namespace aggrelod::runtime

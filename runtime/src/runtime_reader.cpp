@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -246,7 +248,10 @@ struct FileValidator {
             if (r.level == kObjectLodLevel && r.sourceCount != 1)
                 return fail(FileStatus::BadValue, where() + ": per-object LOD node standing for " +
                                                       std::to_string(r.sourceCount) + " objects");
-            if (!leaf && r.level != kObjectLodLevel && r.level >= kMaxAggregateLevel)
+            if (r.level == kCoarserLevel && r.childCount != 1)
+                return fail(FileStatus::BadValue, where() + ": coarser version with " + std::to_string(r.childCount) +
+                                                      " children");
+            if (!leaf && r.level != kObjectLodLevel && r.level != kCoarserLevel && r.level >= kMaxAggregateLevel)
                 return fail(FileStatus::BadValue, where() + ": level " + std::to_string(r.level));
         }
         if (FileStatus s = checkDisjoint("vertices", &NodeRecord::firstVertex, &NodeRecord::vertexCount);
@@ -327,7 +332,8 @@ struct FileValidator {
     }
 
     /// Order of levels from fine to coarse: leaves, per-object LODs, aggregate levels 0, 1, ...
-    /// A child's level must be below its parent's (per-object LODs may also chain).
+    /// A child's level must be below its parent's (per-object LODs may also chain; a coarser
+    /// version ranks as the aggregate it simplifies).
     static int64_t levelRank(uint32_t level) {
         if (level == kLeafLevel) return -2;
         if (level == kObjectLodLevel) return -1;
@@ -341,18 +347,44 @@ struct FileValidator {
         if (n == 0) return fail(FileStatus::BadTree, "no nodes");
         // Parent/child consistency: each non-root is listed exactly once, by its parent.
         std::vector<uint32_t> references(n, 0);
+        // A coarser version ranks as the aggregate it simplifies: the end of its chain of
+        // single children (memoised, so the walk is linear in the node count).
+        constexpr int64_t kUnknown = std::numeric_limits<int64_t>::min();
+        std::vector<int64_t> rank(n, kUnknown);
+        std::vector<uint32_t> path;
+        for (uint32_t i = 0; i < n; ++i) {
+            path.clear();
+            uint32_t at = i;
+            int64_t found = kUnknown;
+            while (found == kUnknown) {
+                if (rank[at] != kUnknown) found = rank[at];
+                else if (nodes[at].level != kCoarserLevel) found = levelRank(nodes[at].level);
+                else if (path.size() > n || out.children(at).size != 1)
+                    return fail(FileStatus::BadTree, "node " + std::to_string(i) + ": a coarser version that is not "
+                                                     "above exactly one chain of single children");
+                else {
+                    path.push_back(at);
+                    at = out.children(at)[0];
+                }
+            }
+            for (uint32_t p : path) rank[p] = found;
+            rank[i] = found;
+        }
         uint64_t parentless = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const NodeRecord& r = nodes[i];
             if (r.parent == kNoIndex) ++parentless;
             for (uint32_t c : out.children(i)) {
+                if (r.level == kCoarserLevel && (nodes[c].level == kLeafLevel || nodes[c].level == kObjectLodLevel))
+                    return fail(FileStatus::BadTree, "node " + std::to_string(i) + ": a coarser version above a " +
+                                                         (nodes[c].level == kLeafLevel ? "leaf" : "per-object LOD"));
                 if (nodes[c].parent != i)
                     return fail(FileStatus::BadTree, "node " + std::to_string(i) + ": child " + std::to_string(c) +
                                                          " has parent " + std::to_string(nodes[c].parent));
                 if (++references[c] > 1)
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + " is listed twice as a child");
                 // Per-object LODs form chains: one may stand under another.
-                if (levelRank(nodes[c].level) >= levelRank(r.level) &&
+                if (rank[c] >= rank[i] && r.level != kCoarserLevel &&
                     !(r.level == kObjectLodLevel && nodes[c].level == kObjectLodLevel))
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + ": level " +
                                                          std::to_string(nodes[c].level) + " is not below its parent's (" +

@@ -172,9 +172,10 @@ double median(std::vector<double> v) {
 
 /// Proxy error and budget per level, relative to the level's delta: what the cut can select.
 void printNodeErrors(const testing::Baked& b) {
-    std::map<int, std::vector<const HierarchyNode*>> byLevel;  // -1: per-object LOD nodes
+    // -2: per-object LOD nodes, -1: coarser versions of aggregates
+    std::map<int, std::vector<const HierarchyNode*>> byLevel;
     for (const HierarchyNode& n : b.nodes.nodes)
-        if (!n.leaf) byLevel[n.objectLod >= 1 ? -1 : n.firstLevel].push_back(&n);
+        if (!n.leaf) byLevel[n.objectLod >= 1 ? -2 : n.coarserStep >= 1 ? -1 : n.firstLevel].push_back(&n);
     std::printf("| level | delta | nodes | budget / delta (median) | certified error / delta (median, max) | over budget | proxy triangles | exact triangles |\n");
     std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const auto& [level, nodes] : byLevel) {
@@ -189,8 +190,8 @@ void printNodeErrors(const testing::Baked& b) {
             exact += n->exactTriangleCount;
         }
         char name[32];
-        std::snprintf(name, sizeof name, level < 0 ? "object LOD" : "%d", level);
-        std::printf("| %s | %.4g | %zu | %.3f | %.3f, %.3f | %zu | %zu | %zu |\n", name, level < 0 ? 0.0 : nodes[0]->delta,
+        std::snprintf(name, sizeof name, level == -2 ? "object LOD" : level == -1 ? "coarser versions" : "%d", level);
+        std::printf("| %s | %.4g | %zu | %.3f | %.3f, %.3f | %zu | %zu | %zu |\n", name, level == -2 ? 0.0 : nodes[0]->delta,
                     nodes.size(), median(budget), median(error), *std::max_element(error.begin(), error.end()), over,
                     triangles, exact);
     }

@@ -64,7 +64,88 @@ bool sphereInsideFloat(const HierarchyNode& inner, const HierarchyNode& outer) {
     return std::sqrt(d2) + float(inner.sphereRadius) <= float(outer.sphereRadius);
 }
 
+/// Triangles of the cut the runtime's screen-space rule selects (DESIGN section 3): from the
+/// roots down, a node is drawn when its geometric error seen from `eye` at the nearest point
+/// of its bounding sphere is at most `pixels` (1080 px viewport, 60 degree field of view).
+size_t cutTriangles(const HierarchyNodes& h, const double eye[3], double pixels) {
+    const double k = 1080.0 / (2 * std::tan(3.14159265358979323846 / 6));
+    size_t triangles = 0;
+    std::vector<uint32_t> stack(h.roots.begin(), h.roots.end());
+    while (!stack.empty()) {
+        const HierarchyNode& n = h.nodes[stack.back()];
+        stack.pop_back();
+        double d2 = 0;
+        for (int c = 0; c < 3; ++c) d2 += (eye[c] - n.sphereCenter[c]) * (eye[c] - n.sphereCenter[c]);
+        const double d = std::max(std::sqrt(d2) - n.sphereRadius, 1e-9);
+        if (n.leaf || n.geometricError * k / d <= pixels) triangles += n.indices.size() / 3;
+        else stack.insert(stack.end(), n.children.begin(), n.children.end());
+    }
+    return triangles;
+}
+
 }  // namespace
+
+// Coarser versions of an aggregate (DESIGN 2.6): each sits between an aggregate and its
+// parent with the aggregate's objects, one child, fewer triangles, an error within its budget
+// and below the parent's; and they make the drawn cut lighter at middle and far distances
+// than the same hierarchy without them.
+TEST(HierarchyNodes, CoarserVersionsLightenTheCut) {
+    const std::vector<InputObject> objects = samples::makeForest(1);
+    Settings3D s;
+    s.automaticLevelCount = 8;
+    s.threadCount = 2;
+    Hierarchy3D hierarchy;
+    ASSERT_TRUE(buildHierarchy3D(objects, s, hierarchy));
+    HierarchyNodes with, without;
+    ProxySettings p;
+    p.threadCount = 2;
+    std::string error;
+    ASSERT_TRUE(buildHierarchyNodes(hierarchy, objects, p, with, error)) << error;
+    p.coarserCount = 0;
+    ASSERT_TRUE(buildHierarchyNodes(hierarchy, objects, p, without, error)) << error;
+
+    size_t coarser = 0;
+    for (size_t i = 0; i < with.nodes.size(); ++i) {
+        const HierarchyNode& n = with.nodes[i];
+        if (n.coarserStep == 0) continue;
+        ++coarser;
+        ASSERT_EQ(n.children.size(), 1u) << "node " << i;
+        const HierarchyNode& below = with.nodes[n.children[0]];
+        EXPECT_FALSE(below.leaf);
+        EXPECT_EQ(below.objectLod, 0);
+        EXPECT_EQ(below.coarserStep, n.coarserStep - 1) << "node " << i;
+        EXPECT_EQ(n.sources, below.sources);
+        EXPECT_EQ(n.firstLevel, -1);
+        EXPECT_LE(5 * n.indices.size(), 4 * below.indices.size()) << "node " << i << " is not 20 % lighter";
+        EXPECT_LE(n.error.bound(), n.budget) << "node " << i;
+        if (n.parent != kNoNode && with.nodes[n.parent].coarserStep == 0)
+            EXPECT_LT(n.error.bound(), with.nodes[n.parent].error.bound()) << "node " << i;
+    }
+    for (const HierarchyNode& n : without.nodes) EXPECT_EQ(n.coarserStep, 0);
+    std::printf("forest: %zu coarser versions over %zu nodes\n", coarser, with.nodes.size());
+    EXPECT_GT(coarser, 20u);
+
+    // Cameras at 4, 8 and 16 scene diameters on a circle (as bench_lod_budget).
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const InputObject& o : objects)
+        for (size_t v = 0; v < o.positions.size(); v += 3)
+            for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], o.positions[v + c]), hi[c] = std::max(hi[c], o.positions[v + c]);
+    const double diameter = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    for (int distance : {4, 8, 16}) {
+        size_t withTriangles = 0, withoutTriangles = 0;
+        for (int az = 0; az < 8; ++az) {
+            const double phi = 2 * 3.14159265358979323846 * az / 8, r = distance * diameter;
+            const double eye[3] = {0.5 * (lo[0] + hi[0]) + r * std::cos(phi), 0.5 * (lo[1] + hi[1]) + r * std::sin(phi),
+                                   0.5 * (lo[2] + hi[2]) + 0.4 * r};
+            withTriangles += cutTriangles(with, eye, 1.0);
+            withoutTriangles += cutTriangles(without, eye, 1.0);
+        }
+        std::printf("  %2d diameters: cut %zu triangles with coarser versions, %zu without (8 cameras)\n", distance,
+                    withTriangles, withoutTriangles);
+        EXPECT_LT(withTriangles, withoutTriangles) << distance << " diameters";
+    }
+}
 
 TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
     const Baked& b = spheres15();
@@ -76,7 +157,7 @@ TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
     size_t aggregateNodes = 0, objectLodNodes = 0;
     for (const HierarchyNode& n : nodes) {
         if (n.leaf) continue;
-        ++(n.objectLod > 0 ? objectLodNodes : aggregateNodes);
+        if (n.coarserStep == 0) ++(n.objectLod > 0 ? objectLodNodes : aggregateNodes);
         if (n.objectLod > 0) {  // per-object LOD: one object, no level, within its budget
             EXPECT_EQ(n.sources.size(), 1u);
             EXPECT_EQ(n.firstLevel, -1);

@@ -206,7 +206,7 @@ TEST(RuntimeExport, FileCarriesNormalsColoursAndPerObjectLodLevels) {
     ASSERT_TRUE(runtime::writeRuntimeFile(params, bytes, error)) << error;
     runtime::RuntimeFile file;
     ASSERT_EQ(runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), file, error), runtime::FileStatus::Ok) << error;
-    EXPECT_EQ(file.versionMajor(), 2u);
+    EXPECT_EQ(file.versionMajor(), runtime::kFormatMajor);
     EXPECT_EQ(file.node(red).level, runtime::kLeafLevel);
     EXPECT_EQ(file.node(2).level, runtime::kObjectLodLevel);
     EXPECT_EQ(file.node(3).level, runtime::kObjectLodLevel);

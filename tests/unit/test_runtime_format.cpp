@@ -166,6 +166,7 @@ TEST(RuntimeFormat, WriterRefusesInconsistentHierarchies) {
         {"inner node with the leaf level", [](BuildParams& p) { p.nodes.back().level = kLeafLevel; }, "bad value"},
         {"per-object LOD of several objects", [](BuildParams& p) { p.nodes.back().level = kObjectLodLevel; }, "bad value"},
         {"level out of range", [](BuildParams& p) { p.nodes.back().level = kMaxAggregateLevel; }, "bad value"},
+        {"coarser version with two children", [](BuildParams& p) { p.nodes.back().level = kCoarserLevel; }, "coarser version"},
     };
     for (const Case& c : cases) {
         BuildParams p = good;
@@ -274,7 +275,7 @@ TEST(RuntimeFormat, NormalsAndColorsSectionsAreOnePerVertex) {
     EXPECT_EQ(std::memcmp(bytes.data() + colors.offset, p.colors.data(), p.colors.size()), 0);
     uint16_t major = 0;
     std::memcpy(&major, bytes.data() + 8, 2);
-    EXPECT_EQ(major, 2u);
+    EXPECT_EQ(major, kFormatMajor);
 }
 
 TEST(RuntimeFormat, ForgedNormalsAndColorSectionsAreRefused) {

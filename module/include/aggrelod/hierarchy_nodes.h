@@ -36,6 +36,10 @@ struct ProxySettings {
     /// apart from a thousandth of the object's diagonal up to that aggregate's error. They
     /// stand in for the aggregates of the object alone. 0 = none (those aggregates stay).
     int objectLodCount = 16;
+    /// Most coarser versions of one aggregate between it and its parent: enclosing
+    /// simplifications of its proxy at error targets sqrt(2) apart from its budget up to its
+    /// parent's error (a root: up to its diagonal). 0 = none.
+    int coarserCount = 16;
     /// How far (world units, as a fraction of delta_k) the certified upper bound of the
     /// error may exceed the largest distance actually found; the refinement stops there ...
     double toleranceFraction = 0.02;
@@ -71,6 +75,12 @@ struct HierarchyNode {
     /// (per-object LOD below the aggregation levels; sources holds that one object, firstLevel
     /// and lastLevel are -1, j rises towards the root of its chain).
     int objectLod = 0;
+    /// 0 for leaves, aggregates and per-object LODs; j >= 1 for the j-th coarser version of
+    /// the aggregate below it (its only child is that aggregate or the (j-1)-th version):
+    /// an enclosing simplification of the aggregate's proxy with an error between the
+    /// aggregate's and its parent's. sources and delta are the aggregate's, firstLevel and
+    /// lastLevel are -1 (no level of its own).
+    int coarserStep = 0;
     int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
     int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
     uint32_t aggregateIndex = 0;       ///< index in levels[firstLevel].aggregates (aggregates only)

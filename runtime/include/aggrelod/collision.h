@@ -72,6 +72,16 @@ public:
     /// True when anything lies on origin + t * direction, t in [0, maxDistance].
     bool occluded(const float origin[3], const float direction[3], float maxDistance) const;
 
+    /// True when a triangle of the cut comes within `radius` (world units, >= 0) of `center`:
+    /// a sphere of that radius there touches the cut's surfaces. Exact distances in double
+    /// arithmetic over the candidates of an Embree point query. Does not tell whether the
+    /// centre lies inside a solid: combine with raycast (first hit seen from inside).
+    bool sphereTouches(const float center[3], float radius) const;
+    /// True when a triangle of the cut comes within `radius` (world units, >= 0) of the
+    /// segment from a to b: the capsule swept by a sphere of that radius moving from a to b
+    /// touches the cut's surfaces (exact segment-triangle distances, double arithmetic).
+    bool capsuleTouches(const float a[3], const float b[3], float radius) const;
+
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;

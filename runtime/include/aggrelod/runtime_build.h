@@ -28,7 +28,8 @@ struct BuildNode {
     uint32_t firstIndex = 0;         ///< range in indices (counted in indices, 3 per triangle);
     uint32_t indexCount = 0;         ///<   indices are relative to firstVertex
     uint32_t level = 0;              ///< 0 = finest aggregate level, rising with delta; kLeafLevel
-                                     ///<   for originals, kObjectLodLevel for per-object LODs
+                                     ///<   for originals, kObjectLodLevel for per-object LODs,
+                                     ///<   kCoarserLevel for coarser versions of an aggregate
     float delta = 0.0f;              ///< threshold of the level, world units (0 for leaves)
     float geometricError = 0.0f;     ///< world units; >= every child's (0 for leaves)
     float boundsMin[3] = {0, 0, 0};  ///< axis-aligned box, world units, contains the children's
@@ -43,6 +44,11 @@ constexpr uint32_t kLeafLevel = 0xFFFFu;
 /// in the chain between that object's leaf and its first aggregate. Ranked finer than
 /// aggregate level 0 and coarser than the leaves (cutAtLevel, levelsOf).
 constexpr uint32_t kObjectLodLevel = 0xFFFEu;
+/// Level of a coarser version of an aggregate: an enclosing simplification of the proxy of
+/// its only child (that aggregate, or the next finer version), error between the aggregate's
+/// and its parent's; same objects, same delta. No level of its own: a cut at a level passes
+/// through it (cutAtLevel), levelsOf does not list it; selection by screen-space error draws it.
+constexpr uint32_t kCoarserLevel = 0xFFFDu;
 /// Aggregate levels are < kMaxAggregateLevel; larger values other than the two above are refused.
 constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
 
@@ -76,7 +82,8 @@ struct BuildParams {
 ///   geometricError/sphereRadius/delta >= 0, boundsMin <= boundsMax;
 /// - parent/children consistent (each non-root listed exactly once, by its parent), no cycle,
 ///   at least one node;
-/// - level kLeafLevel exactly for the leaves; kObjectLodLevel only on an inner node standing
+/// - level kLeafLevel exactly for the leaves; kCoarserLevel only on an inner node with one
+///   child; kObjectLodLevel only on an inner node standing
 ///   for one object; any other level < kMaxAggregateLevel;
 /// - each leaf (childCount 0) stands for >= 1 object, every object in exactly one leaf, an
 ///   inner node lists exactly the objects of its leaves (any order, no duplicates);

@@ -16,7 +16,7 @@ namespace aggrelod::runtime {
 
 /// Format version written by writeRuntimeFile. A reader accepts only its own major version.
 /// 2: per-vertex normals and colours (sections 9 and 10).
-constexpr uint16_t kFormatMajor = 2;
+constexpr uint16_t kFormatMajor = 3;
 constexpr uint16_t kFormatMinor = 0;
 
 /// Why a file was refused (FileStatus::Ok when it was accepted).
@@ -45,7 +45,7 @@ struct NodeRecord {
     uint32_t firstSource, sourceCount;  ///< range in sourceObjects()
     uint32_t firstVertex, vertexCount;  ///< range in positions/normals/colors, counted in vertices
     uint32_t firstIndex, indexCount;    ///< range in indices(); relative to firstVertex
-    uint32_t level;                     ///< aggregate level; kLeafLevel / kObjectLodLevel
+    uint32_t level;                     ///< aggregate level; kLeafLevel / kObjectLodLevel / kCoarserLevel
     float delta;                        ///< world units
     float geometricError;               ///< world units, >= every child's
     float boundsMin[3], boundsMax[3];   ///< world units, contains the children's
@@ -114,6 +114,8 @@ public:
     bool isLeaf(uint32_t node) const { return nodes_.data[node].childCount == 0; }
     /// A simplified version of one object (level kObjectLodLevel), not an aggregate.
     bool isObjectLod(uint32_t node) const { return nodes_.data[node].level == kObjectLodLevel; }
+    /// A coarser version of the aggregate below it (level kCoarserLevel), not a level of its own.
+    bool isCoarser(uint32_t node) const { return nodes_.data[node].level == kCoarserLevel; }
     /// The whole source-object array (NodeRecord::firstSource indexes it).
     Span<uint32_t> allSourceObjects() const { return sourceObjects_; }
     /// Name of original object `object` (< objectCount()), UTF-8.
