@@ -19,10 +19,11 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev
   libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
   libompl-dev
-  chromium clang libclang-rt-14-dev
+  chromium clang libclang-rt-14-dev python3
 )
 # libompl-dev: motion planning on the hierarchy (planning/, `aggrelod plan`).
-# clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz.
+# clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz; python3: their
+# mutation corpora (tests/fuzz/mutate.py).
 # chromium: the web viewer test (tests/web) loads samples/web in headless Chromium.
 # node and npm run the glTF validator in the tests. Take them from Debian only when they are
 # missing: a node installed otherwise (e.g. a vendor repack) conflicts with Debian's npm.

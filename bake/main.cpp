@@ -20,11 +20,13 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <system_error>
@@ -84,8 +86,41 @@ bool createExclusive(const fs::path& p, std::string& error) {
     return true;
 }
 
+/// The journal of a commit in its temporary folder: one line per output, written and synced
+/// before that output is moved ("1" or "0" for whether an old version existed, the name of its
+/// backup in the folder, the final path, tab-separated), then a line "committed" after the
+/// last move.
+constexpr const char* kJournal = "journal";
+
+/// Puts the old set back after a bake was killed while moving its outputs into place (its
+/// journal has no "committed" line): each output already moved is replaced by its backup, or
+/// removed when there was no old version.
+void undoInterruptedCommit(const fs::path& tempDir) {
+    std::ifstream journal(tempDir / kJournal);
+    if (!journal) return;
+    std::vector<std::array<std::string, 3>> moves;
+    for (std::string line; std::getline(journal, line);) {
+        if (line == "committed") return;  // the new set is complete
+        const size_t a = line.find('\t'), b = line.find('\t', a == std::string::npos ? a : a + 1);
+        if (a == std::string::npos || b == std::string::npos) break;  // cut short: written last
+        moves.push_back({line.substr(0, a), line.substr(a + 1, b - a - 1), line.substr(b + 1)});
+    }
+    std::error_code ec;
+    for (auto m = moves.rbegin(); m != moves.rend(); ++m) {
+        const fs::path backup = tempDir / (*m)[1], final = (*m)[2];
+        if ((*m)[0] == "1") {
+            if (!fs::exists(fs::symlink_status(backup, ec))) continue;  // not moved aside yet: still the old one
+            if (fs::is_directory(fs::symlink_status(backup, ec))) fs::remove_all(final, ec);
+            ::rename(backup.c_str(), final.c_str());
+        } else {
+            fs::remove_all(final, ec);
+        }
+    }
+}
+
 /// Removes temporary folders of bakes that are no longer running (killed, or the machine
-/// stopped), and the fixed-name temporaries of older versions.
+/// stopped), after undoing a commit they were killed in, and the fixed-name temporaries of
+/// older versions.
 void removeStaleTemporaries(const fs::path& outDir) {
     std::error_code ec;
     for (const char* legacy : {"levels.glb.tmp", "proxies.glb.tmp", "scene.aglod.tmp", "tiles.tmp", "tiles.old"})
@@ -95,6 +130,7 @@ void removeStaleTemporaries(const fs::path& outDir) {
         if (name.rfind(kTempPrefix, 0) != 0) continue;
         const long pid = std::strtol(name.c_str() + std::strlen(kTempPrefix), nullptr, 10);
         if (pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM)) continue;  // its bake still runs
+        undoInterruptedCommit(it->path());
         std::error_code removeError;
         fs::remove_all(it->path(), removeError);
     }
@@ -166,11 +202,30 @@ public:
                 }
             }
         };
+        const fs::path journalPath = tempDir_ / kJournal;
+        const int journal = ::open(journalPath.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_APPEND | O_CLOEXEC, 0644);
+        if (journal < 0) {
+            error = journalPath.string() + ": cannot create: " + std::strerror(errno);
+            return false;
+        }
+        struct Closer {
+            int fd;
+            ~Closer() { ::close(fd); }
+        } closeJournal{journal};
+        const auto record = [&](const std::string& line) {
+            return ::write(journal, line.data(), line.size()) == ssize_t(line.size()) && ::fdatasync(journal) == 0;
+        };
         size_t k = 0;
         for (const Entry& e : entries_) {
             std::error_code ec;
-            const fs::path backup = tempDir_ / ("old-" + std::to_string(k++) + "-" + e.final.filename().string());
+            const std::string backupName = "old-" + std::to_string(k++) + "-" + e.final.filename().string();
+            const fs::path backup = tempDir_ / backupName;
             const bool hadOld = fs::exists(fs::symlink_status(e.final, ec));
+            if (!record(std::string(hadOld ? "1" : "0") + "\t" + backupName + "\t" + fs::absolute(e.final, ec).string() + "\n")) {
+                error = journalPath.string() + ": cannot write: " + std::strerror(errno);
+                rollBack();
+                return false;
+            }
             if (!e.folder && fs::is_directory(fs::symlink_status(e.final, ec))) {
                 error = e.final.string() + ": cannot replace: it is a folder";
                 rollBack();
@@ -196,6 +251,7 @@ public:
         }
         std::string ignored;
         syncPath(outDir_, ignored);
+        record("committed\n");
         return true;
     }
 
@@ -411,6 +467,12 @@ int runBake(BakeOptions o) {
             printError(outDir.string() + "/tiles is replaced whole by --tiles: the input and --stats must lie outside it");
             return kUsage;
         }
+    }
+
+    // A bake into this OUTDIR killed while moving its outputs: its old set comes back first.
+    {
+        std::error_code ec;
+        if (fs::is_directory(o.outDir, ec)) removeStaleTemporaries(o.outDir);
     }
 
     // Read.

@@ -1,7 +1,7 @@
 // Integration tests of the `aggrelod bake` command line:
 //  a) real scenes from ../shared/data bake, every output mesh is closed, and the output
 //     passes the Khronos glTF validator;
-//  b) bad input (run under AddressSanitizer): a clear message and a clean exit status,
+//  b) bad input (run under AddressSanitizer and UBSan): a clear message and a clean exit status,
 //     never a crash;
 //  c) determinism: two bakes of one scene give byte-identical outputs;
 //  plus the sample scenes (generated here) baked end to end.
@@ -40,6 +40,8 @@ constexpr int kAsanExitCode = 86;
 void setAsanOptions() {
     ::setenv("ASAN_OPTIONS",
              ("detect_leaks=0:abort_on_error=0:exitcode=" + std::to_string(kAsanExitCode)).c_str(), 1);
+    // The sanitizer CLI has UndefinedBehaviorSanitizer too: a report ends the run the same way.
+    ::setenv("UBSAN_OPTIONS", ("halt_on_error=1:print_stacktrace=1:exitcode=" + std::to_string(kAsanExitCode)).c_str(), 1);
 }
 
 /// Reads the aggregates of OUTDIR/levels.glb back (one object per aggregate node). Support
@@ -109,7 +111,8 @@ void expectCleanExit(const RunResult& r, const std::set<int>& allowed) {
     ASSERT_TRUE(r.started) << r.describe();
     EXPECT_FALSE(r.signaled) << "crashed\n" << r.describe();
     EXPECT_EQ(r.err.find("ERROR: AddressSanitizer"), std::string::npos) << r.describe();
-    EXPECT_NE(r.exitCode, kAsanExitCode) << "AddressSanitizer error\n" << r.describe();
+    EXPECT_EQ(r.err.find("runtime error:"), std::string::npos) << "undefined behaviour\n" << r.describe();
+    EXPECT_NE(r.exitCode, kAsanExitCode) << "sanitizer error\n" << r.describe();
     EXPECT_TRUE(r.exited && allowed.count(r.exitCode)) << r.describe();
 }
 

@@ -113,6 +113,40 @@ TEST(OutputSet, StaleTemporariesAreRemoved) {
     EXPECT_TRUE(fs::exists(live));
 }
 
+TEST(OutputSet, AMoveInterruptedByAKillIsUndoneByTheNextBake) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "in.glb", threeCubes());
+    ASSERT_EQ(bake(dir / "in.glb", dir / "out", dir, {"--levels", "2"}).exitCode, 0);
+    ASSERT_EQ(bake(dir / "in.glb", dir / "new", dir, {"--levels", "3"}).exitCode, 0);
+    const std::vector<std::string> oldSet = readSet(dir / "out");
+    // The state a bake leaves when killed right after moving levels.glb into place: the old
+    // levels.glb as its backup, the rest still in the temporary folder, the journal.
+    const fs::path temp = dir / "out" / ".aggrelod-tmp-999999999-killed";
+    fs::create_directories(temp);
+    fs::create_hard_link(dir / "out" / "levels.glb", temp / "old-0-levels.glb");
+    fs::remove(dir / "out" / "levels.glb");  // a new file in its place, as rename does (the link keeps the old)
+    fs::copy_file(dir / "new" / "levels.glb", dir / "out" / "levels.glb");
+    fs::copy_file(dir / "new" / "proxies.glb", temp / "proxies.glb");
+    fs::copy_file(dir / "new" / "scene.aglod", temp / "scene.aglod");
+    writeFile(temp / "journal", "1\told-0-levels.glb\t" + fs::absolute(dir / "out" / "levels.glb").string() + "\n");
+    ASSERT_FALSE(readSet(dir / "out") == oldSet);  // mixed
+    // The next bake, even one that fails on its input, first puts the old set back.
+    const RunResult r = bake(dir / "missing.glb", dir / "out", dir);
+    EXPECT_EQ(r.exitCode, 2) << r.describe();
+    EXPECT_TRUE(readSet(dir / "out") == oldSet) << "the old set is not back";
+    EXPECT_FALSE(fs::exists(temp));
+
+    // A journal that reached "committed": the new set stays.
+    const std::vector<std::string> newSet = readSet(dir / "new");
+    for (const auto& name : kSet) fs::copy_file(dir / "new" / name, dir / "out" / name, fs::copy_options::overwrite_existing);
+    fs::create_directories(temp);
+    writeFile(temp / "old-0-levels.glb", oldSet[0]);
+    writeFile(temp / "journal", "1\told-0-levels.glb\t" + fs::absolute(dir / "out" / "levels.glb").string() + "\ncommitted\n");
+    EXPECT_EQ(bake(dir / "missing.glb", dir / "out", dir).exitCode, 2);
+    EXPECT_TRUE(readSet(dir / "out") == newSet) << "a committed set was undone";
+    EXPECT_FALSE(fs::exists(temp));
+}
+
 TEST(OutputSet, ABakeKilledAtAnyMomentLeavesTheOldOrTheNewSet) {
     const fs::path dir = freshTestDir(currentTestName());
     // Enough objects for the bake to take a while (kill times spread over all its stages).
