@@ -1893,12 +1893,8 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 // A coarser version of an aggregate neither: it is named after its step and
                 // tinted as the level of the aggregate it simplifies.
                 const bool objectLod = n.objectLod >= 1, coarser = n.coarserStep >= 1;
-                int tintLevel = objectLod ? 0 : n.firstLevel;
-                if (coarser) {
-                    size_t below = i;
-                    while (nodes.nodes[below].coarserStep >= 1) below = nodes.nodes[below].children.front();
-                    tintLevel = std::max(nodes.nodes[below].firstLevel, 0);
-                }
+                const int tintLevel =
+                    objectLod ? 0 : std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0);
                 node.name = "node" + std::to_string(i) +
                             (objectLod ? "_object_lod" + std::to_string(n.objectLod)
                              : coarser ? "_coarser" + std::to_string(n.coarserStep)

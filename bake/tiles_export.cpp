@@ -236,9 +236,7 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
         TileMesh tile;
         const bool objectLod = node.objectLod >= 1;
         // A coarser version takes the level (and tint) of the aggregate it simplifies.
-        uint32_t below = n;
-        while (nodes.nodes[below].coarserStep >= 1) below = nodes.nodes[below].children.front();
-        const int level = std::max(nodes.nodes[below].firstLevel, 0);
+        const int level = std::max(nodes.nodes[aggregateBelow(nodes, n)].firstLevel, 0);
         tile.name = node.leaf                ? "object_" + objects[n].name
                     : objectLod             ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
                     : node.coarserStep >= 1 ? "node" + std::to_string(n) + "_coarser" + std::to_string(node.coarserStep)

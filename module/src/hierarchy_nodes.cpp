@@ -649,4 +649,9 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     return true;
 }
 
+uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node) {
+    while (nodes.nodes[node].coarserStep >= 1) node = nodes.nodes[node].children.front();
+    return node;
+}
+
 }  // namespace aggrelod

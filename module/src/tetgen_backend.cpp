@@ -35,8 +35,15 @@ namespace {
 // them straight into the destination vectors: no intermediate buffer, no second copy.
 bool writeAll(int fd, const void* data, size_t size) {
     const char* p = static_cast<const char*>(data);
+    bool socket = true;
     while (size > 0) {
-        ssize_t n = ::write(fd, p, size);
+        // To a socket with MSG_NOSIGNAL: a helper that died must give an error here, not
+        // SIGPIPE the bake. A pipe (the forked child's) takes write().
+        ssize_t n = socket ? ::send(fd, p, size, MSG_NOSIGNAL) : ::write(fd, p, size);
+        if (n < 0 && socket && errno == ENOTSOCK) {
+            socket = false;
+            continue;
+        }
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) return false;
         p += n;
@@ -297,32 +304,13 @@ void doJobReportingErrors(Job job, const PlcInput& plc, const std::string& extra
 
 constexpr uint32_t kRequestMagic = 0x47544741u;  // "AGTG"
 
-bool sendAll(int fd, const void* data, size_t size) {
-    const char* p = static_cast<const char*>(data);
-    while (size > 0) {
-        // MSG_NOSIGNAL: a helper that died must give an error here, not SIGPIPE the bake.
-        const ssize_t n = ::send(fd, p, size, MSG_NOSIGNAL);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        size -= static_cast<size_t>(n);
-    }
-    return true;
-}
-
-template <class T>
-bool sendArray(int fd, const T* data, size_t count) {
-    const uint64_t n = count;
-    return sendAll(fd, &n, sizeof n) && (count == 0 || sendAll(fd, data, count * sizeof(T)));
-}
-
 bool sendRequest(int fd, Job job, const PlcInput& plc, const std::string& extraSwitches, double cpuSeconds,
                  uint64_t memoryBytes) {
     const uint32_t head[2] = {kRequestMagic, static_cast<uint32_t>(job)};
-    return sendAll(fd, head, sizeof head) && sendAll(fd, &cpuSeconds, sizeof cpuSeconds) &&
-           sendAll(fd, &memoryBytes, sizeof memoryBytes) && sendArray(fd, extraSwitches.data(), extraSwitches.size()) &&
-           sendArray(fd, plc.points.data(), plc.points.size()) && sendArray(fd, plc.triangles.data(), plc.triangles.size()) &&
-           sendArray(fd, plc.triangleMarkers.data(), plc.triangleMarkers.size());
+    return writeAll(fd, head, sizeof head) && writeAll(fd, &cpuSeconds, sizeof cpuSeconds) &&
+           writeAll(fd, &memoryBytes, sizeof memoryBytes) && writeArray(fd, extraSwitches.data(), extraSwitches.size()) &&
+           writeArray(fd, plc.points.data(), plc.points.size()) && writeArray(fd, plc.triangles.data(), plc.triangles.size()) &&
+           writeArray(fd, plc.triangleMarkers.data(), plc.triangleMarkers.size());
 }
 
 // The helper: AGGRELOD_TETGEN_HELPER when set (empty: none, fork instead), else

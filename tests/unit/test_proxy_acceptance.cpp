@@ -416,9 +416,7 @@ std::vector<ProxyUnderTest> nodeProxies(const AcceptanceScene& s) {
         p.indices = &n.indices;
         p.sources.assign(n.sources.begin(), n.sources.end());
         // A coarser version has the shells of the aggregate it simplifies.
-        uint32_t below = i;
-        while (nodes.nodes[below].coarserStep >= 1) below = nodes.nodes[below].children.front();
-        const HierarchyNode& a = nodes.nodes[below];
+        const HierarchyNode& a = nodes.nodes[aggregateBelow(nodes, i)];
         p.expectedShells = n.objectLod >= 1
                                ? objectShells(s.input.objects[n.sources.front()])
                                : s.baked.hierarchy.levels[size_t(a.firstLevel)].aggregates[a.aggregateIndex].componentCount;

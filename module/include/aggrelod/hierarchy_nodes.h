@@ -126,6 +126,10 @@ struct HierarchyNodes {
 bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                          const ProxySettings& settings, HierarchyNodes& out, std::string& error);
 
+/// The aggregate node that coarser version `node` simplifies (the end of its chain of single
+/// children); `node` itself when it is not a coarser version. `node` < nodes.nodes.size().
+uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node);
+
 /// Measures the error of a proxy (float positions, 3 * vertexCount; indices 3 * triangleCount,
 /// closed) against `originals` (world units) by branch and bound over triangles and, for
 /// originals -> proxy, boxes of per-object BVHs: refines until the bounds are within
