@@ -6,6 +6,7 @@
 // measures its error (proxy_error.cpp), colours its faces after the nearest original surface
 // (surface_colors.cpp), and makes bounds nested and errors monotone so that
 // the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
+#include "bounding_polytope.h"
 #include "conservative_simplify.h"
 #include "convex_hull.h"
 #include "mesh_optimize.h"
@@ -174,6 +175,72 @@ private:
     std::vector<char> pinned_;
 };
 
+/// Whether a triangle has two corners at one float position.
+bool hasCollapsedTriangle(const std::vector<float>& positions, const std::vector<uint32_t>& indices) {
+    const auto same = [&](uint32_t a, uint32_t b) {
+        return positions[3 * a] == positions[3 * b] && positions[3 * a + 1] == positions[3 * b + 1] &&
+               positions[3 * a + 2] == positions[3 * b + 2];
+    };
+    for (size_t t = 0; t + 2 < indices.size(); t += 3)
+        if (same(indices[t], indices[t + 1]) || same(indices[t + 1], indices[t + 2]) || same(indices[t + 2], indices[t]))
+            return true;
+    return false;
+}
+
+/// Few-faced convex polytopes around a closed mesh's convex hull (bounding_polytope.h), and
+/// the certified error of that hull against the originals: a polytope within d of the hull
+/// lies within d + that error of them, which picks the candidate before it is measured.
+class PolytopeSource {
+public:
+    PolytopeSource(const std::vector<double>& positions, const std::vector<const detail::PreparedOriginal*>& originals,
+                   double tolerance, const ProxySettings& settings, double giveUpAbove)
+        : originals_(originals), settings_(settings) {
+        if (settings.polytopeVertices < 4) return;
+        std::vector<double> hullPositions;
+        std::vector<uint32_t> hullIndices;
+        if (!detail::convexHull3(positions, hullPositions, hullIndices)) return;
+        const std::vector<float> rounded = toFloats(hullPositions);
+        hullError_ = measureEnclosure(hullPositions, rounded, hullIndices, originals, tolerance, settings, giveUpAbove).bound();
+        if (!(hullError_ < giveUpAbove)) return;
+        enclosed_ = positions;
+        polytopes_ = detail::boundingPolytopes(hullPositions, hullIndices, size_t(settings.polytopeVertices), 0.0);
+    }
+
+    /// The coarsest polytope whose certified error fits `budget`, with at most
+    /// maxTriangles triangles; false when none does. n gets positions, indices and error.
+    bool coarsestWithin(double budget, size_t maxTriangles, double tolerance, HierarchyNode& n) const {
+        int tried = 0;
+        for (const detail::BoundingPolytope& p : polytopes_) {
+            if (2 * (p.vertices.size() / 3) > maxTriangles + 4) break;  // a triangulated polytope has 2V - 4 faces
+            if (!(p.distanceToHull + hullError_ <= budget)) continue;
+            std::vector<double> positions;
+            std::vector<uint32_t> indices;
+            if (!detail::boundingPolytopeMesh(p, enclosed_, positions, indices) || indices.size() / 3 > maxTriangles) continue;
+            HierarchyNode candidate;
+            candidate.positions = toFloats(positions);
+            candidate.indices = std::move(indices);
+            if (hasCollapsedTriangle(candidate.positions, candidate.indices)) continue;  // corners merged by float rounding
+            candidate.error = measureEnclosure(positions, candidate.positions, candidate.indices, originals_, tolerance,
+                                               settings_, budget);
+            if (candidate.error.bound() <= budget) {
+                n.positions = std::move(candidate.positions);
+                n.indices = std::move(candidate.indices);
+                n.error = candidate.error;
+                return true;
+            }
+            if (++tried == 2) break;  // the bound by the triangle inequality was loose twice
+        }
+        return false;
+    }
+
+private:
+    const std::vector<const detail::PreparedOriginal*>& originals_;
+    const ProxySettings& settings_;
+    std::vector<double> enclosed_;
+    std::vector<detail::BoundingPolytope> polytopes_;
+    double hullError_ = INFINITY;
+};
+
 /// A proxy as built, in doubles, before vertex-cache ordering: what its coarser versions
 /// are simplified from.
 struct ExactProxy {
@@ -230,6 +297,46 @@ const detail::ConservativeSnapshot* lighterCleanSnapshot(EnclosureSeries& series
     return clean;
 }
 
+/// Connected pieces of a triangle mesh (triangles sharing a vertex are connected).
+size_t shellCount(size_t vertexCount, const std::vector<uint32_t>& triangles) {
+    std::vector<uint32_t> parent(vertexCount);
+    for (uint32_t v = 0; v < vertexCount; ++v) parent[v] = v;
+    const auto root = [&](uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (size_t t = 0; t + 2 < triangles.size(); t += 3)
+        for (int k = 1; k < 3; ++k) parent[root(triangles[t + k])] = root(triangles[t]);
+    std::vector<char> used(vertexCount, 0);
+    for (uint32_t v : triangles) used[v] = 1;
+    size_t count = 0;
+    for (uint32_t v = 0; v < vertexCount; ++v) count += used[v] && root(v) == v;
+    return count;
+}
+
+/// The lightest chain through candidate versions of one node, finest first: by ascending
+/// certified error, a candidate is kept when it has at most 80 % of the triangles of the one
+/// kept before it (the first: of finerTriangles, the node's own), at most maxCount of them.
+/// A version with a larger error is selectable only from farther away, so of two errors the
+/// chain keeps both when the coarser one is lighter enough to be worth a node.
+std::vector<HierarchyNode> lightestChain(std::vector<HierarchyNode> candidates, size_t finerTriangles, int maxCount) {
+    std::vector<size_t> order(candidates.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        const double ea = candidates[a].error.bound(), eb = candidates[b].error.bound();
+        return ea < eb || (ea == eb && candidates[a].indices.size() < candidates[b].indices.size());
+    });
+    std::vector<HierarchyNode> chain;
+    for (size_t i : order) {
+        if (int(chain.size()) >= maxCount) break;
+        const size_t triangles = candidates[i].indices.size() / 3;
+        if (5 * triangles > 4 * finerTriangles) continue;
+        finerTriangles = triangles;
+        chain.push_back(std::move(candidates[i]));
+    }
+    return chain;
+}
+
 /// Error targets of per-object LOD chains: a geometric series sqrt(2) apart, from this
 /// fraction of the object's box diagonal up.
 constexpr double kChainFinestFraction = 1.0 / 1024;
@@ -238,10 +345,12 @@ constexpr double kChainRatio = 1.4142135623730951;
 /// Per-object LOD (DESIGN section 2.6): conservative simplifications of one object at error
 /// targets sqrt(2) apart, from a thousandth of its diagonal up to below `ceiling` (the error
 /// of the first aggregate above it holding other objects; infinity for none, then up to its
-/// diagonal). A level is kept when it does not intersect itself, its certified error fits its
-/// budget (twice its target) and stays below the ceiling, and it has at most 80 % of the
-/// triangles of the finer one kept. Returned finest first; empty for an object that is not a
-/// closed solid (only a closed mesh can be simplified into an enclosure of it).
+/// diagonal), and for an object of one shell the coarsest enclosing polytope of its convex
+/// hull that fits each target. A candidate counts when it does not intersect itself and its
+/// certified error fits its budget (twice its target) and stays below the ceiling; the chain
+/// is the lightest one through them (lightestChain). Returned finest first; empty for an
+/// object that is not a closed solid (only a closed mesh can be simplified into an enclosure
+/// of it).
 std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t objectIndex,
                                           const detail::PreparedOriginal& original, double ceiling,
                                           const ProxySettings& settings) {
@@ -260,25 +369,41 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
     for (double t = kChainFinestFraction * diagonal; t < top; t *= kChainRatio) targets.push_back(t);
     if (targets.empty()) return chain;
     EnclosureSeries series(prepared.positions, prepared.triangles, targets);
-    size_t finerTriangles = object.indices.size() / 3;
     const std::vector<const detail::PreparedOriginal*> originals{&original};
-    for (size_t i = 0; i < series.size() && int(chain.size()) < settings.objectLodCount; ++i) {
-        const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, finerTriangles);
+    std::unique_ptr<PolytopeSource> polytopes;
+    if (shellCount(prepared.positions.size() / 3, prepared.triangles) == 1)
+        polytopes = std::make_unique<PolytopeSource>(prepared.positions, originals,
+                                                     settings.toleranceFraction * targets.front(), settings,
+                                                     std::min(ceiling, 2 * top));
+    std::vector<HierarchyNode> candidates;
+    const size_t objectTriangles = object.indices.size() / 3;
+    size_t lastTriangles = 0;
+    for (size_t i = 0; i < series.size(); ++i) {
+        const double budget = 2 * targets[i], tolerance = settings.toleranceFraction * targets[i];
+        HierarchyNode p;
+        if (polytopes && polytopes->coarsestWithin(std::min(budget, std::nextafter(ceiling, 0.0)), 4 * objectTriangles / 5,
+                                                   tolerance, p)) {
+            p.budget = budget;
+            candidates.push_back(std::move(p));
+        }
+        if (series.triangleCount(i) == lastTriangles) continue;  // stopped simplifying: the same mesh again
+        const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, objectTriangles);
         if (!clean) continue;
-        const detail::ConservativeSnapshot& s = *clean;
-        const size_t triangles = s.indices.size() / 3;
+        lastTriangles = series.triangleCount(i);
         HierarchyNode n;
-        n.objectLod = static_cast<int>(chain.size()) + 1;
-        n.sources = {objectIndex};
-        n.budget = 2 * targets[i];
-        n.positions = toFloats(s.positions);
-        n.indices = s.indices;
-        n.exactTriangleCount = object.indices.size() / 3;
-        n.error = measureEnclosure(s.positions, n.positions, n.indices, originals, settings.toleranceFraction * targets[i],
-                                   settings, std::min(n.budget, ceiling));
-        if (!(n.error.bound() <= n.budget) || !(n.error.bound() < ceiling)) continue;
-        finerTriangles = triangles;
-        chain.push_back(std::move(n));
+        n.positions = toFloats(clean->positions);
+        n.indices = clean->indices;
+        n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals, tolerance, settings,
+                                   std::min(budget, ceiling));
+        if (!(n.error.bound() <= budget) || !(n.error.bound() < ceiling)) continue;
+        n.budget = budget;
+        candidates.push_back(std::move(n));
+    }
+    chain = lightestChain(std::move(candidates), objectTriangles, settings.objectLodCount);
+    for (size_t j = 0; j < chain.size(); ++j) {
+        chain[j].objectLod = static_cast<int>(j) + 1;
+        chain[j].sources = {objectIndex};
+        chain[j].exactTriangleCount = objectTriangles;
     }
     return chain;
 }
@@ -290,10 +415,10 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
 /// of a wider fill; these versions fill the gap, so that at any distance the cut can draw a
 /// version of the group whose error is near what the pixel tolerance allows. Each target is
 /// tried on the proxy and, for a proxy of one shell, on its convex hull (both simplified in
-/// one pass each); of the two that fit, the one with the smaller error. A version is kept as a per-object LOD
-/// level is: it does not intersect itself, its certified error fits its budget (the node's
-/// error plus twice its push-out allowance) and stays below the ceiling, and it has at most
-/// 80 % of the triangles of the finer one kept. Finest first.
+/// one pass each) and as the coarsest enclosing polytope of that hull. A candidate counts
+/// when it does not intersect itself, its certified error fits its budget (the node's error
+/// plus twice its push-out allowance) and stays below the ceiling; the chain is the lightest
+/// one through them (lightestChain). Finest first.
 std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactProxy& proxy, bool oneShell,
                                         const std::vector<const detail::PreparedOriginal*>& originals, double ceiling,
                                         const ProxySettings& settings) {
@@ -317,35 +442,46 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
     if (oneShell && detail::convexHull3(proxy.positions, hull.positions, hull.indices) &&
         hull.indices.size() < proxy.indices.size())
         sources.push_back(std::make_unique<EnclosureSeries>(hull.positions, hull.indices, allowances));
-    size_t finerTriangles = proxy.indices.size() / 3;
-    for (size_t i = 0; i < allowances.size() && int(chain.size()) < settings.coarserCount; ++i) {
-        const double budget = own + 2 * allowances[i];
-        HierarchyNode best;
-        for (const auto& series : sources) {
-            const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(*series, i, finerTriangles);
+    std::unique_ptr<PolytopeSource> polytopes;
+    if (oneShell)
+        polytopes = std::make_unique<PolytopeSource>(proxy.positions, originals,
+                                                     settings.toleranceFraction * base, settings,
+                                                     std::min(ceiling, own + 2 * top));
+    // Every version that fits its target's budget, from every source; then the lightest chain.
+    std::vector<HierarchyNode> candidates;
+    std::vector<size_t> lastTriangles(sources.size(), 0);
+    for (size_t i = 0; i < allowances.size(); ++i) {
+        const double budget = own + 2 * allowances[i], tolerance = settings.toleranceFraction * (own + allowances[i]);
+        HierarchyNode p;
+        if (polytopes && polytopes->coarsestWithin(std::min(budget, std::nextafter(ceiling, 0.0)),
+                                                   4 * (proxy.indices.size() / 3) / 5, tolerance, p)) {
+            p.budget = budget;
+            candidates.push_back(std::move(p));
+        }
+        for (size_t k = 0; k < sources.size(); ++k) {
+            EnclosureSeries& series = *sources[k];
+            // A series that stopped simplifying repeats its snapshot: measured once.
+            if (series.triangleCount(i) == lastTriangles[k]) continue;
+            const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, proxy.indices.size() / 3);
             if (!clean) continue;
+            lastTriangles[k] = series.triangleCount(i);
             HierarchyNode n;
             n.positions = toFloats(clean->positions);
             n.indices = clean->indices;
-            n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals,
-                                       settings.toleranceFraction * (own + allowances[i]), settings,
+            n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals, tolerance, settings,
                                        std::min(budget, ceiling));
             if (!(n.error.bound() <= budget && n.error.bound() < ceiling)) continue;
-            // Of two that fit, the one with the smaller error, unless the other is also
-            // lighter: the coarser one is reached at a later target, while a version that
-            // takes the whole budget at once is selectable only from farther away.
-            const bool better = best.indices.empty() || n.error.bound() < best.error.bound() ||
-                                (n.error.bound() <= best.error.bound() && n.indices.size() < best.indices.size());
-            if (better) best = std::move(n);
+            n.budget = budget;
+            candidates.push_back(std::move(n));
         }
-        if (best.indices.empty()) continue;
-        best.coarserStep = static_cast<int>(chain.size()) + 1;
-        best.sources = node.sources;
-        best.delta = node.delta;
-        best.budget = budget;
-        best.exactTriangleCount = node.exactTriangleCount;
-        finerTriangles = best.indices.size() / 3;
-        chain.push_back(std::move(best));
+    }
+    chain = lightestChain(std::move(candidates), proxy.indices.size() / 3, settings.coarserCount);
+    for (size_t j = 0; j < chain.size(); ++j) {
+        HierarchyNode& c = chain[j];
+        c.coarserStep = static_cast<int>(j) + 1;
+        c.sources = node.sources;
+        c.delta = node.delta;
+        c.exactTriangleCount = node.exactTriangleCount;
     }
     return chain;
 }

@@ -134,6 +134,16 @@ typedef struct aglod_cut_changes {
 /* One selector per view; allocates at creation only. NULL on failure. */
 aglod_selector* aglod_selector_create(const aglod_file* file);
 void aglod_selector_destroy(aglod_selector* selector);
+/* Drawing costs: a node that costs more (triangles + triangles_per_draw_call) than the
+ * cheapest cover of its objects by nodes below it is never drawn; the cut stays within the
+ * pixel tolerance and draws no more triangles than without this, often fewer.
+ * original_triangles: triangles the engine draws per original object (aglod_object_count
+ * entries), or NULL when unknown (a leaf then never counts as cheaper). Resets the
+ * selection (the next call starts from the roots). Without this call the selector behaves
+ * as after (NULL, 16). AGLOD_INVALID_ARGUMENT for a NULL selector or a negative or
+ * non-finite triangles_per_draw_call. */
+aglod_status aglod_selector_set_draw_costs(aglod_selector* selector, const uint32_t* original_triangles,
+                                           float triangles_per_draw_call);
 /* Screen-space-error selection, incremental from the previous call (DESIGN section 3).
  * pixel_tolerance: tau in pixels (> 0); coarsen_ratio in (0, 1]: hysteresis (1 = none). */
 aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera,

@@ -193,6 +193,16 @@ aglod_selector* aglod_selector_create(const aglod_file* file) {
 
 void aglod_selector_destroy(aglod_selector* selector) { delete selector; }
 
+aglod_status aglod_selector_set_draw_costs(aglod_selector* selector, const uint32_t* original_triangles,
+                                           float triangles_per_draw_call) {
+    if (!selector) return failWith(AGLOD_INVALID_ARGUMENT, "aglod_selector_set_draw_costs: selector is NULL");
+    if (!(triangles_per_draw_call >= 0.0f) || !std::isfinite(triangles_per_draw_call))
+        return failWith(AGLOD_INVALID_ARGUMENT,
+                        "aglod_selector_set_draw_costs: triangles_per_draw_call must be finite and >= 0");
+    selector->selector.setDrawCosts(original_triangles, triangles_per_draw_call);
+    return AGLOD_OK;
+}
+
 static bool validSelection(const char* function, const float position[3], float pixel_tolerance,
                            float coarsen_ratio, float fov_y, float viewport_height) {
     if (!inRange(position, 3)) {

@@ -86,6 +86,55 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
     left_.resize(n);
     touched_.resize(n);
     touchStamp_.assign(n, 0);
+    setDrawCosts(nullptr, kDefaultTrianglesPerDrawCall);
+}
+
+void Selector::setDrawCosts(const uint32_t* originalTriangles, float trianglesPerDrawCall) {
+    const RuntimeFile& file = *file_;
+    const uint32_t n = file.nodeCount();
+    const double perDraw = trianglesPerDrawCall > 0 && std::isfinite(trianglesPerDrawCall) ? trianglesPerDrawCall : 0.0;
+    // Preorder from the roots; the cheapest cover of a node's objects, children before
+    // parents: min(own cost, sum over the children). A leaf costs its originals (unknown:
+    // infinite, so it is never preferred).
+    std::vector<uint32_t> order;
+    order.reserve(n);
+    std::vector<uint32_t>& stack = stack_;  // free outside a selection
+    uint32_t top = 0;
+    for (uint32_t root : file.roots()) stack[top++] = root;
+    while (top > 0) {
+        const uint32_t x = stack[--top];
+        order.push_back(x);
+        for (uint32_t c : file.children(x)) stack[top++] = c;
+    }
+    std::vector<double> cheapest(n, 0.0);
+    skipped_.assign(n, 0);
+    skippedCount_ = 0;
+    for (size_t i = order.size(); i-- > 0;) {
+        const uint32_t x = order[i];
+        const NodeRecord& r = file.node(x);
+        if (r.childCount == 0) {
+            double own = originalTriangles ? perDraw : INFINITY;
+            if (originalTriangles)
+                for (uint32_t o : file.sources(x)) own += originalTriangles[o] + (o == file.sources(x)[0] ? 0.0 : perDraw);
+            cheapest[x] = own;
+            continue;
+        }
+        const double own = double(r.indexCount / 3) + perDraw;
+        double below = 0;
+        for (uint32_t c : file.children(x)) below += cheapest[c];
+        if (below < own) {
+            skipped_[x] = 1;
+            ++skippedCount_;
+        }
+        cheapest[x] = std::min(own, below);
+    }
+    // The climb of the incremental pass goes from a node to the nearest ancestor that can be
+    // drawn: skipped nodes are always refined, so they never stop it.
+    for (const uint32_t x : order) {  // parents before children
+        uint32_t up = file.node(x).parent;
+        while (up != kNoIndex && skipped_[up]) up = file.node(up).parent;
+        hot_[x].parent = up;
+    }
     reset();
 }
 
@@ -131,7 +180,7 @@ inline bool Selector::refine(uint32_t node, const Frame& f) {
     if (st.decidedStamp == frame_) return st.decision != 0;
     ++stats_.errorTests;
     const bool yes = hot_[node].leafSources == 0 &&
-                     (exceeds(node, f.reachRefine) || (st.refined && exceeds(node, f.reachCoarsen)));
+                     (skipped_[node] || exceeds(node, f.reachRefine) || (st.refined && exceeds(node, f.reachCoarsen)));
     st.decidedStamp = frame_;
     st.decision = yes;
     return yes;
@@ -424,7 +473,7 @@ inline float Selector::slack(uint32_t node, float reach, const Frame& f) const {
 void Selector::grantLease(uint32_t node, const Frame& f) {
     const Hot& h = hot_[node];
     float s = INFINITY;
-    if (h.leafSources == 0 && h.error > 0.0f) s = slack(node, f.reachRefine, f);
+    if (h.leafSources == 0 && h.error > 0.0f && !skipped_[node]) s = slack(node, f.reachRefine, f);
     if (h.parent != kNoIndex) s = std::min(s, slack(h.parent, f.reachCoarsen, f));
     const uint32_t serial = ++leaseSerial_[node];
     if (s == INFINITY) return;  // nothing can change this node's state

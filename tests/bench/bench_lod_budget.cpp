@@ -8,8 +8,9 @@
 //      errors sqrt(2) apart), each level's error measured as ours (measureProxyError, the
 //      certified two-sided Hausdorff distance), the level with the fewest triangles whose
 //      error projects to <= tau at the object's bounding sphere; one draw call per object;
-//  (c) aggrelod's cut: Selector::selectFull at tau, no hysteresis; proxy triangles plus the
-//      originals drawn as leaves, one draw call per proxy node and per leaf.
+//  (c) aggrelod's cut: Selector::selectFull at tau, no hysteresis, with the originals'
+//      triangle counts given (Selector::setDrawCosts, default cost per draw call); proxy
+//      triangles plus the originals drawn as leaves, one draw call per proxy node and per leaf.
 // Figures are means per camera over the 8 azimuths. Then the goals (PASS / FAIL) and the
 // proxies stage's share of the bake. A benchmark: nothing is asserted; apart from the
 // timings the output is deterministic.
@@ -271,6 +272,9 @@ bool runScene(const Options& o, const std::string& name) {
     if (input.upAxis == 1) a1 = 2, a2 = 0;
     const double elevation = o.elevationDegrees * kPi / 180.0;
     runtime::Selector selector(file);
+    std::vector<uint32_t> originalTriangles(objects.size());
+    for (size_t i = 0; i < objects.size(); ++i) originalTriangles[i] = uint32_t(objects[i].indices.size() / 3);
+    selector.setDrawCosts(originalTriangles.data(), runtime::Selector::kDefaultTrianglesPerDrawCall);
     runtime::SelectionSettings settings;
     settings.pixelTolerance = kTau;
     settings.coarsenRatio = 1.0f;

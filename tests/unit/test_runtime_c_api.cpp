@@ -11,8 +11,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
+#include <vector>
 
 using aggrelod::testing::makeSyntheticHierarchy;
 
@@ -73,6 +75,21 @@ TEST(RuntimeCApi, OpenSelectAndNames) {
     EXPECT_GT(cut.original_count, 0u);
     EXPECT_EQ(aglod_select(selector, &camera, 0.0f, 0.75f, &cut), AGLOD_INVALID_ARGUMENT);
     EXPECT_NE(std::string(aglod_last_error()).find("pixel_tolerance"), std::string::npos);
+    // Drawing costs: the same as the C++ call; bad arguments refused.
+    std::vector<uint32_t> originalTriangles(aglod_object_count(file), 12u);
+    ASSERT_EQ(aglod_selector_set_draw_costs(selector, originalTriangles.data(), 8.0f), AGLOD_OK);
+    reference.setDrawCosts(originalTriangles.data(), 8.0f);
+    ASSERT_EQ(aglod_select(selector, &camera, 4.0f, 0.75f, &cut), AGLOD_OK);
+    reference.selectFull(c, {4.0f, 0.75f});
+    a.assign(cut.nodes, cut.nodes + cut.node_count);
+    b.assign(reference.cut().begin(), reference.cut().end());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(aglod_selector_set_draw_costs(nullptr, nullptr, 1.0f), AGLOD_INVALID_ARGUMENT);
+    EXPECT_EQ(aglod_selector_set_draw_costs(selector, nullptr, -1.0f), AGLOD_INVALID_ARGUMENT);
+    EXPECT_EQ(aglod_selector_set_draw_costs(selector, nullptr, INFINITY), AGLOD_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(aglod_last_error()).find("triangles_per_draw_call"), std::string::npos);
     aglod_selector_destroy(selector);
     aglod_close(file);
 }

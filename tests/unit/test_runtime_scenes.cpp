@@ -491,7 +491,8 @@ TEST(RuntimeScenes, ValidCutForRandomCameras) {
                 if (n.childCount > 0) {
                     EXPECT_LE(fresh.screenSpaceErrorOf(node, c), 1.0f) << s.label << " node " << node;
                 }
-                if (n.parent != runtime::kNoIndex) {
+                // Its parent exceeds tau, or is never worth drawing (Selector::setDrawCosts).
+                if (n.parent != runtime::kNoIndex && !fresh.skipsNode(n.parent)) {
                     EXPECT_GT(fresh.screenSpaceErrorOf(n.parent, c), 1.0f) << s.label << " node " << node;
                 }
             }
@@ -506,6 +507,73 @@ TEST(RuntimeScenes, ValidCutForRandomCameras) {
                     s.label.c_str(), withProxies, withOriginals, mixed, double(totalCut) / 1000, f.nodeCount());
         EXPECT_GT(mixed, 0u) << s.label << ": no camera gave a cut mixing proxies and originals; the test would be weak";
     }
+}
+
+// Selector::setDrawCosts: skipping the nodes that cost more than the cheapest cover below
+// them never draws more (triangles + a cost per draw call) than the plain rule, keeps every
+// drawn proxy within tau and the cover exact, and the incremental selection equals the full one.
+TEST(RuntimeScenes, DrawCostsNeverDrawMoreThanThePlainRule) {
+    size_t lighter = 0, skipped = 0;
+    for (SceneId id : {SceneId::Spheres15, SceneId::Chess, SceneId::TruckTown}) {
+        BakedScene& s = scene(id);
+        if (s.problem.rfind("absent", 0) == 0) continue;
+        ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
+        const runtime::RuntimeFile& f = s.file;
+        ASSERT_EQ(size_t(f.objectCount()), s.originals.size());
+        std::vector<uint32_t> originalTriangles(f.objectCount());
+        for (uint32_t o = 0; o < f.objectCount(); ++o) originalTriangles[o] = uint32_t(s.originals[o].indices.size() / 3);
+        const float perDraw = runtime::Selector::kDefaultTrianglesPerDrawCall;
+        runtime::Selector costed(f), incremental(f), plain(f);
+        costed.setDrawCosts(originalTriangles.data(), perDraw);
+        incremental.setDrawCosts(originalTriangles.data(), perDraw);
+        plain.setDrawCosts(nullptr, 1e30f);
+        EXPECT_EQ(plain.skippedNodeCount(), 0u);
+        skipped += costed.skippedNodeCount();
+        const auto cost = [&](const runtime::Selector& sel) {
+            double total = 0;
+            for (uint32_t node : sel.cut()) {
+                total += perDraw;
+                if (f.isLeaf(node))
+                    for (uint32_t o : f.sources(node)) total += originalTriangles[o];
+                else
+                    total += double(f.triangles(node).size / 3);
+            }
+            return total;
+        };
+        std::mt19937_64 rng(4242);
+        runtime::SelectionSettings settings;
+        settings.pixelTolerance = 1.0f;
+        settings.coarsenRatio = 1.0f;
+        for (int camera = 0; camera < 300; ++camera) {
+            runtime::Camera c;
+            randomCameraPosition(rng, s, 0.05, 200, c.position);
+            c.fovY = float(60 * M_PI / 180);
+            c.viewportHeight = 1080.0f;
+            costed.selectFull(c, settings);
+            plain.selectFull(c, settings);
+            incremental.select(c, settings);
+            std::vector<uint32_t> a(costed.cut().begin(), costed.cut().end()), b(incremental.cut().begin(), incremental.cut().end());
+            std::sort(a.begin(), a.end());
+            std::sort(b.begin(), b.end());
+            ASSERT_EQ(a, b) << s.label << " camera " << camera << ": incremental differs from full";
+            std::vector<int> cover(f.objectCount(), 0);
+            for (uint32_t node : costed.cut()) {
+                for (uint32_t o : f.sources(node)) ++cover[o];
+                EXPECT_FALSE(costed.skipsNode(node)) << s.label << " node " << node;
+                if (!f.isLeaf(node)) {
+                    EXPECT_LE(costed.screenSpaceErrorOf(node, c), 1.0f) << s.label << " node " << node;
+                }
+            }
+            for (uint32_t o = 0; o < f.objectCount(); ++o) ASSERT_EQ(cover[o], 1) << s.label << " object " << o;
+            const double withCosts = cost(costed), without = cost(plain);
+            EXPECT_LE(withCosts, without) << s.label << " camera " << camera;
+            lighter += withCosts < without;
+        }
+        std::printf("%-10s %u of %u nodes never worth drawing\n", s.label.c_str(), costed.skippedNodeCount(), f.nodeCount());
+    }
+    std::printf("cameras where the cut got lighter: %zu\n", lighter);
+    EXPECT_GT(skipped, 0u) << "no node skipped: the test would not exercise the rule";
+    EXPECT_GT(lighter, 0u);
 }
 
 namespace {

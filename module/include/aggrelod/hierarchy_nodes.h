@@ -40,6 +40,11 @@ struct ProxySettings {
     /// simplifications of its proxy at error targets sqrt(2) apart from its budget up to its
     /// parent's error (a root: up to its diagonal). 0 = none.
     int coarserCount = 16;
+    /// Most vertices of the few-faced convex polytopes that enclose a one-shell proxy's
+    /// convex hull (intersections of its supporting half-spaces), tried beside the enclosing
+    /// simplifications for per-object LOD levels and coarser versions: they reach down to a
+    /// tetrahedron where edge collapses stop. 0 = not tried.
+    int polytopeVertices = 24;
     /// How far (world units, as a fraction of delta_k) the certified upper bound of the
     /// error may exceed the largest distance actually found; the refinement stops there ...
     double toleranceFraction = 0.02;

@@ -68,6 +68,25 @@ public:
     /// Forgets the previous frame: the next selection starts from the roots, nothing refined.
     void reset();
 
+    /// Drawing costs, used to skip nodes that are never worth drawing. A node costs its
+    /// triangles plus trianglesPerDrawCall; one that costs more than the cheapest cover of
+    /// its objects by nodes below it is always refined. Every node below a node passes the
+    /// screen-space rule whenever that node does (errors and spheres nest), so the cut stays
+    /// within tau and draws no more than the rule alone would, often less.
+    /// originalTriangles: the triangles the engine draws for each original object
+    /// (file.objectCount() entries), or null when unknown (then a leaf never counts as
+    /// cheaper than the node above it). trianglesPerDrawCall >= 0 (triangles; NaN counts as
+    /// 0). O(nodes); resets the selection. The constructor applies
+    /// setDrawCosts(nullptr, kDefaultTrianglesPerDrawCall).
+    void setDrawCosts(const uint32_t* originalTriangles, float trianglesPerDrawCall);
+    /// Default cost of one draw call in triangles: descending to save fewer triangles than
+    /// this per extra draw call is not worth it.
+    static constexpr float kDefaultTrianglesPerDrawCall = 16.0f;
+    /// Nodes that setDrawCosts found never worth drawing (always refined).
+    uint32_t skippedNodeCount() const { return skippedCount_; }
+    /// Whether `node` (< nodeCount) is one of them.
+    bool skipsNode(uint32_t node) const { return skipped_[node] != 0; }
+
     /// Incremental selection: starts from the previous cut, refines or coarsens only where
     /// the errors crossed a threshold. Same result as selectFull() for the same state.
     void select(const Camera& camera, const SelectionSettings& settings);
@@ -171,6 +190,8 @@ private:
     const RuntimeFile* file_;
     const uint32_t* sourceObjects_ = nullptr;
     std::vector<Hot> hot_;
+    std::vector<uint8_t> skipped_;  // never worth drawing: always refined (setDrawCosts)
+    uint32_t skippedCount_ = 0;
     std::vector<State> state_;
     std::vector<uint32_t> targetStamp_, target_;  // per-frame memo of coarsening climbs
     float frameP_[3] = {0, 0, 0};
