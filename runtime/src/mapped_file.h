@@ -1,4 +1,5 @@
-// Read-only memory mapping of a whole file (POSIX mmap; the only place that calls it).
+// Read-only memory mapping of a whole file (POSIX mmap, Windows MapViewOfFile; the only place
+// that calls them).
 #pragma once
 
 #include <cstddef>

@@ -65,7 +65,7 @@ struct Span {
     bool empty() const { return size == 0; }
 };
 
-class MappedFile;  // POSIX mmap, runtime/src/mapped_file.cpp
+class MappedFile;  // POSIX mmap or Windows MapViewOfFile, runtime/src/mapped_file.cpp
 
 /// A validated `.aglod` file. Move-only; owns its mapping when opened from a path.
 class RuntimeFile {
