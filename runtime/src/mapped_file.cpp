@@ -64,9 +64,10 @@ bool MappedFile::open(const std::string& path, std::string& message) {
         message = path + ": cannot open (not a valid UTF-8 path)";
         return false;
     }
-    // Others may read, rename or delete the file while it is mapped (a bake replacing it),
-    // but not write to it: the validated bytes must not change under the reader.
-    const HANDLE file = CreateFileW(wide.c_str(), GENERIC_READ, FILE_SHARE_READ | FILE_SHARE_DELETE, nullptr,
+    // Others may read the file while it is open, not write to it: the validated bytes must not
+    // change under the reader. (Windows refuses to replace or delete a file while a view of it
+    // is mapped, whatever the share mode: a bake can replace it only once it is closed.)
+    const HANDLE file = CreateFileW(wide.c_str(), GENERIC_READ, FILE_SHARE_READ, nullptr,
                                     OPEN_EXISTING, FILE_ATTRIBUTE_NORMAL, nullptr);
     if (file == INVALID_HANDLE_VALUE) {
         message = path + ": cannot open (" + windowsErrorText(GetLastError()) + ")";
