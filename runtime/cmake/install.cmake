@@ -21,10 +21,8 @@ install(DIRECTORY ${_aggrelod_runtime_dir}/include/ DESTINATION ${CMAKE_INSTALL_
   FILES_MATCHING PATTERN "*.h" PATTERN "collision.h" EXCLUDE)
 install(EXPORT aggrelod_runtime_targets NAMESPACE aggrelod:: FILE aggrelod-runtime-targets.cmake
   DESTINATION ${AGGRELOD_INSTALL_CMAKEDIR} COMPONENT runtime)
-if(EXISTS ${_aggrelod_runtime_dir}/LICENSE)
-  install(FILES ${_aggrelod_runtime_dir}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/aggrelod-runtime
-    COMPONENT runtime)
-endif()
+install(FILES ${_aggrelod_runtime_dir}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/aggrelod-runtime
+  COMPONENT runtime)
 
 # --- aggrelod::runtime_collision (Embree 3) --------------------------------------------------
 if(TARGET aggrelod_runtime_collision)

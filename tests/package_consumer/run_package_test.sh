@@ -41,6 +41,7 @@ for f in include/aggrelod_runtime.h include/aggrelod/runtime_file.h include/aggr
          include/aggrelod/runtime_build.h include/aggrelod/collision.h; do
   [ -f "$prefix/$f" ] || fail "$f was not installed"
 done
+grep -q "MIT License" "$prefix/share/doc/aggrelod-runtime/LICENSE" || fail "the runtime's LICENSE was not installed"
 config="$(find "$prefix" -name aggrelod-config.cmake)"
 [ -n "$config" ] || fail "no aggrelod-config.cmake installed"
 pcdir="$(dirname "$(find "$prefix" -name aggrelod-runtime.pc)")"
