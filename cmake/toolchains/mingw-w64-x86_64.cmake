@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Cross-compiling for 64-bit Windows with the mingw-w64 GCC toolchain (Debian: mingw-w64).
 #   cmake -S . -B build-windows -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/mingw-w64-x86_64.cmake \
 #         -DAGGRELOD_RUNTIME_ONLY=ON

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Install rules of the runtime: libraries, public headers, the CMake package `aggrelod`
 # (components runtime and collision) and the pkg-config files aggrelod-runtime.pc and
 # aggrelod-runtime-collision.pc. Included from runtime/CMakeLists.txt, in the full build and in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Read-only memory mapping of a whole file (POSIX mmap, Windows MapViewOfFile; the only place
 // that calls them).
 #pragma once

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """SPDX-License-Identifier lines of aggrelod's source files (LICENSE explains the split).
 
     spdx_headers.py check REPO_ROOT    every source file has the line its place asks for

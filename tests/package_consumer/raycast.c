@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Package consumer, C API with the collision part (Embree 3): rays against the originals and
  * against the root's proxy of the two-box file written by write_and_select.
  *   raycast_c FILE.aglod

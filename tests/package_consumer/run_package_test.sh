@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # CTest runtime_package_consumer: builds the runtime alone (AGGRELOD_RUNTIME_ONLY=ON), installs
 # it into a fresh prefix, then builds tests/package_consumer against the installed CMake
 # package (find_package(aggrelod CONFIG REQUIRED COMPONENTS runtime collision)) and runs its

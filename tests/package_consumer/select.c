@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Package consumer, C API (runtime only): opens FILE.aglod and selects from far and near.
  *   select_c FILE.aglod   (the file written by write_and_select)
  * Exit status 0 only when the cuts are the expected ones. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Package consumer, C++ API: writes a two-box scene with aggrelod::runtime::writeRuntimeFile,
 // maps it with RuntimeFile::openFile and checks what a Selector draws from far and near.
 //   write_and_select OUT.aglod

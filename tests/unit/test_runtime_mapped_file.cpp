@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // RuntimeFile::openFile on the file system (runtime/src/mapped_file.cpp: POSIX mmap, Windows
 // MapViewOfFile): UTF-8 paths outside ASCII, directories refused with the path in the message,
 // and what happens when a new bake replaces a file that is open. Also built for Windows and

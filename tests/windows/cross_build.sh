@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The runtime for Windows: cross-compiled with Debian's mingw-w64 toolchain from a
 # runtime-only configure (no collision part: there is no Embree for mingw), with its unit tests
 # (tests/runtime_only), and those tests run under wine.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // aggrelod runtime: the `.aglod` runtime file, read in place (DESIGN section 4).
 // A RuntimeFile views a memory-mapped file or a caller buffer; it never copies the arrays.
 // Every count, stride, index range and the tree shape are validated once at open; a bad
