@@ -4,6 +4,7 @@
 
     spdx_headers.py check REPO_ROOT    every source file has the line its place asks for
     spdx_headers.py apply REPO_ROOT    adds the missing lines (never changes an existing one)
+    spdx_headers.py selftest TMP_DIR   the check finds planted problems in a small tree
 
 The runtime and what an engine copies or builds with it is MIT; the rest (module/, bake/,
 planning/, the other samples and tests) is AGPL-3.0-or-later. The line goes first, or right
@@ -87,6 +88,10 @@ def header_line(style, licence):
 
 def tracked_files(root):
     try:
+        top = subprocess.run(["git", "-C", root, "rev-parse", "--show-toplevel"], check=True,
+                             capture_output=True, text=True).stdout.strip()
+        if os.path.realpath(top) != os.path.realpath(root):
+            raise OSError("not the top of a git work tree")  # e.g. a folder inside a build tree
         out = subprocess.run(["git", "-C", root, "ls-files", "-z"], check=True,
                              capture_output=True).stdout.decode("utf-8")
         return sorted(p for p in out.split("\0") if p and os.path.isfile(os.path.join(root, p)))
@@ -107,11 +112,48 @@ def insertion_index(lines):
     return 0
 
 
+def selftest(tmp):
+    """A tree with four planted problems and one good file: check must report exactly those
+    four, apply must add the one missing line and leave the wrong ones alone."""
+    import shutil
+    root = os.path.join(tmp, "spdx_selftest")
+    shutil.rmtree(root, ignore_errors=True)
+    files = {
+        "runtime/src/a.cpp": "// SPDX-License-Identifier: AGPL-3.0-or-later\nint a;\n",  # wrong id
+        "module/src/b.cpp": "int b;\n",                                                  # missing
+        "bake/c.sh": "#!/bin/sh\necho\n# SPDX-License-Identifier: AGPL-3.0-or-later\n",  # wrong line
+        "tests/unit/test_runtime_format.cpp": "// SPDX-License-Identifier: AGPL-3.0-or-later\n",  # MIT file
+        "planning/d.h": "// SPDX-License-Identifier: AGPL-3.0-or-later\n#pragma once\n",  # good
+    }
+    for path, text in files.items():
+        os.makedirs(os.path.dirname(os.path.join(root, path)), exist_ok=True)
+        with open(os.path.join(root, path), "w") as f:
+            f.write(text)
+    def run(mode):
+        out = subprocess.run([sys.executable, __file__, mode, root], capture_output=True, text=True)
+        print(out.stdout, end="")
+        return out.returncode, [l for l in out.stdout.splitlines() if not l.startswith("spdx_headers:")]
+    code, problems = run("check")
+    ok = code == 1 and len(problems) == 4 and all(any(l.startswith(p) for l in problems) for p in
+                                                   ("runtime/src/a.cpp:1", "module/src/b.cpp:", "bake/c.sh:3",
+                                                    "tests/unit/test_runtime_format.cpp:1"))
+    run("apply")
+    with open(os.path.join(root, "module/src/b.cpp")) as f:
+        ok = ok and f.read() == "// SPDX-License-Identifier: AGPL-3.0-or-later\nint b;\n"
+    code, problems = run("check")
+    ok = ok and code == 1 and len(problems) == 3
+    shutil.rmtree(root, ignore_errors=True)
+    print("spdx_headers selftest:", "PASSED" if ok else "FAILED")
+    return 0 if ok else 1
+
+
 def main():
-    if len(sys.argv) != 3 or sys.argv[1] not in ("check", "apply"):
+    if len(sys.argv) != 3 or sys.argv[1] not in ("check", "apply", "selftest"):
         print(__doc__, file=sys.stderr)
         return 2
     mode, root = sys.argv[1], sys.argv[2]
+    if mode == "selftest":
+        return selftest(root)
     problems, added, checked = [], [], 0
     for path in tracked_files(root):
         if not in_scope(path):
