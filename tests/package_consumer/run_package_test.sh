@@ -76,6 +76,11 @@ echo "aggrelod-runtime-collision: $flags"
 # shellcheck disable=SC2086
 "$cc" -std=c99 -Wall -Wextra -Werror "$consumer/raycast.c" -o "$work/raycast_pkgconfig" $flags -lm
 "$work/raycast_pkgconfig" "$work/scene.aglod"
+# The engine-integration sample as a user would build it from the installed tree.
+# shellcheck disable=SC2086
+"$cc" -std=c99 -Wall -Wextra -Werror "$src/samples/hello_runtime.c" -o "$work/hello_runtime_pkgconfig" $flags -lm
+"$work/hello_runtime_pkgconfig" "$work/scene.aglod" | tee "$work/hello_runtime.log"
+grep -q 'ray against level 0 *: hit at' "$work/hello_runtime.log" || fail "hello_runtime: no hit on level 0"
 [ "$(pkg-config --modversion aggrelod-runtime)" = "$(pkg-config --modversion aggrelod-runtime-collision)" ] ||
   fail "the two .pc files disagree on the version"
 
