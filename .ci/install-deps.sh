@@ -20,7 +20,10 @@ packages=(
   libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
   libompl-dev
   chromium clang libclang-rt-14-dev python3
+  mingw-w64 wine wine64
 )
+# mingw-w64: the Windows cross build of the runtime (tests/windows); wine, wine64: run its unit
+# tests there.
 # libompl-dev: motion planning on the hierarchy (planning/, `aggrelod plan`).
 # clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz; python3: their
 # mutation corpora (tests/fuzz/mutate.py).

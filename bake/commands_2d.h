@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: the 2D subcommands (aggregate2d, reproduce2d). Options are declared in
 // main.cpp (the only CLI11 user); the work is done here.
 #pragma once

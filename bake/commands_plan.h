@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: the motion-planning subcommands (plan, reproduce-planning), paper Section 4.3.
 // Options are declared in main.cpp (the only CLI11 user); the work is done in
 // plan_command.cpp and reproduce_planning_command.cpp.

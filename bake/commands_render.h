@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: the render subcommand. Options are declared in main.cpp (the only CLI11
 // user); the work is done in render_command.cpp.
 #pragma once

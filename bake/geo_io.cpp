@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: WKT and GeoJSON readers and writers, link table and 2D stats JSON.
 // A small hand-written JSON parser (with line/column in messages) keeps the bake free of
 // another dependency; numbers are written shortest round-trip, locale-independent.

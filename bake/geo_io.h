@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: 2D polygon files in and out (WKT, GeoJSON, link table CSV, stats JSON)
 // and pictures (SVG, PNG). module/ sees plain polygons; only this code knows formats.
 // Coordinates are taken as plain planar numbers (degrees are not projected).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: glTF in and out. The only translation unit that includes tiny_gltf.h
 // (Debian ships tinygltf's implementation compiled in libtinygltf.so, so no
 // TINYGLTF_IMPLEMENTATION here).

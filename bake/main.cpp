@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod: the command-line tool. The only translation unit that includes CLI11.
 //
 // Exit codes: 0 success, 1 usage error, 2 input or output file problem,

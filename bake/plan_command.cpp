@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod plan: one motion-planning query on a hierarchy (paper Section 4.3, Fig. 7), 2D or 3D,
 // with the stats JSON and the Fig. 7-style picture (roadmap coloured by level, path on top).
 #include "commands_plan.h"

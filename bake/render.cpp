@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: ray-cast renders of the levels (render.h). Not an algorithm of the paper: a
 // viewer for its Figs. 9-10 style level sheets. Rays go through the runtime CollisionWorld
 // (Embree lives only in runtime/src/collision_embree.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: ray-cast renders of the baked levels (`aggrelod render`). Each pixel casts
 // rays through the runtime collision world (Embree, wrapped in runtime/src/collision_embree.cpp)
 // over the cut of one level; the hit node picks a colour from a fixed palette (originals grey)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: `aggrelod render` (commands_render.h): renders one level or a sheet of all
 // levels of a .aglod or levels.glb to PNG.
 #include "commands_render.h"

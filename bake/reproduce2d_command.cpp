@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod reproduce2d: the paper's 2D evaluation (Section 4: Fig. 4, Fig. 6 b-d, Eq. 3)
 // rerun on seeded analogues of its five environments. For each environment, 4 thresholds
 // between the smallest and largest neighbour distance (the paper picks them at random in

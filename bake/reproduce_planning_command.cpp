@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod reproduce-planning: the paper's motion-planning experiment (Section 4.3, Fig. 7) as a
 // command. On the five 2D environments (aggregated here, 6 automatic levels) and on the 3D
 // forest, village and a 1000-object random scene (baked with `aggrelod bake`, 8 automatic

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: hierarchy nodes -> runtime BuildParams -> scene.aglod (DESIGN section 4).
 #include "runtime_export.h"
 

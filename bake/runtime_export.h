@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: the hierarchy nodes (module) turned into the runtime's flat BuildParams,
 // and the bytes of OUTDIR/scene.aglod (DESIGN section 4).
 #pragma once

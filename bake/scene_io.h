@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: scene files in and out (glTF via tinygltf, stats JSON).
 // This is the only place that knows file formats; module/ sees plain meshes.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: the stats JSON file, with a small hand-written JSON writer
 // (deterministic: shortest round-trip doubles, locale-independent; NaN/inf as null).
 #include "scene_io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: terminal output helpers shared by the subcommands (progress line,
 // diagnostics, tables). No CLI11 here.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Seeded analogues of the paper's five 2D environments (paper Section 4, Fig. 4) and square
 // grids. Each generator places simple polygons and rejects any that would come closer than
 // a minimum gap to one already placed (bounding-circle test), so no two polygons touch.

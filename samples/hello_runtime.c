@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* hello_runtime: the smallest engine integration of the aggrelod runtime, in plain C.
  *
  *   hello_runtime FILE.aglod      (a file written by `aggrelod bake`)

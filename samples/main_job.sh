@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # aggrelod main job: install the dependencies, build (Release) into build/, generate the
 # 15-spheres sample scene (paper Fig. 9) into out/ and bake its LOD hierarchy, printing the
 # level table and rendering a sheet of its levels; then run the runtime example on the baked

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod_make_sample: writes one of the generated sample scenes as a GLB file.
 //
 //   aggrelod_make_sample NAME -o FILE.glb [--seed N] [options]

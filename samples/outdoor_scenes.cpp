@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod samples: the forest and the village (samples.h). Outdoor scenes of many small
 // separate objects with varied spacing: dense clumps that merge at small thresholds,
 // clearings and scattered objects that stay apart until large ones (the situation of the

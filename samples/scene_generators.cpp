@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod samples: deterministic scene generators (see samples.h for the contracts).
 #include <aggrelod/samples.h>
 

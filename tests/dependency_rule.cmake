@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # Checks the dependency rule of DESIGN section 1. Run as
 #   cmake -DSOURCE_DIR=<repo root> [-DLINK_INFO=<generated file>] -P dependency_rule.cmake
 #

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # aggrelod test run: install the dependencies, build everything (Release, tests and the
 # AddressSanitizer copy of the CLI on) into build/, then run the whole CTest suite.
 # Exit status: that of ctest. Works from any directory.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Built-in aggregate functions (paper Section 3.3).
 //   constant, Eq. 1:  F(m1, m2) = delta
 //   adaptive, Eq. 2:  F(m1, m2) = 0.5 * (min(m1, m2) + sigma(m1, m2) + delta)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // CGAL wrapper: 2D constrained Delaunay triangulation (DESIGN 2.1; paper Section 3.1).
 // All points and constraints go in as one batch, the way CGAL's insert_constraints() does it
 // (spatially sorted insertion: about 40x faster than inserting polygon by polygon, see

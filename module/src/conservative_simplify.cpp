@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: conservative simplification of closed meshes (DESIGN section 2.6).
 //
 // Implements progressive hulls (Sander, Gu, Gortler, Hoppe, Snyder, "Silhouette clipping",

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Convex hull via CGAL::convex_hull_3 (exact predicates, inexact constructions).
 #include "convex_hull.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // 3D convex hull (CGAL convex_hull_3, GPL-3+; bake side only). The one place that calls it.
 #pragma once
 

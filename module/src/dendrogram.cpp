@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Kruskal dendrogram and level thresholds (DESIGN 2.3; paper Algorithm 1, Section 3.2).
 #include <aggrelod/dendrogram.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: hierarchy nodes for real-time use (DESIGN sections 2.5 and 2.6).
 // Builds the tree (leaves = original objects, inner nodes = aggregates, unchanged aggregates
 // collapsed across levels), simplifies every aggregate into an enclosing proxy within its

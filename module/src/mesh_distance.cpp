@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): exact minimum distance between triangle meshes with a BVH.
 // See mesh_distance.h for what is implemented (Ericson, "Real-Time Collision Detection",
 // 2005: 5.1.2, 5.1.5, 5.1.9, 5.3.4, 6.3.x), units (world units) and array sizes.

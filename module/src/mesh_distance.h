@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): exact minimum distance between triangle meshes, and closest
 // point on a mesh, accelerated by a bounding volume hierarchy (BVH) of axis-aligned boxes.
 //

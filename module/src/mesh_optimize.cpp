@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: vertex-cache order of proxy meshes (mesh_optimize.h) with meshoptimizer.
 #include "mesh_optimize.h"
 

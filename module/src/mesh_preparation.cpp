@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Input clean-up (DESIGN 2 and 5): exact weld, degenerate removal, finiteness check,
 // closedness / manifoldness / orientation analysis, inside-out repair per shell.
 #include "mesh_preparation.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Deterministic parallel loop: body(i) for i in [0, count) on up to threadCount threads
 // (0 = hardware concurrency). Every index must write only its own output slot, so results
 // do not depend on the thread count. The first exception thrown is rethrown here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The 2D pipeline (paper Sections 3.1-3.3 and 4.2; DESIGN 2.1-2.5 in 2D):
 // check input -> one constrained Delaunay triangulation -> inside/outside by winding ->
 // models (touching / overlapping polygons merged) -> neighbourhood graph -> Kruskal

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The 3D bake (DESIGN 2): prepare objects, set support surfaces aside and solidify what is
 // not a valid closed solid (DESIGN 2.0), group touching objects into models, triangulate
 // the free space once, build the neighbourhood graph and dendrogram, then shape and measure

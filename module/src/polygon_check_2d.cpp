@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Input checks for 2D polygons and detection of touching / overlapping polygons.
 // Segment pairs are found with a uniform grid (each pair tested once, in the cell holding
 // the lower-left corner of their boxes' overlap), so the check is near-linear.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: geometric error of a proxy against the original objects (DESIGN 2.5,
 // "Geometric error of a proxy"): both one-sided Hausdorff distances, with certified upper
 // bounds.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): the proxy error measurement of proxy_error.cpp with the
 // originals' search structures prepared once by the caller (hierarchy_nodes.cpp prepares
 // each object once and reuses it for every node and level holding it, instead of merging

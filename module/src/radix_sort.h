@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Stable LSD radix sort on an unsigned integer key: linear passes of 11-bit digits instead of
 // a comparison sort, for the large flat arrays of the 2D pipeline and the dendrogram.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Sculpting in 2D (DESIGN 2.4; paper Section 3.3 "Aggregated Approximation") and the
 // extraction of polygons with holes from the kept triangles.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Sculpting one 2D level (DESIGN 2.4; paper Section 3.3) and turning the kept triangles
 // into OGC-valid polygons with holes.
 #pragma once

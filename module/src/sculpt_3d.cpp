@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Sculpting (DESIGN 2.4; paper Section 3.3 "Aggregated Approximation", 3D as Section 4.4)
 // and surface extraction of the aggregates.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Sculpting one level (DESIGN 2.4; paper Sections 3.3 and 4.4) and extracting the
 // aggregate surfaces (DESIGN 2.4 step 5).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Solidification by CGAL 3D Alpha Wrapping (Portaneri et al., "Alpha Wrapping with an
 // Offset", ACM TOG 41(4), 2022; CGAL 5.5 `CGAL::alpha_wrap_3`). The only translation unit
 // that includes the alpha-wrap headers (they are heavy: keep them here).

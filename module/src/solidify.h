@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Solidification of objects that are not valid closed solids (DESIGN 2.0 "Solidify"):
 // CGAL 3D Alpha Wrapping (Portaneri, Rouxel-Labbé, Hemmer, Cohen-Steiner, Alliez,
 // "Alpha Wrapping with an Offset", ACM TOG 41(4), 2022), CGAL 5.5 `alpha_wrap_3`, GPL-3+:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Steiner points on constrained edges of a flat constrained Delaunay triangulation, and the
 // canonical numbering of its faces (DESIGN 2.4 step 4; paper Section 3.1). Insertion is the
 // textbook incremental one for a point on an edge (split the two faces, then Lawson flips

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: proxy face colours from the nearest original surface (surface_colors.h).
 // An engine-facing addition, not a section of the paper.
 #include "surface_colors.h"

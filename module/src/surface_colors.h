@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): proxies carry the look of what they replace.
 // Each face of a proxy or aggregate takes the base colour of the original surface nearest to
 // its centroid (one closest-point query per face on a BVH of the originals, mesh_distance.h).

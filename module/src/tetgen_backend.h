@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The one place that calls TetGen 1.5 (AGPL-3+). Swap this file to change triangulator.
 //
 // TetGen runs in a forked child process: the Debian build keeps its assert()s and

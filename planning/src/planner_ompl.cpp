@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Coarse-to-fine roadmap planning on the aggregation hierarchy (paper Section 4.3, Fig. 7),
 // with OMPL's LazyPRM. The only translation unit that includes OMPL (its headers pull Boost).
 //

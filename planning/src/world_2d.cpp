@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The 2D planning world (paper Section 4.3, in the plane): a disc agent against the polygons of
 // one level. Obstacle edges are indexed in a uniform grid shared by all levels; each level also
 // stores the winding number of its polygons at every cell centre (a scanline per row), so that

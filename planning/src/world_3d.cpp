@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The 3D planning world (paper Sections 4.3 and 4.4): a ball agent against one level of a baked
 // runtime file, through the runtime's Embree collision world (one per level). A state is free
 // when no triangle of the level lies within the radius (sphere query) and its centre is not

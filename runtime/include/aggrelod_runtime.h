@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* aggrelod runtime, C API: open a baked `.aglod` file, select the nodes to draw for a camera,
  * cast rays against a cut (optional collision library). For engines written in C or bound
  * from other languages. Plain C99; every function is safe to call with NULL handles (it then

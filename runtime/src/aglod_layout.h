@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Byte layout of the `.aglod` runtime file (DESIGN section 4), shared by the writer and the
 // reader so they cannot drift apart. Everything little-endian.
 //

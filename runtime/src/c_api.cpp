@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // C API of the runtime (aggrelod_runtime.h): file and selection. Thin wrappers over
 // RuntimeFile and Selector; no exception crosses the C boundary.
 #include <aggrelod_runtime.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // C API of the optional collision part (aggrelod_runtime.h, aglod_collision_* and
 // aglod_raycast): thin wrappers over CollisionWorld.
 #include <aggrelod_runtime.h>

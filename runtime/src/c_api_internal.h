@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shared by the two halves of the C API (c_api.cpp, c_api_collision.cpp).
 #pragma once
 

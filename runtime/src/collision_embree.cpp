@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Collision queries with Embree 3 (DESIGN section 3): the only file that includes Embree.
 // Pitfalls handled here (NOTES-deps): ray mask 0xFFFFFFFF (a zeroed ray never hits),
 // tnear/tfar/flags/geomID set explicitly, an error callback on the device, vertex buffers

@@ -1,4 +1,6 @@
-// Read-only memory mapping of a whole file (POSIX mmap; the only place that calls it).
+// SPDX-License-Identifier: MIT
+// Read-only memory mapping of a whole file (POSIX mmap, Windows MapViewOfFile; the only place
+// that calls them).
 #pragma once
 
 #include <cstddef>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Screen-space error rule of DESIGN section 3 (the 3D Tiles / CesiumJS formula).
 #include <aggrelod/runtime.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Level selection by screen-space error (DESIGN section 3): the cut of the hierarchy to draw,
 // with hysteresis, incremental from the previous frame, allocation-free per frame.
 //

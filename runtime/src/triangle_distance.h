@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Exact distances between points, segments and triangles in 3D (double arithmetic), for the
 // sphere and capsule overlap queries of the collision world (an agent of radius r at a point,
 // or swept along a segment). Closest point on a triangle after Ericson, "Real-Time Collision

@@ -1,4 +1,5 @@
 #!/usr/bin/env node
+// SPDX-License-Identifier: MIT
 // Serves the aggrelod web viewer (this folder, with its node_modules) and one tileset on
 // localhost, without any network access:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // aggrelod web viewer: streams a 3D Tiles tileset written by `aggrelod bake ... --tiles` with
 // three.js and 3DTilesRendererJS, choosing tiles by screen-space error (DESIGN section 3).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Benchmark: where the 2D pipeline's time goes (issue 3), on the jittered square grids of
 // bench_geos (unit squares, gaps 0.5 +- 0.2, constant function, 8 levels 0.25..8 x 0.45, no
 // baselines: the same settings as bench_geos). Prints, per grid size, the median over the

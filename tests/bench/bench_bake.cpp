@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Benchmark of the whole 3D bake versus TetGen alone on the same input (issue 2):
 // a generated scene of ~1000 objects / ~150k triangles, 8 levels. TetGen's constrained
 // tetrahedralization is the floor of this design, so the figure that matters is the ratio

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Benchmark: aggrelod 2D (constant function, paper Eq. 1) against GEOS 3.11
 // ConcaveHullOfPolygons, the strongest open peer, at the same edge-length threshold.
 //

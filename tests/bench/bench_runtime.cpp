@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Runtime benchmarks (issue 4): level selection per frame (full walk vs incremental, with an
 // allocation count from a replaced operator new), Embree ray throughput against the originals
 // and every level (1 and 2 threads), and open time / bytes per node of large runtime files.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // What solidifying costs on the shared real scenes (DESIGN 2.0, docs/real-art.md): per scene,
 // as `aggrelod bake SCENE` with no options does it (default read options and settings, then
 // the proxies), the seconds of the "solidify" stage against the whole bake, the peak resident

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Benchmark of the TetGen backend's process isolation (issue 2): the same PLC (the generated
 // scene's surfaces, no prerefine points) tetrahedralized by
 //   fresh  - TetGen alone in a fresh process (this program re-executed: the peer of issue 2),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Developer check for speed work on the 2D pipeline: prints one hash per case of everything
 // buildHierarchy2D returns (every level's polygons, sources, measures and baselines, the
 // dendrogram, models, diagnostics, triangulation size), timings excepted. Two builds that

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The peer of the issue-2 benchmarks: TetGen alone on a scene's surfaces, with the switches
 // the bake uses (pczQn), timed in this process or in a fresh one. Shared by bench_bake and
 // bench_tetgen_child so both compare against exactly the same TetGen call.

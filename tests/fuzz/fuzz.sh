@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # The libFuzzer targets of tests/fuzz, for CTest (tests/CMakeLists.txt):
 #   fuzz.sh build DIR SOURCE_DIR MODULE_LIBRARY CLANGXX   configure and build them with clang++
 #   fuzz.sh seeds DIR MAKE_SAMPLE CLI MAKE_SYNTHETIC DATA  seed corpora from the samples, and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // libFuzzer target: the WKT and GeoJSON readers (readPolygonText), both on every input.
 #include "geo_io.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // libFuzzer target: the glTF import (GLB or .gltf text) through readGltfScene, as the bake
 // reads a file. The input is written to a private folder; its uris may name files there only.
 #include "scene_io.h"

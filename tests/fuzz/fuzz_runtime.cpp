@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // libFuzzer target: the runtime reader (aglod_open_memory); on a file it accepts, selection
 // and ray casts through the C API with cameras and rays taken from the input's last bytes.
 #include <aggrelod_runtime.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: AGPL-3.0-or-later
 """Mutation corpora for the readers: COUNT deterministic mutants of each seed set.
 
     mutate.py SEEDS_DIR OUT_DIR COUNT [SEED]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // `aggrelod plan` end to end: 2D polygons (aggregated in the command) and a 3D runtime file;
 // exit 0 with the stats JSON when solved, 3 when no path exists, a clear message and a
 // non-zero exit for bad input (start in an obstacle or outside, radius <= 0, wrong file kind).

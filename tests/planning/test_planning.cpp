@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Motion planning on the aggregation hierarchy (paper Section 4.3) with OMPL's LazyPRM: every
 // returned path is re-checked against the original objects by an independent referee (dense
 // samples along the path, and for each path segment its exact distance to every original edge

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Writes a synthetic `.aglod` file (city boxes, tests/runtime_support/synthetic_hierarchy.h)
 // for the C sample test and the runtime benchmarks:
 //   aglod_make_synthetic OUT.aglod [objects=1000] [seed=1] [branching=4]

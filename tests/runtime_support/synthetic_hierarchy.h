@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Synthetic hierarchies for the runtime tests and benchmarks: N disjoint boxes on a jittered
 // grid (a "city"), grouped by recursive median splits into a tree of the given branching.
 // Inner nodes carry their bounding box as proxy mesh (it contains every child, so rays hit it

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The scenes of the proxy acceptance test and of bench_lod_budget, and an in-process bake of
 // them through the module API (buildHierarchy3D + buildHierarchyNodes, as `aggrelod bake` does),
 // with the stage timings. Header-only: included by a test (tests/unit) and a benchmark.

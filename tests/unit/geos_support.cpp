@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // GEOS C API wrapper for the tests (the only test file that includes geos_c.h).
 #include "geos_support.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // GEOS as an independent referee for the 2D tests (validity, containment, area).
 // GEOS is used only in tests and benchmarks (peer, not dependency); all its calls are in
 // geos_support.cpp.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Brute-force measurement of a proxy's distances to its originals, independent of the
 // branch-and-bound in module/src/proxy_error.cpp: points on a barycentric grid of every
 // triangle, exact closest points (BVH), inside-ness by the winding number. Shared by the

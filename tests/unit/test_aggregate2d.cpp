@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // 2D aggregation (paper Sections 3-4 in 2D): the acceptance properties on the five
 // generated environments and on real data, with GEOS as the independent referee.
 #include "geos_support.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod aggregate2d from the command line: outputs, determinism and bad input (every
 // problem named with its feature and line; never a crash). Runs the ASan build when present.
 #include "geos_support.h"

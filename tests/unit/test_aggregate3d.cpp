@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Acceptance tests of the 3D core (issue "Foundation"): two cubes, offset slabs, and the
 // paper's two 3D environments (15 spheres, chess board).
 #include <aggrelod/aggregate3d.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Integration tests of the `aggrelod bake` command line:
 //  a) real scenes from ../shared/data bake, every output mesh is closed, and the output
 //     passes the Khronos glTF validator;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Conservative (progressive-hull) simplification: the output is closed, edge-manifold,
 // encloses its input and really is coarser (module/src/conservative_simplify.cpp).
 #include "conservative_simplify.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Tests of the hierarchy nodes for real-time use (issue 4, deliverable 1; DESIGN 2.5, 2.6):
 // bounds nested, errors monotone, every original object under exactly one root path,
 // proxies simpler than the exact aggregates, an independent denser error measurement below

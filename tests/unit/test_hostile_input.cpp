@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Hostile input: files crafted to read outside their folder, exhaust memory or stack, or
 // overflow arithmetic. Each is refused with a clean exit (< 128) and a message naming the
 // problem, never a crash, a hang or an unbounded allocation. The CLI runs are under the

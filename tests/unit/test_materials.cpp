@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Materials (issue 5, deliverable 4): proxies carry the base colour of the original surface
 // nearest to each face, so a far level still reads right in an engine.
 //  - base colours round-trip through GLB (one material per colour, or COLOR_0);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Unit tests for mesh_distance (exact triangle-mesh minimum distance with a BVH).
 // Known-answer cases on cubes and triangles, degenerate inputs, and comparisons of the BVH
 // queries against brute force over all triangle pairs on random meshes (fixed seeds).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The output set of `aggrelod bake`: outputs never overwrite the input or each other, nothing
 // planted in OUTDIR is followed, a failing move puts the old set back, stale temporaries are
 // removed, and a bake killed at any moment leaves the complete old or the complete new set

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Acceptance of the proxies an engine draws and collides against (DESIGN 2.6), for every
 // non-leaf node (aggregates and per-object LOD nodes) of in-process bakes of spheres15, chess,
 // forest, village, truck_town without its ground and a 400-object generated scene:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Tests of the certified proxy error bounds (module/src/proxy_error.cpp, DESIGN 2.5) against
 // a brute-force measurement on small cases: a dense barycentric grid on every triangle, exact
 // closest points, inside-ness by the generalized winding number (independent of the ray

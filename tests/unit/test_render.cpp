@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Tests of `aggrelod render` and bake/render.h: ray-cast images of the baked levels of the
 // 15-spheres sample (deterministic bytes, size, objects where they project, colours per
 // group, grey originals, one sheet panel per level) and its errors on bad input.

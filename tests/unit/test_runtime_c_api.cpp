@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The C API (aggrelod_runtime.h): open/close, statuses and messages, selection views,
 // raycast, and NULL-safety of every entry point.
 #include <aggrelod_runtime.h>

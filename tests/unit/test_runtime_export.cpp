@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The bake's export to the runtime file (bake/runtime_export.cpp): render vertices split at
 // creases and colour boundaries with positions kept bit for bit, angle-weighted smooth
 // normals elsewhere, face colours sRGB-encoded per vertex, per-object LOD nodes at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The `.aglod` runtime file (DESIGN section 4): round trip of the writer and the in-place
 // reader, refusal of inconsistent hierarchies by the writer, and refusal of corrupt bytes by
 // the reader (every single-byte change of the header and section table, truncations, forged

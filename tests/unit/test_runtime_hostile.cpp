@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Hostile runtime input: forged `.aglod` files whose checksum is valid (trailing bytes,
 // shared ranges, levels out of order, coordinates Embree cannot take), out-of-range float
 // arguments to the C API, and a valid but very deep tree through `aggrelod inspect`.

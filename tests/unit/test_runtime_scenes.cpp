@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Acceptance tests of issue 4 on real baked scenes (15 spheres, chess pieces, truck_town
 // without its ground), checked with Embree ray queries against the original objects:
 //  - scene.aglod is byte-identical across two bakes and across --threads 1 / 2;

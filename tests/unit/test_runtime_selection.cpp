@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Level selection (DESIGN section 3): valid cuts for 1000 random cameras, the
 // screen-space-error rule, incremental == full, hysteresis against flicker, and the
 // collision cut by distance. On synthetic hierarchies (tests/runtime_support).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Checks of the sample scene generators (samples/): closed, outward, welded meshes, no
 // overlaps, the documented gaps, and determinism.
 #include <aggrelod/samples.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Steiner points inserted into the flat triangulation (module/src/steiner_2d.cpp) against
 // CGAL: after insertSplitPoints2D + renumberAfterSplits2D the triangulation must be the one
 // CGAL builds from scratch for all the points with the split segments as constraint chains

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Helpers shared by the integration tests: running the CLI, temporary directories, shared
 // test data, mesh checks on read-back outputs, hand-made GLB files and the glTF validator.
 // Header-only (tests/unit/*.cpp are globbed into one executable).

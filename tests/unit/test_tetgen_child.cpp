@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The TetGen child process: it runs in the helper executable aggrelod-tetgen (started with
 // posix_spawn, so it inherits no lock of the bake); a hung child (blocked, gaining no CPU time, as on a lock held at
 // fork time) is stopped by the watchdog and retried once, then reported; a child never

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // 3D Tiles export (`aggrelod bake --tiles`, bake/tiles_export.cpp):
 //  - the axis convention and the box / error mapping on a hand-made hierarchy;
 //  - a sample scene baked with --tiles: tileset.json structure (errors monotone, children

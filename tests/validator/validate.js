@@ -1,4 +1,5 @@
 #!/usr/bin/env node
+// SPDX-License-Identifier: MIT
 // Runs the Khronos glTF validator (npm gltf-validator) on .glb / .gltf files, offline.
 //
 //   node tests/validator/validate.js FILE.glb [FILE2.gltf ...]

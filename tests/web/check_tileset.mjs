@@ -1,4 +1,5 @@
 #!/usr/bin/env node
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Checks a 3D Tiles tileset written by `aggrelod bake ... --tiles` (run from CTest through the
 // unit tests, see test_tiles_export.cpp):
 //

@@ -1,4 +1,5 @@
 #!/usr/bin/env node
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The web viewer (samples/web) in a real browser: serves it and a baked tileset on localhost,
 // opens it in headless Chromium (driven over the DevTools protocol on a pipe, no extra npm
 // package) from a far and a near camera, saves both screenshots and checks that different

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: 2D aggregation of disjoint polygons into a hierarchy of levels.
 //
 // Implements the paper's own 2D method (shared/paper, Sections 3.1-3.3, Eqs. 1-3):

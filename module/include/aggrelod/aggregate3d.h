@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: 3D aggregation of disjoint objects into a level-of-detail hierarchy.
 //
 // Implements "distance aggregation" (paper in shared/paper, Sections 3 and 4.4):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: types shared by the 2D and 3D pipelines (diagnostics, aggregate
 // functions, progress, dendrogram merges). Included by aggregate2d.h and aggregate3d.h.
 #pragma once

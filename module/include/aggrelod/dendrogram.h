@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Neighbourhood graph -> dendrogram -> levels (DESIGN 2.3; paper Section 3.2, Algorithm 1).
 // Shared by 2D and 3D: models are plain indices, weights are distances in world units.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: the hierarchy of a 3D bake as a tree of nodes for real-time use
 // (DESIGN sections 2.5 and 2.6).
 //

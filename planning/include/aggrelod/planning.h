@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod planning: motion planning for a round agent (a disc in 2D, a ball in 3D) with the
 // aggregation hierarchy, paper Section 4.3 and Fig. 7, on OMPL.
 //

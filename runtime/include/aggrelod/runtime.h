@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // aggrelod runtime: what a game engine links (standard library only; MIT-compatible).
 // Level selection by screen-space error, as in 3D Tiles / CesiumJS (DESIGN section 3).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // aggrelod runtime: the `.aglod` runtime file, read in place (DESIGN section 4).
 // A RuntimeFile views a memory-mapped file or a caller buffer; it never copies the arrays.
 // Every count, stride, index range and the tree shape are validated once at open; a bad
@@ -65,7 +66,7 @@ struct Span {
     bool empty() const { return size == 0; }
 };
 
-class MappedFile;  // POSIX mmap, runtime/src/mapped_file.cpp
+class MappedFile;  // POSIX mmap or Windows MapViewOfFile, runtime/src/mapped_file.cpp
 
 /// A validated `.aglod` file. Move-only; owns its mapping when opened from a path.
 class RuntimeFile {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // aggrelod runtime: which nodes to draw this frame (DESIGN section 3), by the screen-space
 // error rule of 3D Tiles / CesiumJS, with hysteresis, incremental from the previous frame's
 // cut, without allocating per frame. Standard library only.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod samples: seeded 2D test environments, analogues of the five scenes of the
 // paper's evaluation (Fig. 4: Tree, Scatter, Room, Colony, Forest), and square grids for
 // benchmarks. Polygons never overlap or touch; the same seed gives the same polygons

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod samples: deterministic scene generators for demos, tests and benchmarks.
 //
 // Every generator returns closed triangle meshes in world space: every undirected edge is

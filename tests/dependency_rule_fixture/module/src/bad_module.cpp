@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Violations: tinygltf and a runtime header in the module.
 #include <aggrelod/fixture_module.h>
 #include <tiny_gltf.h>

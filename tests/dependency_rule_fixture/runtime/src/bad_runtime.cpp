@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Violations: TetGen, CGAL, GLM and a module header in the runtime.
 #include <aggrelod/fixture_runtime.h>
 #include <tetgen.h>
