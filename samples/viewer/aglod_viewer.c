@@ -84,7 +84,7 @@ typedef struct options {
 static void usage(void) {
     fprintf(stderr,
             "usage: aglod_viewer SCENE.aglod [--out DIR] [--frames N (default 24)]\n"
-            "         [--near D (default 0.6)] [--far D (default 16)]   scene diameters from the centre\n"
+            "         [--near D (default 0.3)] [--far D (default 16)]   scene diameters from the centre\n"
             "         [--width W (1920)] [--height H (1080)] [--fov DEG (60)] [--tau PX (1)]\n"
             "         [--coarsen-ratio R (1 = no hysteresis)] [--elevation DEG (25)]\n"
             "         [--azimuth DEG (30)] [--sweep DEG (60)] [--up x|y|z|auto (auto: the scene box's\n"
@@ -95,7 +95,7 @@ static int parse_options(int argc, char** argv, options* o) {
     o->scene = NULL;
     o->out = NULL;
     o->frames = 24;
-    o->near_diameters = 0.6;
+    o->near_diameters = 0.3;
     o->far_diameters = 16;
     o->width = 1920;
     o->height = 1080;
@@ -222,9 +222,11 @@ static const char* kVertexShader =
     "layout(location = 1) in vec3 normal;\n"
     "layout(location = 2) in vec4 color;\n" /* sRGB bytes, normalised */
     "uniform mat4 view_projection;\n"
+    "out vec3 v_position;\n"
     "out vec3 v_normal;\n"
     "out vec4 v_color;\n"
     "void main() {\n"
+    "  v_position = position;\n"
     "  v_normal = normal;\n"
     "  v_color = color;\n"
     "  gl_Position = view_projection * vec4(position, 1.0);\n"
@@ -232,10 +234,13 @@ static const char* kVertexShader =
 
 static const char* kFragmentShader =
     "#version 330 core\n"
+    "in vec3 v_position;\n"
     "in vec3 v_normal;\n"
     "in vec4 v_color;\n"
     "uniform vec3 sun;\n" /* unit, towards the sun, world space */
     "uniform vec3 up;\n"  /* unit, the scene's up axis */
+    "uniform vec3 eye;\n"
+    "uniform int faceted;\n" /* 1: the triangles' own normals instead of the file's (a check) */
     "out vec4 frag;\n"
     "vec3 to_linear(vec3 c) {\n"
     "  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));\n"
@@ -247,6 +252,10 @@ static const char* kFragmentShader =
     "void main() {\n"
     "  vec3 n = normalize(v_normal);\n"
     "  if (!gl_FrontFacing) n = -n;\n" /* open originals seen from behind */
+    "  if (faceted == 1) {\n"
+    "    n = normalize(cross(dFdx(v_position), dFdy(v_position)));\n"
+    "    if (dot(n, eye - v_position) < 0.0) n = -n;\n"
+    "  }\n"
     "  vec3 base = to_linear(v_color.rgb);\n"
     "  float diffuse = max(dot(n, sun), 0.0);\n"
     "  vec3 ambient = mix(vec3(0.20, 0.18, 0.16), vec3(0.38, 0.44, 0.55), 0.5 + 0.5 * dot(n, up));\n"
@@ -371,11 +380,16 @@ static void release(streaming* s, uint32_t node) {
 /* One frame's drawing state: the offscreen target and the program with its uniforms. */
 typedef struct renderer {
     GLuint fbo, program;
-    GLint u_view_projection, u_sun, u_up;
+    GLint u_view_projection, u_sun, u_up, u_eye, u_faceted;
     int width, height;
 } renderer;
 
-static void begin_pass(const renderer* r, const float view_projection[16], const float sun[3], const float up[3]) {
+typedef struct pass_uniforms {
+    float view_projection[16], sun[3], up[3], eye[3];
+    int faceted;
+} pass_uniforms;
+
+static void begin_pass(const renderer* r, const pass_uniforms* u) {
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
     glViewport(0, 0, r->width, r->height);
     glClearColor(kBackground[0] / 255.0f, kBackground[1] / 255.0f, kBackground[2] / 255.0f, 1.0f);
@@ -384,9 +398,11 @@ static void begin_pass(const renderer* r, const float view_projection[16], const
     glDisable(GL_CULL_FACE); /* originals may be open or inconsistently wound */
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glUseProgram(r->program);
-    glUniformMatrix4fv(r->u_view_projection, 1, GL_FALSE, view_projection);
-    glUniform3fv(r->u_sun, 1, sun);
-    glUniform3fv(r->u_up, 1, up);
+    glUniformMatrix4fv(r->u_view_projection, 1, GL_FALSE, u->view_projection);
+    glUniform3fv(r->u_sun, 1, u->sun);
+    glUniform3fv(r->u_up, 1, u->up);
+    glUniform3fv(r->u_eye, 1, u->eye);
+    glUniform1i(r->u_faceted, u->faceted);
 }
 
 /* One draw call per node with triangles; counts them. */
@@ -550,6 +566,8 @@ int main(int argc, char** argv) {
     r.u_view_projection = glGetUniformLocation(program, "view_projection");
     r.u_sun = glGetUniformLocation(program, "sun");
     r.u_up = glGetUniformLocation(program, "up");
+    r.u_eye = glGetUniformLocation(program, "eye");
+    r.u_faceted = glGetUniformLocation(program, "faceted");
     r.width = o.width;
     r.height = o.height;
     GLuint query = 0;
@@ -576,7 +594,7 @@ int main(int argc, char** argv) {
                      "entered,left,uploads,frees,resident,missing,draw_calls,triangles,gpu_primitives,select_ms,"
                      "frame_ms\n");
         fprintf(shots, "file,frame,width,height,sphere_x_px,sphere_y_px,sphere_radius_px,background_r,background_g,"
-                       "background_b,coverage,originals_coverage,missing_share,extra_share\n");
+                       "background_b,coverage,originals_coverage,missing_share,extra_share,shading_difference\n");
     }
 
     /* Streaming: creating the selector is the first change (the roots enter). */
@@ -608,7 +626,6 @@ int main(int argc, char** argv) {
     sun[up_axis] = 0.80;
     up[up_axis] = 1;
     normalize3(sun);
-    const float sunf[3] = {(float)sun[0], (float)sun[1], (float)sun[2]}, upf[3] = {(float)up[0], (float)up[1], (float)up[2]};
     printf("aglod_viewer: up axis %c; path %.3g -> %.3g diameters, %d frames, %dx%d px, fov %.3g deg, tau %.3g px\n",
            "xyz"[up_axis], o.near_diameters, o.far_diameters, o.frames, o.width, o.height, o.fov_degrees, o.tau);
     const double fov_y = o.fov_degrees * kPi / 180.0, aspect = (double)o.width / (double)o.height;
@@ -666,9 +683,15 @@ int main(int argc, char** argv) {
         apply_changes(file, selector, &s);
 
         /* Draw the cut. */
-        float vp[16];
-        view_projection(eye, forward, up, fov_y, aspect, z_near, z_far, vp);
-        begin_pass(&r, vp, sunf, upf);
+        pass_uniforms uniforms;
+        view_projection(eye, forward, up, fov_y, aspect, z_near, z_far, uniforms.view_projection);
+        for (int k = 0; k < 3; ++k) {
+            uniforms.sun[k] = (float)sun[k];
+            uniforms.up[k] = (float)up[k];
+            uniforms.eye[k] = (float)eye[k];
+        }
+        uniforms.faceted = 0;
+        begin_pass(&r, &uniforms);
         uint32_t draws = 0, missing = 0;
         unsigned long long triangles = 0;
         glBeginQuery(GL_PRIMITIVES_GENERATED, query);
@@ -728,10 +751,33 @@ int main(int argc, char** argv) {
                 const double f = (double)o.height / (2 * tan(fov_y / 2));
                 const double sphere_px = f * radius / sqrt(d * d - fmin(radius * radius, 0.99 * d * d));
                 printf("wrote %s: %.2f %% of the pixels show the scene\n", path, 100 * coverage);
-                double originals_coverage = -1, missing_share = -1, extra_share = -1;
+                double originals_coverage = -1, missing_share = -1, extra_share = -1, shading_difference = -1;
                 if (o.compare_originals) {
+                    /* The cut again, lit by its triangles' own (geometric) normals instead of the
+                     * file's per-vertex normals: the two pictures differ only by smooth versus
+                     * faceted shading when the normals reach the shader right. */
+                    pass_uniforms faceted = uniforms;
+                    faceted.faceted = 1;
+                    begin_pass(&r, &faceted);
+                    uint32_t unused_draws = 0;
+                    unsigned long long unused_triangles = 0;
+                    for (uint32_t n = 0; n < cut.node_count; ++n)
+                        if (s.meshes[cut.nodes[n]].resident) draw_mesh(&s.meshes[cut.nodes[n]], &unused_draws, &unused_triangles);
+                    read_pixels(&r, reference_pixels);
+                    double sum = 0;
+                    size_t both = 0;
+                    for (size_t p = 0; p < (size_t)o.width * (size_t)o.height; ++p) {
+                        const unsigned char *a = pixels + 3 * p, *b = reference_pixels + 3 * p;
+                        if (is_background(a) || is_background(b)) continue;
+                        sum += fabs((0.299 * a[0] + 0.587 * a[1] + 0.114 * a[2]) - (0.299 * b[0] + 0.587 * b[1] + 0.114 * b[2]));
+                        ++both;
+                    }
+                    shading_difference = both ? sum / (double)both : 0.0;
+                    printf("%s: smooth (file normals) and faceted (triangle normals) shading differ by %.2f of 255 "
+                           "brightness levels on average\n", name, shading_difference);
+
                     /* The same camera, every original object at full detail, no culling. */
-                    begin_pass(&r, vp, sunf, upf);
+                    begin_pass(&r, &uniforms);
                     uint32_t reference_draws = 0;
                     unsigned long long reference_triangles = 0;
                     for (uint32_t n = 0; n < node_count; ++n) {
@@ -761,10 +807,17 @@ int main(int argc, char** argv) {
                            "leaves %zu uncovered (%.3f %%); %.3f %% of the cut's pixels lie outside them\n",
                            path, reference_draws, reference_triangles, covered, lacking, 100 * missing_share,
                            100 * extra_share);
+                    snprintf(path, sizeof path, "%s/%.*s_originals_zoom.png", o.out, (int)(strlen(name) - 4), name);
+                    if (2 * sphere_px < 0.5 * o.height &&
+                        !write_zoom(path, o.width, o.height, reference_pixels, 0.5 * o.width, 0.5 * o.height,
+                                    1.1 * sphere_px)) {
+                        fprintf(stderr, "aglod_viewer: cannot write %s\n", path);
+                        return 1;
+                    }
                 }
-                fprintf(shots, "%s,%d,%d,%d,%.2f,%.2f,%.2f,%d,%d,%d,%.6f,%.6f,%.6f,%.6f\n", name, frame, o.width,
+                fprintf(shots, "%s,%d,%d,%d,%.2f,%.2f,%.2f,%d,%d,%d,%.6f,%.6f,%.6f,%.6f,%.4f\n", name, frame, o.width,
                         o.height, 0.5 * o.width, 0.5 * o.height, sphere_px, kBackground[0], kBackground[1],
-                        kBackground[2], coverage, originals_coverage, missing_share, extra_share);
+                        kBackground[2], coverage, originals_coverage, missing_share, extra_share, shading_difference);
                 if (2 * sphere_px < 0.5 * o.height) {
                     snprintf(path, sizeof path, "%s/%.*s_zoom.png", o.out, (int)(strlen(name) - 4), name);
                     if (!write_zoom(path, o.width, o.height, pixels, 0.5 * o.width, 0.5 * o.height, 1.1 * sphere_px)) {
@@ -784,6 +837,7 @@ int main(int argc, char** argv) {
             glfwSwapBuffers(window);
         }
         glfwPollEvents();
+        if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, GLFW_TRUE);
         if (glfwWindowShouldClose(window)) break;
     }
 

@@ -45,6 +45,7 @@
     X(void, glUniformMatrix4fv, (GLint location, GLsizei count, GLboolean transpose,             \
                                  const GLfloat* value))                                          \
     X(void, glUniform3fv, (GLint location, GLsizei count, const GLfloat* value))                 \
+    X(void, glUniform1i, (GLint location, GLint value))                                          \
     X(void, glGenFramebuffers, (GLsizei n, GLuint* framebuffers))                                \
     X(void, glBindFramebuffer, (GLenum target, GLuint framebuffer))                              \
     X(void, glDeleteFramebuffers, (GLsizei n, const GLuint* framebuffers))                       \

@@ -15,7 +15,9 @@
 //  - the screenshots, decoded from the PNG files: near shows the scene on >= 5 % of the
 //    picture, far on >= 3 % of the scene's projected bounding circle (and >= 50 pixels); the
 //    pixels are lit (a spread of brightness) and coloured (saturated); with the originals drawn
-//    for comparison, the cut leaves at most 1 % (near) / 5 % (far) of their pixels uncovered.
+//    for comparison, the cut leaves at most 1 % (near) / 5 % (far) of their pixels uncovered,
+//    and the cut lit by the file's normals looks like the cut lit by its triangles' own normals
+//    (mean brightness difference <= 7 levels near, <= 12 far: wrong normals give 12 to 40).
 // Prints every check; exit status 0 when all pass, 1 otherwise.
 #include <stb_image.h>
 
@@ -134,6 +136,15 @@ void checkScreenshot(const std::string& dir, const Row& shot, bool far) {
         check(missing <= limit, fmt("%s: the cut leaves %.3f %% of the originals' pixels uncovered (<= %.0f %%); %.2f %% of "
                                     "its pixels lie outside them",
                                     name.c_str(), 100 * missing, 100 * limit, 100 * real(shot, "extra_share")));
+    }
+    const double shading = real(shot, "shading_difference");
+    if (shading >= 0) {
+        // Lit by the file's normals against lit by the triangles' own: measured 3.5 (near) and
+        // 7.9 (far) levels with the normals right; normals read from the wrong place or
+        // flipped gave 12 to 40.
+        const double limit = far ? 12 : 7;
+        check(shading <= limit, fmt("%s: normals: smooth and faceted shading differ by %.2f brightness levels (<= %.0f)",
+                                    name.c_str(), shading, limit));
     }
 }
 
