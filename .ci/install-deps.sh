@@ -20,11 +20,14 @@ packages=(
   libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
   libompl-dev
   chromium clang libclang-rt-14-dev python3
+  libglfw3-dev libgl1-mesa-dri xvfb
 )
 # libompl-dev: motion planning on the hierarchy (planning/, `aggrelod plan`).
 # clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz; python3: their
 # mutation corpora (tests/fuzz/mutate.py).
 # chromium: the web viewer test (tests/web) loads samples/web in headless Chromium.
+# libglfw3-dev, libgl1-mesa-dri, xvfb: the OpenGL viewer (samples/viewer) and its headless test
+# (tests/viewer) under Xvfb with Mesa's llvmpipe.
 # node and npm run the glTF validator in the tests. Take them from Debian only when they are
 # missing: a node installed otherwise (e.g. a vendor repack) conflicts with Debian's npm.
 if ! command -v node >/dev/null 2>&1; then packages+=(nodejs); fi
