@@ -19,7 +19,12 @@
  * 1080), shown in the window unless --hidden. With --out it writes DIR/frames.csv (one row per
  * frame: the camera exactly as passed to the selection, the cut, the streaming, draw calls,
  * triangles, timings), DIR/screenshots.csv and DIR/near.png (first frame) and DIR/far.png
- * (last frame). Headless: run it under xvfb-run (Mesa llvmpipe), e.g.
+ * (last frame), plus DIR/far_zoom.png (the far view's bounding circle, enlarged). With
+ * --compare-originals it also draws every original object at those two frames
+ * (DIR/near_originals.png, DIR/far_originals.png) and the cut lit by its triangles' own normals, and reports the pixels
+ * of the originals the cut leaves uncovered and the shading difference (docs/runtime.md).
+ * --loop flies the path back and forth until the window is closed (or Esc). Headless: run it
+ * under xvfb-run (Mesa llvmpipe), e.g.
  *   xvfb-run -a aglod_viewer out/forest/scene.aglod --out shots --hidden
  * Exit status 0 when every frame drew exactly the cut; 1 on an error or a streaming
  * inconsistency; 77 when no OpenGL 3.3 context can be created (no display, no driver). */
@@ -33,7 +38,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -3,7 +3,9 @@
 // benchmark's (c) column (a fresh selection per camera, no hysteresis; triangles of the proxy
 // nodes plus those of the originals drawn as leaves; one draw call per proxy node and per leaf),
 // with the camera's frustum culling added (Selector::select(ViewCamera) after reset()), since
-// a renderer's camera has a frustum. FRAMES.csv is what samples/viewer writes (columns frame,
+// a renderer's camera has a frustum, and no draw call for a node without triangles (as in the
+// benchmark's column (a): e.g. a support surface such as a ground, which the file lists as an
+// object without a mesh for the engine to draw itself). FRAMES.csv is what samples/viewer writes (columns frame,
 // eye_*, forward_*, up_*, fov_y, aspect, viewport_height, near, far, tau, coarsen_ratio, by
 // name, any order; coarsen_ratio must be 1). Prints one CSV row per camera:
 //   frame,cut_nodes,proxies,originals,culled,draw_calls,triangles
@@ -98,10 +100,15 @@ inline int printCutsForCameras(const std::string& aglodPath, const std::string& 
         }
         selector.reset();
         selector.select(camera, settings);
-        size_t triangles = 0;
-        for (uint32_t n : selector.proxyNodes()) triangles += file.triangles(n).size / 3;
-        for (uint32_t obj : selector.originalObjects()) triangles += objectTriangles[obj];
-        const size_t draws = size_t(selector.proxyNodes().size) + size_t(selector.originalObjects().size);
+        size_t triangles = 0, draws = 0;
+        for (uint32_t n : selector.proxyNodes()) {
+            triangles += file.triangles(n).size / 3;
+            draws += file.triangles(n).size ? 1 : 0;
+        }
+        for (uint32_t obj : selector.originalObjects()) {
+            triangles += objectTriangles[obj];
+            draws += objectTriangles[obj] ? 1 : 0;
+        }
         std::printf("%s,%zu,%zu,%zu,%zu,%zu,%zu\n", cells[column["frame"]].c_str(), size_t(selector.cut().size),
                     size_t(selector.proxyNodes().size), size_t(selector.originalObjects().size),
                     size_t(selector.culledNodes().size), draws, triangles);
