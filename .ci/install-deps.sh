@@ -26,8 +26,7 @@ packages=(
 # clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz; python3: their
 # mutation corpora (tests/fuzz/mutate.py).
 # chromium: the web viewer test (tests/web) loads samples/web in headless Chromium.
-# libglfw3-dev, libgl1-mesa-dri, xvfb: the OpenGL viewer (samples/viewer) and its headless test
-# (tests/viewer) under Xvfb with Mesa's llvmpipe.
+# libglfw3-dev, libgl1-mesa-dri, xvfb: the OpenGL viewer (samples/viewer), tested headless on llvmpipe.
 # node and npm run the glTF validator in the tests. Take them from Debian only when they are
 # missing: a node installed otherwise (e.g. a vendor repack) conflicts with Debian's npm.
 if ! command -v node >/dev/null 2>&1; then packages+=(nodejs); fi
