@@ -21,9 +21,11 @@ packages=(
   libompl-dev
   chromium clang libclang-rt-14-dev python3
   mingw-w64 wine wine64
+  libglfw3-dev libgl1-mesa-dri xvfb
 )
 # mingw-w64: the Windows cross build of the runtime (tests/windows); wine, wine64: run its unit
 # tests there.
+# libglfw3-dev, libgl1-mesa-dri, xvfb: the OpenGL viewer (samples/viewer), tested headless on llvmpipe.
 # libompl-dev: motion planning on the hierarchy (planning/, `aggrelod plan`).
 # clang (with its libFuzzer runtime): the fuzz targets of tests/fuzz; python3: their
 # mutation corpora (tests/fuzz/mutate.py).

@@ -5,9 +5,13 @@
 # - no file under runtime/ includes TetGen, CGAL, tinygltf, meshoptimizer, GEOS, GLM or any
 #   header of module/;
 # - no file under module/ includes tinygltf or any header of runtime/;
+# - (when samples/viewer exists) no file of the OpenGL viewer includes anything but the runtime's
+#   C API among the project's headers: no header of module/ or bake/, no C++ runtime header
+#   (aggrelod/...), none of the bake-side libraries or Embree;
 # - (with LINK_INFO, written by tests/CMakeLists.txt at generate time) no target defined under
-#   runtime/ links TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS, GLM or the module, and
-#   no target under module/ links tinygltf or the runtime.
+#   runtime/ links TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS, GLM or the module, no
+#   target under module/ links tinygltf or the runtime, and the viewer (TARGETS_viewer) links
+#   none of the bake-side libraries, the module, the bake's or the samples' libraries, or Embree.
 # Prints every violation and fails (FATAL_ERROR) when there is one.
 cmake_minimum_required(VERSION 3.22)
 
@@ -95,6 +99,17 @@ check_includes(runtime
 check_includes(module
   "(^|/)tiny_gltf\\.h$|(^|/)runtime/"
   "${runtime_only}")
+if(EXISTS "${SOURCE_DIR}/samples/viewer")
+  set(bake_headers "")
+  file(GLOB _bake_headers "${SOURCE_DIR}/bake/*.h")
+  foreach(h IN LISTS _bake_headers)
+    get_filename_component(base "${h}" NAME)
+    list(APPEND bake_headers "${base}")
+  endforeach()
+  check_includes(samples/viewer
+    "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|^embree|(^|/)module/|(^|/)bake/|^aggrelod/"
+    "${module_only};${bake_headers}")
+endif()
 
 if(LINK_INFO)
   if(NOT EXISTS "${LINK_INFO}")
@@ -103,7 +118,8 @@ if(LINK_INFO)
   include("${LINK_INFO}")
   set(_forbidden_runtime "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples")
   set(_forbidden_module "tinygltf|aggrelod_runtime|aggrelod::runtime|aggrelod_io")
-  foreach(part runtime module)
+  set(_forbidden_viewer "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|embree|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples|aggrelod_render|aggrelod_planning|aggrelod_runtime_collision")
+  foreach(part runtime module viewer)
     set(count 0)
     foreach(t IN LISTS TARGETS_${part})
       set(links "${LINKS_${t}}")

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: few-faced enclosing polytopes of a convex hull (DESIGN section 2.6).
 //
 // Outer polyhedral approximation by cutting planes (the cutting variant of Kamenev's method

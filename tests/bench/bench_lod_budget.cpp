@@ -19,10 +19,14 @@
 // Usage: bench_lod_budget [--scenes random,forest,village,truck_town] [--seed 1]
 //          [--objects 400] [--triangles 200000] [--levels 8] [--threads 2] [--elevation 25]
 //          [--data DIR (holds 3d/truck_town/town_model.gltf)]
+//        bench_lod_budget --cut-for FILE.aglod --cameras FRAMES.csv   (the cut per given camera,
+//          see lod_budget_cut_for.h)
 #include "acceptance_scenes.h"
 #include "runtime_export.h"
 
 #include "parallel_for.h"
+
+#include "lod_budget_cut_for.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 #include <aggrelod/runtime_build.h>
@@ -381,6 +385,7 @@ std::vector<std::string> split(const std::string& list) {
 
 int main(int argc, char** argv) {
     Options o;
+    std::string cutFor, cameras;  // --cut-for / --cameras (lod_budget_cut_for.h)
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
@@ -397,11 +402,14 @@ int main(int argc, char** argv) {
         else if (arg == "--threads") o.threads = std::atoi(value);
         else if (arg == "--elevation") o.elevationDegrees = std::atof(value);
         else if (arg == "--data") o.data = value;
+        else if (arg == "--cut-for") cutFor = value;
+        else if (arg == "--cameras") cameras = value;
         else {
             std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_lod_budget.cpp)\n", arg.c_str());
             return 2;
         }
     }
+    if (!cutFor.empty()) return lod_budget::printCutsForCameras(cutFor, cameras);
     std::printf("bench_lod_budget: seed %u; random scene = samples::makeRandomScene(%d objects, %d triangles, seed) "
                 "(= aggrelod_make_sample random --objects %d --triangles %d --seed %u); %d levels; threads %d\n",
                 o.seed, o.objects, o.triangles, o.objects, o.triangles, o.seed, o.levels, o.threads);

@@ -25,6 +25,8 @@ MIT_PREFIXES = (
     "runtime/",
     "cmake/",
     "samples/web/",
+    "samples/viewer/",
+    "tests/viewer/",
     "tests/package_consumer/",
     "tests/runtime_only/",
     "tests/runtime_support/",

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Few-faced enclosing polytopes of a convex hull (module/src/bounding_polytope.cpp): each one
 // is a closed, outward convex mesh that contains the hull, its stated distance to the hull is
 // the true one, and the series reaches down to a tetrahedron.
