@@ -9,6 +9,7 @@
 #include "runtime_export.h"
 #include "commands_2d.h"
 #include "commands_render.h"
+#include "output_set.h"
 #ifdef AGGRELOD_HAVE_PLANNING
 #include "commands_plan.h"
 #endif
@@ -57,214 +58,7 @@ void printError(const std::string& message) {
 }
 
 // ---------------------------------------------------------------------------
-// The output set of a bake: every file is written into a fresh private folder inside OUTDIR
-// (created exclusively, so nothing can be planted in it), synced, then moved into place; the
-// files being replaced are kept as backups until every move succeeded, and put back if one
-// fails. A folder left behind by a bake that was killed is removed by the next bake.
-
-/// Prefix of the temporary folders; the rest is "<pid>-<random>".
-constexpr const char* kTempPrefix = ".aggrelod-tmp-";
-
-bool syncPath(const fs::path& p, std::string& error) {
-    const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
-    if (fd < 0 || ::fsync(fd) != 0) {
-        error = p.string() + ": cannot sync: " + std::strerror(errno);
-        if (fd >= 0) ::close(fd);
-        return false;
-    }
-    ::close(fd);
-    return true;
-}
-
-/// Creates an empty file that did not exist, never through a symbolic link.
-bool createExclusive(const fs::path& p, std::string& error) {
-    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        error = p.string() + ": cannot create: " + std::strerror(errno);
-        return false;
-    }
-    ::close(fd);
-    return true;
-}
-
-/// The journal of a commit in its temporary folder: one line per output, written and synced
-/// before that output is moved ("1" or "0" for whether an old version existed, the name of its
-/// backup in the folder, the final path, tab-separated), then a line "committed" after the
-/// last move.
-constexpr const char* kJournal = "journal";
-
-/// Puts the old set back after a bake was killed while moving its outputs into place (its
-/// journal has no "committed" line): each output already moved is replaced by its backup, or
-/// removed when there was no old version.
-void undoInterruptedCommit(const fs::path& tempDir) {
-    std::ifstream journal(tempDir / kJournal);
-    if (!journal) return;
-    std::vector<std::array<std::string, 3>> moves;
-    for (std::string line; std::getline(journal, line);) {
-        if (line == "committed") return;  // the new set is complete
-        const size_t a = line.find('\t'), b = line.find('\t', a == std::string::npos ? a : a + 1);
-        if (a == std::string::npos || b == std::string::npos) break;  // cut short: written last
-        moves.push_back({line.substr(0, a), line.substr(a + 1, b - a - 1), line.substr(b + 1)});
-    }
-    std::error_code ec;
-    for (auto m = moves.rbegin(); m != moves.rend(); ++m) {
-        const fs::path backup = tempDir / (*m)[1], final = (*m)[2];
-        if ((*m)[0] == "1") {
-            if (!fs::exists(fs::symlink_status(backup, ec))) continue;  // not moved aside yet: still the old one
-            if (fs::is_directory(fs::symlink_status(backup, ec))) fs::remove_all(final, ec);
-            ::rename(backup.c_str(), final.c_str());
-        } else {
-            fs::remove_all(final, ec);
-        }
-    }
-}
-
-/// Removes temporary folders of bakes that are no longer running (killed, or the machine
-/// stopped), after undoing a commit they were killed in, and the fixed-name temporaries of
-/// older versions.
-void removeStaleTemporaries(const fs::path& outDir) {
-    std::error_code ec;
-    for (const char* legacy : {"levels.glb.tmp", "proxies.glb.tmp", "scene.aglod.tmp", "tiles.tmp", "tiles.old"})
-        fs::remove_all(outDir / legacy, ec);  // a symbolic link is removed, not followed
-    for (fs::directory_iterator it(outDir, ec), end; !ec && it != end; it.increment(ec)) {
-        const std::string name = it->path().filename().string();
-        if (name.rfind(kTempPrefix, 0) != 0) continue;
-        const long pid = std::strtol(name.c_str() + std::strlen(kTempPrefix), nullptr, 10);
-        if (pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM)) continue;  // its bake still runs
-        undoInterruptedCommit(it->path());
-        std::error_code removeError;
-        fs::remove_all(it->path(), removeError);
-    }
-}
-
-class OutputSet {
-public:
-    ~OutputSet() {
-        std::error_code ec;
-        for (const fs::path& p : outsideTemporaries_) fs::remove(p, ec);
-        if (!tempDir_.empty()) fs::remove_all(tempDir_, ec);
-    }
-
-    bool begin(const fs::path& outDir, std::string& error) {
-        outDir_ = outDir;
-        removeStaleTemporaries(outDir);
-        std::string pattern = (outDir / (kTempPrefix + std::to_string(::getpid()) + "-XXXXXX")).string();
-        if (!::mkdtemp(pattern.data())) {
-            error = outDir.string() + ": cannot create a temporary folder: " + std::strerror(errno);
-            return false;
-        }
-        tempDir_ = pattern;
-        return true;
-    }
-
-    /// A new empty temporary for `final` (OUTDIR/name, or a file elsewhere such as --stats).
-    bool addFile(const fs::path& final, fs::path& temporary, std::string& error) {
-        const bool inOutDir = final.parent_path() == outDir_;
-        if (inOutDir) {
-            temporary = tempDir_ / final.filename();
-        } else {
-            // Elsewhere: beside its final place (a rename cannot cross file systems).
-            temporary = final;
-            temporary += "." + tempDir_.filename().string();
-        }
-        if (!createExclusive(temporary, error)) return false;
-        if (!inOutDir) outsideTemporaries_.push_back(temporary);
-        entries_.push_back({temporary, final, false});
-        return true;
-    }
-
-    /// A folder (the 3D Tiles tileset), written whole into `temporary` by the caller.
-    fs::path folderTemporary(const fs::path& final) {
-        entries_.push_back({tempDir_ / final.filename(), final, true});
-        return entries_.back().temporary;
-    }
-
-    /// Syncs every temporary, then moves each into place; on a failure the set as it was is
-    /// put back.
-    bool commit(std::string& error) {
-        for (const Entry& e : entries_) {
-            if (e.folder) continue;
-            if (!syncPath(e.temporary, error)) return false;
-        }
-        if (!syncPath(tempDir_, error)) return false;
-        struct Done {
-            fs::path final, backup;
-            bool hadOld;
-        };
-        std::vector<Done> done;
-        const auto rollBack = [&] {
-            std::error_code ec;
-            for (auto d = done.rbegin(); d != done.rend(); ++d) {
-                if (d->hadOld) {
-                    if (fs::is_directory(d->final, ec) && !fs::is_symlink(d->final, ec)) fs::remove_all(d->final, ec);
-                    ::rename(d->backup.c_str(), d->final.c_str());
-                } else {
-                    fs::remove_all(d->final, ec);
-                }
-            }
-        };
-        const fs::path journalPath = tempDir_ / kJournal;
-        const int journal = ::open(journalPath.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_APPEND | O_CLOEXEC, 0644);
-        if (journal < 0) {
-            error = journalPath.string() + ": cannot create: " + std::strerror(errno);
-            return false;
-        }
-        struct Closer {
-            int fd;
-            ~Closer() { ::close(fd); }
-        } closeJournal{journal};
-        const auto record = [&](const std::string& line) {
-            return ::write(journal, line.data(), line.size()) == ssize_t(line.size()) && ::fdatasync(journal) == 0;
-        };
-        size_t k = 0;
-        for (const Entry& e : entries_) {
-            std::error_code ec;
-            const std::string backupName = "old-" + std::to_string(k++) + "-" + e.final.filename().string();
-            const fs::path backup = tempDir_ / backupName;
-            const bool hadOld = fs::exists(fs::symlink_status(e.final, ec));
-            if (!record(std::string(hadOld ? "1" : "0") + "\t" + backupName + "\t" + fs::absolute(e.final, ec).string() + "\n")) {
-                error = journalPath.string() + ": cannot write: " + std::strerror(errno);
-                rollBack();
-                return false;
-            }
-            if (!e.folder && fs::is_directory(fs::symlink_status(e.final, ec))) {
-                error = e.final.string() + ": cannot replace: it is a folder";
-                rollBack();
-                return false;
-            }
-            // The old version stays reachable (a second name, or moved aside for a folder).
-            if (hadOld) {
-                const bool ok = e.folder ? ::rename(e.final.c_str(), backup.c_str()) == 0
-                                         : ::link(e.final.c_str(), backup.c_str()) == 0 ||
-                                               ::rename(e.final.c_str(), backup.c_str()) == 0;
-                if (!ok) {
-                    error = e.final.string() + ": cannot replace: " + std::strerror(errno);
-                    rollBack();
-                    return false;
-                }
-            }
-            done.push_back({e.final, backup, hadOld});
-            if (::rename(e.temporary.c_str(), e.final.c_str()) != 0) {
-                error = e.final.string() + ": cannot replace: " + std::strerror(errno);
-                rollBack();
-                return false;
-            }
-        }
-        std::string ignored;
-        syncPath(outDir_, ignored);
-        record("committed\n");
-        return true;
-    }
-
-private:
-    struct Entry {
-        fs::path temporary, final;
-        bool folder;
-    };
-    fs::path outDir_, tempDir_;
-    std::vector<Entry> entries_;
-    std::vector<fs::path> outsideTemporaries_;
-};
+// The output set of a bake (OutputSet, its manifest and the clean-up of killed bakes): output_set.cpp.
 
 /// Two paths naming the same file (or the same place, when one does not exist yet).
 bool samePlace(const fs::path& a, const fs::path& b) {
@@ -448,7 +242,8 @@ int runBake(BakeOptions o) {
     {
         const fs::path outDir(o.outDir);
         std::vector<std::pair<std::string, fs::path>> outputs = {
-            {"levels.glb", outDir / "levels.glb"}, {"proxies.glb", outDir / "proxies.glb"}, {"scene.aglod", outDir / "scene.aglod"}};
+            {"levels.glb", outDir / "levels.glb"}, {"proxies.glb", outDir / "proxies.glb"}, {"scene.aglod", outDir / "scene.aglod"},
+            {io::kSetManifestName, outDir / io::kSetManifestName}};
         if (!o.statsPath.empty()) outputs.emplace_back("--stats", fs::path(o.statsPath));
         for (size_t i = 0; i < outputs.size(); ++i) {
             if (samePlace(outputs[i].second, o.scene)) {
@@ -473,7 +268,7 @@ int runBake(BakeOptions o) {
     // A bake into this OUTDIR killed while moving its outputs: its old set comes back first.
     {
         std::error_code ec;
-        if (fs::is_directory(o.outDir, ec)) removeStaleTemporaries(o.outDir);
+        if (fs::is_directory(o.outDir, ec)) io::removeStaleTemporaries(o.outDir);
     }
 
     // Read.
@@ -551,7 +346,7 @@ int runBake(BakeOptions o) {
         return kInternal;
     }
 
-    // Write: the whole set into a fresh temporary folder, then moved into place (OutputSet).
+    // Write: the whole set into a fresh temporary folder, then switched in (OutputSet).
     const fs::path outDir(o.outDir);
     const fs::path levelsPath = outDir / "levels.glb";
     const fs::path proxiesPath = outDir / "proxies.glb";
@@ -568,7 +363,7 @@ int runBake(BakeOptions o) {
         printError(message);
         return kFileError;
     };
-    OutputSet set;
+    io::OutputSet set;
     if (!set.begin(outDir, error)) return fail(error);
     if (!statsPath.empty() && statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
     fs::path levelsTmp, proxiesTmp, runtimeTmp, statsTmp;
@@ -721,6 +516,25 @@ int runInspect(const InspectOptions& o) {
                 static_cast<unsigned long long>(objectLodTriangles), leaves,
                 static_cast<unsigned long long>(leafTriangles), file.roots().size, file.depth());
     for (uint32_t r : file.roots()) printInspectTree(file, r, o);
+    // The set the file belongs to, when a bake's manifest lies beside it and names it.
+    const fs::path dir = fs::path(o.file).parent_path().empty() ? fs::path(".") : fs::path(o.file).parent_path();
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(dir / io::kSetManifestName, ec))) {
+        const io::SetCheck set = io::checkOutputSet(dir);
+        bool named = false;
+        for (const auto& f : set.files) named = named || f.first == fs::path(o.file).filename().string();
+        if (set.status != io::SetCheck::Status::Complete)
+            std::fprintf(stderr, "warning: %s: the files beside it are not one complete set: %s\n", o.file.c_str(),
+                         set.problem.c_str());
+        else if (!named)
+            std::printf("set: %s does not name this file\n", (dir / io::kSetManifestName).string().c_str());
+        else if (set.moved)
+            std::fprintf(stderr, "warning: %s: a bake is replacing its set (or was killed doing so): the complete "
+                                 "set is the one %s names\n", o.file.c_str(), (dir / io::kSetManifestName).string().c_str());
+        else
+            std::printf("set: complete, %zu files match %s\n", set.files.size(),
+                        (dir / io::kSetManifestName).string().c_str());
+    }
     std::fflush(stdout);
     return kOk;
 }

@@ -2,8 +2,11 @@
 // The output set of `aggrelod bake`: outputs never overwrite the input or each other, nothing
 // planted in OUTDIR is followed, a failing move puts the old set back, stale temporaries are
 // removed, and a bake killed at any moment leaves the complete old or the complete new set
-// with no process of it left running.
+// (as a reader of OUTDIR/aggrelod-set.json sees it, without another bake) with no process of
+// it left running.
 #include "test_support.h"
+
+#include "output_set.h"
 
 #include <aggrelod/samples.h>
 
@@ -11,6 +14,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <map>
 #include <random>
 #include <spawn.h>
 #include <string>
@@ -44,6 +48,29 @@ std::vector<std::string> readSet(const fs::path& out) {
     std::vector<std::string> files;
     for (const auto& name : kSet) files.push_back(fs::exists(out / name) ? readFile(out / name) : std::string("<missing>"));
     return files;
+}
+
+/// The set a reader of OUTDIR/aggrelod-set.json sees: each file of it by name with its bytes
+/// (the stats file, whose timings differ from bake to bake, by its name only); `status` says
+/// whether the manifest is there and every file matches it.
+struct SeenSet {
+    io::SetCheck check;
+    std::map<std::string, std::string> files;
+};
+
+SeenSet readThroughManifest(const fs::path& out) {
+    SeenSet seen;
+    seen.check = io::checkOutputSet(out);
+    for (const auto& [name, path] : seen.check.files)
+        seen.files[name] = name == "stats.json" ? std::string("<stats>") : readFile(path);
+    return seen;
+}
+
+std::vector<std::string> leftTemporaries(const fs::path& out) {
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(out))
+        if (e.path().filename().string().rfind(".aggrelod-tmp-", 0) == 0) left.push_back(e.path().filename().string());
+    return left;
 }
 
 }  // namespace
@@ -199,4 +226,142 @@ TEST(OutputSet, ABakeKilledAtAnyMomentLeavesTheOldOrTheNewSet) {
     }
     ::prctl(PR_SET_CHILD_SUBREAPER, 0);
     std::printf("bake %.2f s; killed 10 times: old set %d, new set %d\n", duration, oldSeen, newSeen);
+}
+
+TEST(OutputSet, ManifestNamesEveryFileOfTheSet) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "in.glb", threeCubes());
+    const RunResult r = bake(dir / "in.glb", dir / "out", dir, {"--levels", "2", "--tiles", "--stats", (dir / "out" / "stats.json").string()});
+    ASSERT_EQ(r.exitCode, 0) << r.describe();
+    const SeenSet seen = readThroughManifest(dir / "out");
+    ASSERT_EQ(seen.check.status, io::SetCheck::Status::Complete) << seen.check.problem;
+    EXPECT_FALSE(seen.check.moved);
+    for (const char* name : {"levels.glb", "proxies.glb", "scene.aglod", "stats.json", "tiles/tileset.json"})
+        EXPECT_EQ(seen.files.count(name), 1u) << name;
+    size_t tiles = 0;
+    for (const auto& [name, bytes] : seen.files) {
+        if (name.rfind("tiles/", 0) == 0) ++tiles;
+        if (name != "stats.json") EXPECT_EQ(bytes, readFile(dir / "out" / name)) << name;
+    }
+    size_t tilesOnDisk = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir / "out" / "tiles")) tilesOnDisk += e.is_regular_file();
+    EXPECT_EQ(tiles, tilesOnDisk);
+
+    // inspect tells a complete set from a damaged one.
+    const RunResult ok = runProgram({AGGRELOD_CLI, "inspect", (dir / "out" / "scene.aglod").string()}, dir);
+    EXPECT_EQ(ok.exitCode, 0) << ok.describe();
+    EXPECT_NE(ok.out.find("set: complete"), std::string::npos) << ok.describe();
+    std::string levels = readFile(dir / "out" / "levels.glb");
+    levels[levels.size() / 2] ^= 1;
+    writeFile(dir / "out" / "levels.glb", levels);
+    EXPECT_EQ(io::checkOutputSet(dir / "out").status, io::SetCheck::Status::Incomplete);
+    const RunResult damaged = runProgram({AGGRELOD_CLI, "inspect", (dir / "out" / "scene.aglod").string()}, dir);
+    EXPECT_EQ(damaged.exitCode, 0) << damaged.describe();
+    EXPECT_NE(damaged.err.find("not one complete set: levels.glb: its SHA-256 differs"), std::string::npos)
+        << damaged.describe();
+
+    // The manifest reader refuses paths out of the folder and malformed text.
+    io::SetManifest m;
+    std::string error;
+    const std::string hash(64, 'a');
+    EXPECT_FALSE(io::parseSetManifest(R"({"format": "aggrelod-set", "version": 1, "files": [{"name": "../x", "size": 1, "sha256": ")" + hash + "\"}]}", m, error));
+    EXPECT_FALSE(io::parseSetManifest(R"({"format": "aggrelod-set", "version": 1, "files": [{"name": "x", "size": 1, "sha256": ")" + hash + R"(", "at": "/etc/passwd"}]})", m, error));
+    EXPECT_FALSE(io::parseSetManifest(R"({"format": "aggrelod-set", "files": [)", m, error));
+    ASSERT_TRUE(io::parseSetManifest(R"({"format": "aggrelod-set", "version": 1, "extra": [1, {"a": null}], "files": [{"name": "a b", "size": 3, "sha256": ")" + hash + "\"}]}", m, error)) << error;
+    ASSERT_EQ(m.files.size(), 1u);
+    EXPECT_EQ(m.files[0].name, "a b");
+    EXPECT_EQ(io::sha256Hex("abc", 3), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    EXPECT_EQ(io::sha256Hex("", 0), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    const std::string million(1000000, 'a');
+    EXPECT_EQ(io::sha256Hex(million.data(), million.size()), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+// Fault injection: AGGRELOD_TEST_KILL_AFTER_COMMIT_STEP=K makes the bake kill itself (SIGKILL)
+// right after the K-th step of its commit (the journal, each backup, each rename, each switch
+// of the manifest; bake/output_set.cpp); without it the variable does nothing. For every K up
+// to the first that the bake outlives, a reader of the manifest must find, without another
+// bake, the complete old set or the complete new set; then the next bake into OUTDIR (one that
+// fails on its input) must leave that set at its names with no temporary folder.
+TEST(OutputSet, AKillAfterEveryStepOfTheCommitLeavesTheOldOrTheNewSet) {
+    const fs::path dir = freshTestDir(currentTestName());
+    writeFile(dir / "in.glb", threeCubes());
+    const std::string statsInside = "--stats=" + (dir / "out" / "stats.json").string();
+    struct Scenario {
+        std::string name;
+        std::vector<std::string> oldOptions;  // empty: no old set (a fresh OUTDIR)
+        std::vector<std::string> newOptions;
+    };
+    const std::vector<Scenario> scenarios = {
+        {"tiles and stats", {"--levels", "2", "--tiles", statsInside}, {"--levels", "3", "--tiles", statsInside}},
+        {"fresh OUTDIR", {}, {"--levels", "3", "--tiles"}},
+        {"tiles added, stats elsewhere", {"--levels", "2"}, {"--levels", "3", "--tiles", "--stats", (dir / "stats.json").string()}},
+    };
+    for (const Scenario& sc : scenarios) {
+        SCOPED_TRACE(sc.name);
+        // The reference sets, each baked once into a folder of its own and read back through
+        // their manifests (a set copied elsewhere stays complete: its names are relative).
+        const auto reference = [&](const std::vector<std::string>& options, const fs::path& folder) {
+            fs::remove_all(dir / "out");
+            if (options.empty()) return std::map<std::string, std::string>();
+            const RunResult r = bake(dir / "in.glb", dir / "out", dir, options);
+            EXPECT_EQ(r.exitCode, 0) << r.describe();
+            fs::remove_all(folder);
+            fs::rename(dir / "out", folder);
+            const SeenSet seen = readThroughManifest(folder);
+            EXPECT_EQ(seen.check.status, io::SetCheck::Status::Complete) << seen.check.problem;
+            return seen.files;
+        };
+        const std::map<std::string, std::string> oldSet = reference(sc.oldOptions, dir / "old");
+        const std::map<std::string, std::string> newSet = reference(sc.newOptions, dir / "new");
+        ASSERT_FALSE(oldSet == newSet);
+        const bool noOld = sc.oldOptions.empty();
+
+        int oldSeen = 0, newSeen = 0, steps = 0;
+        for (int k = 1;; ++k) {
+            ASSERT_LT(k, 200) << "the commit never ends";
+            fs::remove_all(dir / "out");
+            if (noOld) fs::create_directories(dir / "out");
+            else fs::copy(dir / "old", dir / "out", fs::copy_options::recursive);
+            ::setenv("AGGRELOD_TEST_KILL_AFTER_COMMIT_STEP", std::to_string(k).c_str(), 1);
+            const RunResult r = bake(dir / "in.glb", dir / "out", dir, sc.newOptions);
+            ::unsetenv("AGGRELOD_TEST_KILL_AFTER_COMMIT_STEP");
+            if (r.exited && r.exitCode == 0) break;  // K is past the last step
+            ASSERT_TRUE(r.signaled && r.signal == SIGKILL) << "step " << k << ": " << r.describe();
+            ++steps;
+
+            // The reader, before anything else touches OUTDIR.
+            const SeenSet seen = readThroughManifest(dir / "out");
+            if (noOld && seen.check.status == io::SetCheck::Status::NoManifest) {
+                ++oldSeen;  // no set yet: the old (empty) one
+            } else {
+                ASSERT_EQ(seen.check.status, io::SetCheck::Status::Complete)
+                    << "killed after step " << k << ": " << seen.check.problem;
+                if (seen.files == oldSet) ++oldSeen;
+                else if (seen.files == newSet) ++newSeen;
+                else ADD_FAILURE() << "killed after step " << k << ": the manifest names a set neither old nor new";
+            }
+
+            // The next bake (failing on its input) puts that set back at its names.
+            const bool sawNew = seen.check.status == io::SetCheck::Status::Complete && seen.files == newSet;
+            const RunResult next = bake(dir / "missing.glb", dir / "out", dir);
+            EXPECT_EQ(next.exitCode, 2) << next.describe();
+            const SeenSet after = readThroughManifest(dir / "out");
+            EXPECT_TRUE(leftTemporaries(dir / "out").empty()) << "step " << k << ": " << leftTemporaries(dir / "out")[0];
+            if (!sawNew && noOld) {
+                EXPECT_EQ(after.check.status, io::SetCheck::Status::NoManifest) << "step " << k;
+                for (const char* name : {"levels.glb", "proxies.glb", "scene.aglod", "tiles"})
+                    EXPECT_FALSE(fs::exists(dir / "out" / name)) << "step " << k << ": " << name << " left over";
+                continue;
+            }
+            ASSERT_EQ(after.check.status, io::SetCheck::Status::Complete) << "step " << k << ": " << after.check.problem;
+            EXPECT_FALSE(after.check.moved) << "step " << k;
+            EXPECT_TRUE(after.files == (sawNew ? newSet : oldSet)) << "step " << k << ": the next bake changed the set";
+            for (const auto& [name, path] : after.check.files) EXPECT_EQ(path, dir / "out" / name) << "step " << k;
+        }
+        std::printf("%s: killed after each of %d commit steps: old set %d, new set %d\n", sc.name.c_str(), steps,
+                    oldSeen, newSeen);
+        EXPECT_GE(steps, 5);
+        EXPECT_GE(oldSeen, 1);
+        EXPECT_GE(newSeen, 1);
+    }
 }

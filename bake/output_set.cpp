@@ -1,0 +1,843 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The output set of a bake and its manifest (output_set.h).
+//
+// A commit, in this order (each step leaves one complete set for a reader of the manifest):
+//  1. every temporary is synced; the new manifest is written into the temporary folder;
+//  2. the journal lists every output (whether an old version existed, the name of its backup,
+//     the final path), then each old version gets a backup in the temporary folder: a second
+//     name (hard link; a copy across file systems; a tree of them for tiles/) - nothing in
+//     OUTDIR has changed yet;
+//  3. the old manifest, with each replaced file named at its backup ("at"), takes the place of
+//     the manifest (one rename): the old set stays complete through the moves;
+//  4. each new file is renamed into place (tiles/ first moved aside);
+//  5. the new manifest takes the place of the manifest (one rename): the new set is switched
+//     in; then "committed" ends the journal.
+// A bake killed before step 5 is undone by the next bake into OUTDIR (removeStaleTemporaries):
+// the backups go back to their names, then the old manifest; a bake killed after it is not.
+// Commits and that clean-up hold an exclusive lock on OUTDIR (flock), so that two bakes into
+// one OUTDIR do not interleave their moves.
+#include "output_set.h"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace aggrelod::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Prefix of the temporary folders; the rest is "<pid>-<random>".
+constexpr const char* kTempPrefix = ".aggrelod-tmp-";
+
+/// The journal of a commit in its temporary folder: one line per output ("1" or "0" for
+/// whether an old version existed, the name of its backup in the folder, the final path,
+/// tab-separated), written and synced before any backup is made, then a line "committed"
+/// after the new manifest took its place.
+constexpr const char* kJournal = "journal";
+/// In the temporary folder: the new manifest, and a second name of the old one.
+constexpr const char* kNewManifest = "manifest";
+constexpr const char* kOldManifest = "old-manifest";
+
+// --- SHA-256 (FIPS 180-4) -------------------------------------------------------------------
+
+class Sha256 {
+public:
+    void update(const unsigned char* data, size_t size) {
+        length_ += size;
+        while (size > 0) {
+            const size_t n = std::min(size, size_t(64) - fill_);
+            std::memcpy(block_ + fill_, data, n);
+            fill_ += n;
+            data += n;
+            size -= n;
+            if (fill_ == 64) {
+                compress(block_);
+                fill_ = 0;
+            }
+        }
+    }
+    std::string hex() {
+        const uint64_t bits = length_ * 8;
+        const unsigned char pad = 0x80, zero = 0;
+        update(&pad, 1);
+        while (fill_ != 56) update(&zero, 1);
+        unsigned char tail[8];
+        for (int i = 0; i < 8; ++i) tail[i] = static_cast<unsigned char>(bits >> (56 - 8 * i));
+        update(tail, 8);
+        static const char* digits = "0123456789abcdef";
+        std::string out;
+        for (uint32_t word : h_)
+            for (int shift = 28; shift >= 0; shift -= 4) out += digits[(word >> shift) & 0xF];
+        return out;
+    }
+
+private:
+    static uint32_t rotr(uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
+    void compress(const unsigned char* p) {
+        static const uint32_t k[64] = {
+            0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
+            0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
+            0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
+            0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
+            0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
+            0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
+            0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
+            0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
+        uint32_t w[64];
+        for (int i = 0; i < 16; ++i)
+            w[i] = uint32_t(p[4 * i]) << 24 | uint32_t(p[4 * i + 1]) << 16 | uint32_t(p[4 * i + 2]) << 8 | p[4 * i + 3];
+        for (int i = 16; i < 64; ++i) {
+            const uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
+            const uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
+            w[i] = w[i - 16] + s0 + w[i - 7] + s1;
+        }
+        uint32_t a = h_[0], b = h_[1], c = h_[2], d = h_[3], e = h_[4], f = h_[5], g = h_[6], h = h_[7];
+        for (int i = 0; i < 64; ++i) {
+            const uint32_t t1 = h + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) + ((e & f) ^ (~e & g)) + k[i] + w[i];
+            const uint32_t t2 = (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
+            h = g;
+            g = f;
+            f = e;
+            e = d + t1;
+            d = c;
+            c = b;
+            b = a;
+            a = t1 + t2;
+        }
+        h_[0] += a, h_[1] += b, h_[2] += c, h_[3] += d, h_[4] += e, h_[5] += f, h_[6] += g, h_[7] += h;
+    }
+    uint32_t h_[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+    unsigned char block_[64];
+    size_t fill_ = 0;
+    uint64_t length_ = 0;
+};
+
+// --- small file-system helpers ----------------------------------------------------------------
+
+bool syncPath(const fs::path& p, std::string& error) {
+    const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0 || ::fsync(fd) != 0) {
+        error = p.string() + ": cannot sync: " + std::strerror(errno);
+        if (fd >= 0) ::close(fd);
+        return false;
+    }
+    ::close(fd);
+    return true;
+}
+
+/// Syncs every file and folder of the tree `dir`, `dir` last.
+bool syncTree(const fs::path& dir, std::string& error) {
+    std::error_code ec;
+    for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const fs::file_status s = it->symlink_status(ec);
+        if (ec) break;
+        if ((fs::is_regular_file(s) || fs::is_directory(s)) && !syncPath(it->path(), error)) return false;
+    }
+    if (ec) {
+        error = dir.string() + ": cannot list: " + ec.message();
+        return false;
+    }
+    return syncPath(dir, error);
+}
+
+/// Creates an empty file that did not exist, never through a symbolic link.
+bool createExclusive(const fs::path& p, std::string& error) {
+    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        error = p.string() + ": cannot create: " + std::strerror(errno);
+        return false;
+    }
+    ::close(fd);
+    return true;
+}
+
+/// Writes `text` into the new file `p` (created exclusively) and syncs it.
+bool writeNewFile(const fs::path& p, const std::string& text, std::string& error) {
+    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        error = p.string() + ": cannot create: " + std::strerror(errno);
+        return false;
+    }
+    size_t done = 0;
+    while (done < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        done += size_t(n);
+    }
+    const bool ok = done == text.size() && ::fsync(fd) == 0;
+    if (!ok) error = p.string() + ": cannot write: " + std::strerror(errno);
+    ::close(fd);
+    return ok;
+}
+
+/// The content of a regular file (not through a symbolic link), or false.
+bool readSmallFile(const fs::path& p, std::string& text) {
+    const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) return false;
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > (64 << 20)) {
+        ::close(fd);
+        return false;
+    }
+    text.clear();
+    char buffer[65536];
+    for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) != 0;) {
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) {
+            ::close(fd);
+            return false;
+        }
+        text.append(buffer, size_t(n));
+    }
+    ::close(fd);
+    return true;
+}
+
+/// A second name `to` for the file `from` (a hard link, or a copy where links do not work).
+bool linkOrCopy(const fs::path& from, const fs::path& to) {
+    if (::link(from.c_str(), to.c_str()) == 0) return true;
+    std::error_code ec;
+    return fs::copy_file(from, to, fs::copy_options::none, ec) && !ec;
+}
+
+/// A tree `to` of second names for the files of the tree `from` (folders made anew, symbolic
+/// links copied as links, never followed).
+bool linkTree(const fs::path& from, const fs::path& to) {
+    std::error_code ec;
+    if (!fs::create_directory(to, ec) || ec) return false;
+    for (fs::recursive_directory_iterator it(from, ec), end; !ec && it != end; it.increment(ec)) {
+        const fs::path target = to / fs::relative(it->path(), from, ec);
+        if (ec) return false;
+        const fs::file_status s = it->symlink_status(ec);
+        if (fs::is_directory(s)) {
+            if (!fs::create_directory(target, ec) || ec) return false;
+        } else if (fs::is_symlink(s)) {
+            fs::copy_symlink(it->path(), target, ec);
+            if (ec) return false;
+        } else if (fs::is_regular_file(s)) {
+            if (!linkOrCopy(it->path(), target)) return false;
+        }
+    }
+    return !ec;
+}
+
+/// An exclusive lock on the folder (released when the process ends, killed or not).
+class FolderLock {
+public:
+    explicit FolderLock(const fs::path& dir) : fd_(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
+        if (fd_ >= 0)
+            while (::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+            }
+    }
+    ~FolderLock() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    FolderLock(const FolderLock&) = delete;
+    FolderLock& operator=(const FolderLock&) = delete;
+
+private:
+    int fd_;
+};
+
+/// A relative path with '/' and no empty, "." or ".." component.
+bool isPlainRelative(const std::string& p) {
+    if (p.empty() || p.front() == '/' || p.back() == '/' || p.find('\0') != std::string::npos) return false;
+    std::stringstream parts(p);
+    for (std::string part; std::getline(parts, part, '/');)
+        if (part.empty() || part == "." || part == "..") return false;
+    return true;
+}
+
+// --- the manifest as JSON -----------------------------------------------------------------------
+
+void appendJsonString(std::string& out, const std::string& s) {
+    out += '"';
+    for (const char c : s) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char buffer[8];
+            std::snprintf(buffer, sizeof buffer, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
+            out += buffer;
+        } else {
+            out += c;
+        }
+    }
+    out += '"';
+}
+
+/// Just enough JSON for the manifest: objects, arrays, strings, non-negative integers, and
+/// true / false / null (skipped).
+class ManifestParser {
+public:
+    explicit ManifestParser(const std::string& text) : s_(text) {}
+
+    bool parse(SetManifest& manifest, std::string& error) {
+        bool ok = expect('{');
+        bool sawFormat = false, sawFiles = false;
+        while (ok && !peek('}')) {
+            std::string key;
+            ok = string(key) && expect(':');
+            if (!ok) break;
+            if (key == "format") {
+                std::string format;
+                ok = string(format);
+                if (ok && format != "aggrelod-set") ok = fail("\"format\" is not \"aggrelod-set\"");
+                sawFormat = true;
+            } else if (key == "version") {
+                uint64_t version = 0;
+                ok = number(version);
+                if (ok && version != 1) ok = fail("version " + std::to_string(version) + ", this reader reads 1");
+            } else if (key == "files") {
+                ok = files(manifest);
+                sawFiles = true;
+            } else {
+                ok = skipValue(0);
+            }
+            if (ok && !peek('}')) ok = expect(',');
+        }
+        ok = ok && expect('}');
+        skipSpace();
+        if (ok && pos_ != s_.size()) ok = fail("text after the manifest");
+        if (ok && (!sawFormat || !sawFiles)) ok = fail("no \"format\" or no \"files\"");
+        if (!ok) error = error_;
+        return ok;
+    }
+
+private:
+    const std::string& s_;
+    size_t pos_ = 0;
+    std::string error_;
+
+    bool fail(const std::string& what) {
+        if (error_.empty()) error_ = "at byte " + std::to_string(pos_) + ": " + what;
+        return false;
+    }
+    void skipSpace() {
+        while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\n' || s_[pos_] == '\r' || s_[pos_] == '\t')) ++pos_;
+    }
+    bool peek(char c) {
+        skipSpace();
+        return pos_ < s_.size() && s_[pos_] == c;
+    }
+    bool expect(char c) {
+        if (!peek(c)) return fail(std::string("expected '") + c + "'");
+        ++pos_;
+        return true;
+    }
+    bool string(std::string& out) {
+        if (!expect('"')) return false;
+        out.clear();
+        while (pos_ < s_.size()) {
+            const char c = s_[pos_++];
+            if (c == '"') return true;
+            if (static_cast<unsigned char>(c) < 0x20) return fail("control character in a string");
+            if (c != '\\') {
+                out += c;
+                continue;
+            }
+            if (pos_ >= s_.size()) break;
+            const char e = s_[pos_++];
+            switch (e) {
+                case '"': case '\\': case '/': out += e; break;
+                case 'b': out += '\b'; break;
+                case 'f': out += '\f'; break;
+                case 'n': out += '\n'; break;
+                case 'r': out += '\r'; break;
+                case 't': out += '\t'; break;
+                case 'u': {
+                    if (pos_ + 4 > s_.size()) return fail("truncated \\u escape");
+                    unsigned code = 0;
+                    for (int i = 0; i < 4; ++i) {
+                        const char h = s_[pos_++];
+                        code = code * 16 + unsigned(h >= '0' && h <= '9' ? h - '0'
+                                                    : h >= 'a' && h <= 'f' ? h - 'a' + 10
+                                                    : h >= 'A' && h <= 'F' ? h - 'A' + 10
+                                                                           : 99);
+                        if (code > 0xFFFF) return fail("malformed \\u escape");
+                    }
+                    if (code < 0x80) {
+                        out += char(code);
+                    } else if (code < 0x800) {
+                        out += char(0xC0 | (code >> 6));
+                        out += char(0x80 | (code & 0x3F));
+                    } else {
+                        out += char(0xE0 | (code >> 12));
+                        out += char(0x80 | ((code >> 6) & 0x3F));
+                        out += char(0x80 | (code & 0x3F));
+                    }
+                    break;
+                }
+                default: return fail("unknown escape in a string");
+            }
+        }
+        return fail("unterminated string");
+    }
+    bool number(uint64_t& out) {
+        skipSpace();
+        const size_t start = pos_;
+        out = 0;
+        while (pos_ < s_.size() && s_[pos_] >= '0' && s_[pos_] <= '9') {
+            if (out > (UINT64_MAX - 9) / 10) return fail("number too large");
+            out = out * 10 + uint64_t(s_[pos_++] - '0');
+        }
+        if (pos_ == start) return fail("expected a non-negative integer");
+        return true;
+    }
+    bool skipValue(int depth) {
+        if (depth > 16) return fail("nesting too deep");
+        skipSpace();
+        if (pos_ >= s_.size()) return fail("unexpected end");
+        const char c = s_[pos_];
+        std::string ignored;
+        if (c == '"') return string(ignored);
+        if (c == '{' || c == '[') {
+            const char close = c == '{' ? '}' : ']';
+            ++pos_;
+            while (!peek(close)) {
+                if (c == '{' && !(string(ignored) && expect(':'))) return false;
+                if (!skipValue(depth + 1)) return false;
+                if (!peek(close) && !expect(',')) return false;
+            }
+            ++pos_;
+            return true;
+        }
+        for (const char* word : {"true", "false", "null"})
+            if (s_.compare(pos_, std::strlen(word), word) == 0) {
+                pos_ += std::strlen(word);
+                return true;
+            }
+        while (pos_ < s_.size() && std::strchr("+-.eE0123456789", s_[pos_])) ++pos_;
+        return pos_ > 0 && std::strchr("+-.eE0123456789", s_[pos_ - 1]) ? true : fail("unexpected character");
+    }
+    bool files(SetManifest& manifest) {
+        if (!expect('[')) return false;
+        while (!peek(']')) {
+            if (!expect('{')) return false;
+            SetManifestFile f;
+            bool sawName = false, sawSize = false, sawHash = false;
+            while (!peek('}')) {
+                std::string key;
+                if (!string(key) || !expect(':')) return false;
+                bool ok;
+                if (key == "name") ok = string(f.name), sawName = true;
+                else if (key == "size") ok = number(f.size), sawSize = true;
+                else if (key == "sha256") ok = string(f.sha256), sawHash = true;
+                else if (key == "at") ok = string(f.at);
+                else ok = skipValue(0);
+                if (!ok || (!peek('}') && !expect(','))) return false;
+            }
+            ++pos_;
+            if (!sawName || !sawSize || !sawHash) return fail("a file without \"name\", \"size\" or \"sha256\"");
+            if (!isPlainRelative(f.name) || (!f.at.empty() && !isPlainRelative(f.at)))
+                return fail("\"" + f.name + "\": not a path inside the folder");
+            if (f.sha256.size() != 64 || f.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
+                return fail("\"" + f.name + "\": \"sha256\" is not 64 lower-case hex digits");
+            manifest.files.push_back(std::move(f));
+            if (!peek(']') && !expect(',')) return false;
+        }
+        ++pos_;
+        return true;
+    }
+};
+
+// --- undoing a commit -------------------------------------------------------------------------
+
+std::string manifestPath(const fs::path& outDir) { return (outDir / kSetManifestName).string(); }
+
+/// Gives `final` the content of `backup` with one rename, keeping `backup` (a manifest may
+/// name it): a second name made in the temporary folder, or beside `final` when that lies on
+/// another file system.
+void restoreFile(const fs::path& tempDir, const fs::path& backup, const fs::path& final, const std::string& tag) {
+    std::error_code ec;
+    const fs::path here = tempDir / ("restore-" + tag);
+    fs::remove(here, ec);
+    if (linkOrCopy(backup, here) && ::rename(here.c_str(), final.c_str()) == 0) return;
+    fs::remove(here, ec);
+    fs::path beside = final;
+    beside += "." + tempDir.filename().string() + "-restore";
+    fs::remove(beside, ec);
+    if (linkOrCopy(backup, beside) && ::rename(beside.c_str(), final.c_str()) == 0) return;
+    fs::remove(beside, ec);
+}
+
+/// Puts the old set back from the journal of the commit in `tempDir`, unless it reached the
+/// new manifest (or `force`: the commit itself failed and rolls back).
+void undoCommit(const fs::path& outDir, const fs::path& tempDir, bool force) {
+    std::ifstream journal(tempDir / kJournal);
+    if (!journal) return;  // never started: nothing in OUTDIR changed
+    std::vector<std::array<std::string, 3>> moves;
+    for (std::string line; std::getline(journal, line);) {
+        if (line == "committed") return;  // the new set is complete
+        const size_t a = line.find('\t'), b = line.find('\t', a == std::string::npos ? a : a + 1);
+        if (a == std::string::npos || b == std::string::npos) break;  // cut short: written last
+        moves.push_back({line.substr(0, a), line.substr(a + 1, b - a - 1), line.substr(b + 1)});
+    }
+    std::string published, written;
+    if (!force && readSmallFile(outDir / kSetManifestName, published) &&
+        readSmallFile(tempDir / kNewManifest, written) && published == written)
+        return;  // killed after switching the manifest, before the journal's last line
+    std::error_code ec;
+    for (auto m = moves.rbegin(); m != moves.rend(); ++m) {
+        const fs::path backup = tempDir / (*m)[1], final = (*m)[2];
+        if ((*m)[0] != "1") {
+            fs::remove_all(final, ec);  // no old version: what the bake moved there goes
+            continue;
+        }
+        const fs::file_status s = fs::symlink_status(backup, ec);
+        if (!fs::exists(s)) continue;  // no backup made yet: the old one was not touched
+        if (fs::is_directory(s)) {
+            const fs::path restore = tempDir / ("restore-" + (*m)[1]), aside = tempDir / ("undone-" + (*m)[1]);
+            fs::remove_all(restore, ec);
+            if (!linkTree(backup, restore)) continue;
+            fs::remove_all(aside, ec);
+            if (fs::exists(fs::symlink_status(final, ec)) && ::rename(final.c_str(), aside.c_str()) != 0)
+                fs::remove_all(final, ec);
+            ::rename(restore.c_str(), final.c_str());
+        } else {
+            restoreFile(tempDir, backup, final, (*m)[1]);
+        }
+    }
+    // Then the manifest as it was (the old set is back at its names).
+    const fs::path oldManifest = tempDir / kOldManifest, restore = tempDir / "restore-manifest";
+    fs::remove(restore, ec);
+    if (fs::exists(fs::symlink_status(oldManifest, ec)) && linkOrCopy(oldManifest, restore))
+        ::rename(restore.c_str(), manifestPath(outDir).c_str());
+    std::string ignored;
+    syncPath(outDir, ignored);
+}
+
+/// The step counter of the fault-injection test (tests/unit/test_output_set.cpp): with
+/// AGGRELOD_TEST_KILL_AFTER_COMMIT_STEP=K set, a commit kills its own process (SIGKILL) right
+/// after its K-th step. Unset (or not a positive number), nothing happens.
+class KillSwitch {
+public:
+    KillSwitch() {
+        const char* v = std::getenv("AGGRELOD_TEST_KILL_AFTER_COMMIT_STEP");
+        killAfter_ = v ? std::strtol(v, nullptr, 10) : 0;
+    }
+    void step() {
+        if (killAfter_ > 0 && ++steps_ == killAfter_) ::raise(SIGKILL);
+    }
+
+private:
+    long killAfter_ = 0, steps_ = 0;
+};
+
+}  // namespace
+
+// --- public ---------------------------------------------------------------------------------
+
+std::string sha256Hex(const void* data, size_t size) {
+    Sha256 h;
+    h.update(static_cast<const unsigned char*>(data), size);
+    return h.hex();
+}
+
+bool sha256File(const fs::path& path, std::string& hex, uint64_t& size, std::string& error) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        error = path.string() + ": cannot open: " + std::strerror(errno);
+        return false;
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        error = path.string() + ": not a regular file";
+        ::close(fd);
+        return false;
+    }
+    Sha256 h;
+    std::vector<unsigned char> buffer(1 << 20);
+    size = 0;
+    for (ssize_t n; (n = ::read(fd, buffer.data(), buffer.size())) != 0;) {
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) {
+            error = path.string() + ": cannot read: " + std::strerror(errno);
+            ::close(fd);
+            return false;
+        }
+        h.update(buffer.data(), size_t(n));
+        size += uint64_t(n);
+    }
+    ::close(fd);
+    hex = h.hex();
+    return true;
+}
+
+std::string formatSetManifest(const SetManifest& manifest) {
+    std::string out = "{\n  \"format\": \"aggrelod-set\",\n  \"version\": 1,\n  \"files\": [";
+    for (size_t i = 0; i < manifest.files.size(); ++i) {
+        const SetManifestFile& f = manifest.files[i];
+        out += i ? ",\n    {\"name\": " : "\n    {\"name\": ";
+        appendJsonString(out, f.name);
+        out += ", \"size\": " + std::to_string(f.size) + ", \"sha256\": \"" + f.sha256 + "\"";
+        if (!f.at.empty()) {
+            out += ", \"at\": ";
+            appendJsonString(out, f.at);
+        }
+        out += "}";
+    }
+    return out + (manifest.files.empty() ? "]\n}\n" : "\n  ]\n}\n");
+}
+
+bool parseSetManifest(const std::string& text, SetManifest& manifest, std::string& error) {
+    manifest.files.clear();
+    return ManifestParser(text).parse(manifest, error);
+}
+
+SetCheck checkOutputSet(const fs::path& outDir) {
+    SetCheck check;
+    std::string text;
+    for (int attempt = 0; attempt < 5; ++attempt) {
+        check = SetCheck();
+        std::error_code ec;
+        const fs::path path = outDir / kSetManifestName;
+        if (!fs::exists(fs::symlink_status(path, ec))) return check;  // NoManifest
+        check.status = SetCheck::Status::Incomplete;
+        if (!readSmallFile(path, text)) {
+            check.problem = path.string() + ": cannot read (not a regular file, or over 64 MiB)";
+            return check;
+        }
+        SetManifest manifest;
+        std::string error;
+        if (!parseSetManifest(text, manifest, error)) {
+            check.problem = path.string() + ": " + error;
+            return check;
+        }
+        for (const SetManifestFile& f : manifest.files) {
+            const fs::path file = outDir / (f.at.empty() ? f.name : f.at);
+            std::string hex;
+            uint64_t size = 0;
+            if (!sha256File(file, hex, size, error)) {
+                check.problem = f.name + ": " + error;
+                break;
+            }
+            if (size != f.size || hex != f.sha256) {
+                check.problem = f.name + ": " + (size != f.size ? std::to_string(size) + " bytes, the manifest says " +
+                                                                      std::to_string(f.size)
+                                                                : std::string("its SHA-256 differs from the manifest's"));
+                break;
+            }
+            check.files.emplace_back(f.name, file);
+            check.moved = check.moved || !f.at.empty();
+        }
+        if (check.problem.empty()) {
+            check.status = SetCheck::Status::Complete;
+            return check;
+        }
+        // A bake may have switched sets while the files were read: look again if so.
+        std::string now;
+        if (!readSmallFile(path, now) || now == text) return check;
+    }
+    return check;
+}
+
+void removeStaleTemporaries(const fs::path& outDir) {
+    std::error_code ec;
+    for (const char* legacy : {"levels.glb.tmp", "proxies.glb.tmp", "scene.aglod.tmp", "tiles.tmp", "tiles.old"})
+        fs::remove_all(outDir / legacy, ec);  // a symbolic link is removed, not followed
+    FolderLock lock(outDir);
+    for (fs::directory_iterator it(outDir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.rfind(kTempPrefix, 0) != 0) continue;
+        const long pid = std::strtol(name.c_str() + std::strlen(kTempPrefix), nullptr, 10);
+        if (pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM)) continue;  // its bake still runs
+        undoCommit(outDir, it->path(), false);
+        std::error_code removeError;
+        fs::remove_all(it->path(), removeError);
+    }
+}
+
+OutputSet::~OutputSet() {
+    std::error_code ec;
+    for (const fs::path& p : outsideTemporaries_) fs::remove(p, ec);
+    if (!tempDir_.empty()) fs::remove_all(tempDir_, ec);
+}
+
+bool OutputSet::begin(const fs::path& outDir, std::string& error) {
+    outDir_ = outDir;
+    removeStaleTemporaries(outDir);
+    std::string pattern = (outDir / (kTempPrefix + std::to_string(::getpid()) + "-XXXXXX")).string();
+    if (!::mkdtemp(pattern.data())) {
+        error = outDir.string() + ": cannot create a temporary folder: " + std::strerror(errno);
+        return false;
+    }
+    tempDir_ = pattern;
+    return true;
+}
+
+bool OutputSet::addFile(const fs::path& final, fs::path& temporary, std::string& error) {
+    const bool inOutDir = final.parent_path() == outDir_;
+    if (inOutDir) {
+        temporary = tempDir_ / final.filename();
+    } else {
+        // Elsewhere: beside its final place (a rename cannot cross file systems).
+        temporary = final;
+        temporary += "." + tempDir_.filename().string();
+    }
+    if (!createExclusive(temporary, error)) return false;
+    if (!inOutDir) outsideTemporaries_.push_back(temporary);
+    entries_.push_back({temporary, final, false});
+    return true;
+}
+
+fs::path OutputSet::folderTemporary(const fs::path& final) {
+    entries_.push_back({tempDir_ / final.filename(), final, true});
+    return entries_.back().temporary;
+}
+
+bool OutputSet::commit(std::string& error) {
+    // 1. Everything on disk, and the new manifest: every output inside OUTDIR, by its place.
+    SetManifest manifest;
+    std::vector<std::string> names(entries_.size());  // place in the set; empty: outside OUTDIR
+    std::error_code ec;
+    const fs::path outCanonical = fs::weakly_canonical(fs::absolute(outDir_, ec), ec);
+    for (size_t k = 0; k < entries_.size(); ++k) {
+        const Entry& e = entries_[k];
+        if (!(e.folder ? syncTree(e.temporary, error) : syncPath(e.temporary, error))) return false;
+        std::error_code ec1;  // the folder resolved, not the name (it may be a planted link)
+        const fs::path parent = fs::weakly_canonical(fs::absolute(e.final, ec1).parent_path(), ec1);
+        const fs::path rel = (parent / e.final.filename()).lexically_relative(outCanonical);
+        if (!ec1 && isPlainRelative(rel.generic_string())) names[k] = rel.generic_string();
+        if (names[k].empty()) continue;
+        std::vector<std::pair<std::string, fs::path>> files;
+        if (e.folder) {
+            for (fs::recursive_directory_iterator it(e.temporary, ec), end; !ec && it != end; it.increment(ec))
+                if (it->is_regular_file(ec))
+                    files.emplace_back(names[k] + "/" + it->path().lexically_relative(e.temporary).generic_string(),
+                                       it->path());
+            std::sort(files.begin(), files.end());
+        } else {
+            files.emplace_back(names[k], e.temporary);
+        }
+        for (const auto& [name, path] : files) {
+            SetManifestFile f;
+            f.name = name;
+            if (!sha256File(path, f.sha256, f.size, error)) return false;
+            manifest.files.push_back(f);
+        }
+    }
+    if (!writeNewFile(tempDir_ / kNewManifest, formatSetManifest(manifest), error) || !syncPath(tempDir_, error))
+        return false;
+
+    // Nothing can be replaced by a file of another kind (checked before anything changes).
+    std::vector<bool> hadOld(entries_.size());
+    for (size_t k = 0; k < entries_.size(); ++k) {
+        const Entry& e = entries_[k];
+        const fs::file_status s = fs::symlink_status(e.final, ec);
+        hadOld[k] = fs::exists(s);
+        if (hadOld[k] && fs::is_directory(s) != e.folder) {
+            error = e.final.string() + ": cannot replace: it is " + (e.folder ? "not a folder" : "a folder");
+            return false;
+        }
+    }
+
+    FolderLock lock(outDir_);
+    KillSwitch kill;
+    const auto rollBack = [&](const std::string& message) {
+        error = message;
+        undoCommit(outDir_, tempDir_, true);
+        return false;
+    };
+
+    // 2. The journal, then a backup of every old version.
+    std::vector<std::string> backups(entries_.size());
+    std::string lines;
+    for (size_t k = 0; k < entries_.size(); ++k) {
+        backups[k] = "old-" + std::to_string(k) + "-" + entries_[k].final.filename().string();
+        lines += std::string(hadOld[k] ? "1" : "0") + "\t" + backups[k] + "\t" + fs::absolute(entries_[k].final, ec).string() + "\n";
+    }
+    if (!writeNewFile(tempDir_ / kJournal, lines, error)) return false;
+    kill.step();
+    SetManifest old;
+    bool haveOld = false;
+    {
+        const fs::path path = outDir_ / kSetManifestName;
+        if (fs::is_regular_file(fs::symlink_status(path, ec))) {
+            if (!linkOrCopy(path, tempDir_ / kOldManifest))
+                return rollBack(path.string() + ": cannot keep the old manifest: " + std::strerror(errno));
+            kill.step();
+            std::string text, ignored;
+            haveOld = readSmallFile(tempDir_ / kOldManifest, text) && parseSetManifest(text, old, ignored);
+        }
+    }
+    for (size_t k = 0; k < entries_.size(); ++k) {
+        if (!hadOld[k]) continue;
+        const Entry& e = entries_[k];
+        const fs::path backup = tempDir_ / backups[k];
+        if (!(e.folder ? linkTree(e.final, backup) : linkOrCopy(e.final, backup)))
+            return rollBack(e.final.string() + ": cannot keep the old version: " + std::strerror(errno));
+        kill.step();
+    }
+
+    // 3. The old manifest, naming the backups of the files about to be replaced.
+    if (haveOld) {
+        const std::string tempName = tempDir_.filename().string();
+        for (SetManifestFile& f : old.files) {
+            if (!f.at.empty()) continue;  // already elsewhere (a bake still running into OUTDIR)
+            for (size_t k = 0; k < entries_.size(); ++k) {
+                if (!hadOld[k] || names[k].empty()) continue;
+                if (f.name == names[k] && !entries_[k].folder)
+                    f.at = tempName + "/" + backups[k];
+                else if (entries_[k].folder && f.name.rfind(names[k] + "/", 0) == 0)
+                    f.at = tempName + "/" + backups[k] + f.name.substr(names[k].size());
+            }
+        }
+        const fs::path redirect = tempDir_ / "redirect-manifest";
+        if (!writeNewFile(redirect, formatSetManifest(old), error)) return rollBack(error);
+        if (::rename(redirect.c_str(), manifestPath(outDir_).c_str()) != 0)
+            return rollBack(manifestPath(outDir_) + ": cannot replace: " + std::strerror(errno));
+        std::string ignored;
+        syncPath(outDir_, ignored);
+        kill.step();
+    }
+
+    // 4. The new files into place.
+    for (size_t k = 0; k < entries_.size(); ++k) {
+        const Entry& e = entries_[k];
+        if (e.folder && hadOld[k]) {
+            const fs::path aside = tempDir_ / ("replaced-" + std::to_string(k));
+            if (::rename(e.final.c_str(), aside.c_str()) != 0)
+                return rollBack(e.final.string() + ": cannot replace: " + std::strerror(errno));
+            kill.step();
+        }
+        if (::rename(e.temporary.c_str(), e.final.c_str()) != 0)
+            return rollBack(e.final.string() + ": cannot replace: " + std::strerror(errno));
+        kill.step();
+    }
+    std::string ignored;
+    syncPath(outDir_, ignored);
+    for (size_t k = 0; k < entries_.size(); ++k)
+        if (names[k].empty()) syncPath(entries_[k].final.parent_path().empty() ? "." : entries_[k].final.parent_path(), ignored);
+
+    // 5. The new manifest: the new set is switched in.
+    const fs::path publish = tempDir_ / "publish-manifest";
+    if (!linkOrCopy(tempDir_ / kNewManifest, publish) || ::rename(publish.c_str(), manifestPath(outDir_).c_str()) != 0)
+        return rollBack(manifestPath(outDir_) + ": cannot replace: " + std::strerror(errno));
+    syncPath(outDir_, ignored);
+    kill.step();
+    const int journal = ::open((tempDir_ / kJournal).c_str(), O_WRONLY | O_APPEND | O_NOFOLLOW | O_CLOEXEC);
+    if (journal >= 0) {
+        if (::write(journal, "committed\n", 10) == 10) ::fdatasync(journal);
+        ::close(journal);
+    }
+    kill.step();
+    return true;
+}
+
+}  // namespace aggrelod::io
