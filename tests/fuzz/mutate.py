@@ -9,8 +9,13 @@ receives COUNT mutants each. glTF mutants edit the JSON (numbers set to extreme 
 aimed outside the folder or at directories, nesting deepened, keys dropped) and rebuild a
 consistent GLB around it, or flip and cut bytes; 2D mutants edit numbers and structure;
 runtime mutants change bytes of the header, the section table and the node records (the
-fuzz target re-signs the checksum). Each fuzz target then runs every mutant once (-runs=0)
-under its memory limit: any crash, hang or allocation over the limit fails.
+runtime fuzz target re-signs the checksum of most inputs). Mutants are named
+NNNNN-SEEDNAME (mutant k comes from seed k mod the seed count, in name order).
+
+tests/fuzz/fuzz.sh run executes every mutant of a reader once in its fuzz target (-runs=0,
+before the timed fuzzing), and tests/fuzz/cli_mutants.py runs the glTF and geo mutants
+through the sanitizer CLI (aggrelod_asan bake / aggregate2d): any crash, sanitizer report,
+hang or allocation over 2 GB fails.
 """
 import json
 import os
