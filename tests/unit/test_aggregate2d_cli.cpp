@@ -30,6 +30,7 @@ struct Case {
 RunResult runOn(const fs::path& dir, const std::string& file, const std::string& text,
                 const std::vector<std::string>& extra = {}) {
     ::setenv("ASAN_OPTIONS", "detect_leaks=0:abort_on_error=0:exitcode=86", 1);
+    ::setenv("UBSAN_OPTIONS", "halt_on_error=1:print_stacktrace=1:exitcode=86", 1);
     writeFile(dir / file, text);
     std::vector<std::string> args{cli(), "aggregate2d", (dir / file).string(), "-o", (dir / "out.geojson").string()};
     args.insert(args.end(), extra.begin(), extra.end());
