@@ -1209,6 +1209,7 @@ struct ExternalFiles {
     size_t calls = 0;
     size_t imagesSkipped = 0;
     std::string refusal;  ///< why a buffer's file was refused: the error, instead of tinygltf's
+    std::vector<std::string> read;  ///< canonical paths of the buffer files read
 };
 
 const char* const kImageNotRead = "external image not read (only geometry is baked)";
@@ -1272,11 +1273,12 @@ bool readExternalFile(std::vector<unsigned char>* out, std::string* err, const s
         if (got <= 0) return refuse(std::string("read error: ") + (got < 0 ? std::strerror(errno) : "file shrank"));
         done += size_t(got);
     }
+    files.read.push_back(canonical.string());
     return true;
 }
 
 bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diagnostic>& diags,
-               std::string& error, bool allowExternalUris = false) {
+               std::string& error, bool allowExternalUris = false, std::vector<std::string>* externalFiles = nullptr) {
     std::vector<unsigned char> bytes;
     if (!readWholeFile(path, bytes, error)) return false;
     const bool magicGlb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
@@ -1360,6 +1362,7 @@ bool loadModel(const std::string& path, tinygltf::Model& model, std::vector<Diag
         diags.push_back(Diagnostic{Severity::Note, "",
                                    std::to_string(files.imagesSkipped) +
                                        " external image file(s) not read: only geometry is baked"});
+    if (externalFiles) *externalFiles = files.read;
     return true;
 }
 
@@ -1553,7 +1556,8 @@ bool readGltfScene(const std::string& path, const SceneReadOptions& options,
     error.clear();
     try {
         tinygltf::Model model;
-        if (!loadModel(path, model, out.diagnostics, error, options.allowExternalUris)) {
+        out.externalFiles.clear();
+        if (!loadModel(path, model, out.diagnostics, error, options.allowExternalUris, &out.externalFiles)) {
             error = path + ": " + error;
             return false;
         }

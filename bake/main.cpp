@@ -284,6 +284,22 @@ int runBake(BakeOptions o) {
         printError(error);
         return kFileError;
     }
+    // Nor an external buffer file of the input (known once the input is parsed).
+    for (const std::string& buffer : scene.externalFiles) {
+        const fs::path outDir(o.outDir);
+        for (const fs::path& output : {outDir / "levels.glb", outDir / "proxies.glb", outDir / "scene.aglod",
+                                       outDir / io::kSetManifestName, fs::path(o.statsPath)}) {
+            if (output.empty() || !samePlace(output, buffer)) continue;
+            printError("output " + output.string() + " is the buffer file " + buffer + " of the input " + o.scene +
+                       ": it would be overwritten; choose another output");
+            return kUsage;
+        }
+        if (o.tiles && inside(buffer, outDir / "tiles")) {
+            printError(outDir.string() + "/tiles is replaced whole by --tiles: the input's buffer file " + buffer +
+                       " must lie outside it");
+            return kUsage;
+        }
+    }
     cli::printDiagnostics(scene.diagnostics, o.quiet);
     if (scene.objects.empty()) {
         printError(o.scene + ": no objects to aggregate (all excluded or none with triangles)");

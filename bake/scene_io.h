@@ -39,6 +39,7 @@ struct SceneReadOptions {
 struct SceneReadResult {
     std::vector<InputObject> objects;    ///< world-space triangles, ids = order of appearance
     std::vector<Diagnostic> diagnostics; ///< skipped primitives, unknown extensions, ...
+    std::vector<std::string> externalFiles;  ///< canonical paths of the external buffer files read
 };
 
 /// Reads a .glb or .gltf file. Returns false with a message in `error` when the file

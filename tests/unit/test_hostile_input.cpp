@@ -175,6 +175,31 @@ TEST(HostileGltf, BufferInASubfolderAndDataUrisStillWork) {
     EXPECT_TRUE(fs::exists(dir / "out" / "levels.glb"));
 }
 
+TEST(HostileGltf, AnOutputNamingAnInputBufferIsRefused) {
+    const fs::path dir = freshTestDir(currentTestName());
+    fs::create_directories(dir / "in" / "tiles");
+    for (const std::string uri : {"data.bin", "scene.aglod", "tiles/data.bin"}) {
+        const Gltf g = makeGltf(twoCubes(), uri);
+        writeFile(dir / "in" / uri, g.bin);
+        writeFile(dir / "in" / "scene.gltf", g.json);
+        const std::vector<std::string> argv =
+            uri == "data.bin" ? std::vector<std::string>{"--stats", (dir / "in" / "data.bin").string()}
+                              : std::vector<std::string>{"--tiles"};
+        // OUTDIR is the input's folder: its scene.aglod, or tiles/ with --tiles, would replace the buffer.
+        setSanitizerOptions();
+        std::vector<std::string> bake = {sanitizedCli(), "bake", (dir / "in" / "scene.gltf").string(), "-o",
+                                         (dir / "in").string(), "--levels", "2"};
+        bake.insert(bake.end(), argv.begin(), argv.end());
+        const RunResult r = runProgram(bake, dir);
+        expectCleanExit(r, {1});
+        EXPECT_TRUE(r.err.find("is the buffer file") != std::string::npos ||
+                    r.err.find("the input's buffer file") != std::string::npos)
+            << uri << "\n" << r.describe();
+        EXPECT_EQ(readFile(dir / "in" / uri), g.bin) << uri;
+        EXPECT_FALSE(fs::exists(dir / "in" / "levels.glb")) << uri;
+    }
+}
+
 TEST(HostileGltf, DirectoryUriIsRefused) {
     const fs::path dir = freshTestDir(currentTestName());
     fs::create_directories(dir / "sub");
