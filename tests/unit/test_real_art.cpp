@@ -46,7 +46,9 @@ const Baked& bakedAsGiven(const std::string& relative) {
         std::string error;
         EXPECT_TRUE(io::readLevelsGlb((b.dir / "out" / "levels.glb").string(), b.levels, error)) << error;
         io::SceneReadResult all;
-        EXPECT_TRUE(io::readGltfScene((b.dir / "out" / "levels.glb").string(), {}, all, error)) << error;
+        io::SceneReadOptions everyLevel;
+        everyLevel.allScenes = true;  // one scene per level, each with the support surfaces
+        EXPECT_TRUE(io::readGltfScene((b.dir / "out" / "levels.glb").string(), everyLevel, all, error)) << error;
         for (const InputObject& o : all.objects)
             if (o.name.rfind("support_", 0) == 0) b.support.insert(o.name.substr(8));
         b.stats = readFile(b.dir / "stats.json");
