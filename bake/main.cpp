@@ -423,8 +423,8 @@ struct CollisionSummary {
     double largestConvexError = 0;
 };
 
-/// Writes collision.glb: its scenes are the cuts of the runtime file just written (the
-/// per-object LODs when there are any, every aggregate level, the originals), taken with the
+/// Writes collision.glb: its scenes are the cuts of the runtime file just written (every
+/// aggregate level, the per-object LODs when there are any, the originals), taken with the
 /// runtime's own cutAtLevel.
 bool writeCollisionInto(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                         const std::vector<NodeCollisionShapes>& shapes, const fs::path& runtimeFile, const fs::path& path,
@@ -436,17 +436,18 @@ bool writeCollisionInto(const HierarchyNodes& nodes, const std::vector<InputObje
         error = runtimeFile.string() + ": " + runtime::toString(status) + ": " + message;
         return false;
     }
-    // Finest proxies first (the default scene), the originals last.
+    // The aggregate levels first, finest first (the default scene is the first), then the
+    // per-object LODs and the originals.
     std::vector<io::CollisionCut> cuts;
+    for (uint32_t level : runtime::levelsOf(file)) {
+        cuts.push_back({"level" + std::to_string(level), {}});
+        runtime::cutAtLevel(file, level, cuts.back().nodes);
+    }
     bool anyObjectLod = false;
     for (uint32_t i = 0; i < file.nodeCount(); ++i) anyObjectLod = anyObjectLod || file.isObjectLod(i);
     if (anyObjectLod) {
         cuts.push_back({"object_lods", {}});
         runtime::cutAtLevel(file, runtime::kObjectLodLevel, cuts.back().nodes);
-    }
-    for (uint32_t level : runtime::levelsOf(file)) {
-        cuts.push_back({"level" + std::to_string(level), {}});
-        runtime::cutAtLevel(file, level, cuts.back().nodes);
     }
     cuts.push_back({"originals", {}});
     runtime::cutAtLevel(file, runtime::kLeafLevel, cuts.back().nodes);
