@@ -513,7 +513,9 @@ void compareQueries(const Baked& b, const ColliderScene& scene, BulletScene& bul
                                 << (dir.x() * hit.normal[0] + dir.y() * hit.normal[1] + dir.z() * hit.normal[2])
                                 << "; Bullet normal " << cb.m_hitNormalWorld.x() << " " << cb.m_hitNormalWorld.y() << " "
                                 << cb.m_hitNormalWorld.z() << ")";
-            if (along <= eps) EXPECT_EQ(uint32_t(bulletNode), hit.node) << b.label << " " << scene.name << " ray " << i;
+            if (along <= eps) {
+                EXPECT_EQ(uint32_t(bulletNode), hit.node) << b.label << " " << scene.name << " ray " << i;
+            }
         } else {
             // Hulls contain the proxies: hit no later; the hit lies within the node's error of it.
             if (runtimeHit) {
