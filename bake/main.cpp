@@ -807,7 +807,7 @@ CLI::App* addPlanCommand(CLI::App& app, cli::PlanOptions& o) {
                     "(.wkt, .geojson, .json; aggregated here, see --levels)")
         ->required();
     cmd->add_option("--originals", o.originalsPath,
-                    "aggregate2d GeoJSON: the polygons aggregate2d read (required; they are the level-0 obstacles)");
+                    "aggregate2d GeoJSON: the polygons aggregate2d read (required; the original obstacles)");
     cmd->add_option("--links", o.linksPath,
                     "aggregate2d GeoJSON: its link table (aggregate2d --links); checked row by row against the GeoJSON");
     cmd->add_option("--from", o.from, "Start x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
