@@ -683,14 +683,13 @@ bool readLevelsGeoJsonText(const std::string& text, std::vector<LevelAggregateRe
         const JsonValue* p = f.type == JsonValue::Type::Object ? f.get("properties") : nullptr;
         return p && p->type == JsonValue::Type::Object ? p : nullptr;
     };
+    // Plain polygons may well carry one of these names (a building's "level"): only a feature
+    // with all four marks the file as aggregate2d's output.
     size_t marked = 0;
     for (const JsonValue& f : features->items)
         if (const JsonValue* p = propertiesOf(f))
-            for (const char* key : kKeys)
-                if (p->get(key)) {
-                    ++marked;
-                    break;
-                }
+            if (std::all_of(std::begin(kKeys), std::end(kKeys), [&](const char* key) { return p->get(key) != nullptr; }))
+                ++marked;
     if (marked == 0) return true;
     isLevels = true;
     const std::string notOutput = ": not the GeoJSON of `aggrelod aggregate2d` (each of its features has the properties "

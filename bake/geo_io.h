@@ -45,9 +45,9 @@ struct LevelAggregateRecord {
 };
 
 /// Reads aggregate2d's levels GeoJSON. `isLevels` is false (and true is returned, `out`
-/// empty) when no feature carries any of the properties level / delta / aggregate / sources:
+/// empty) when no feature carries all four properties level, delta, aggregate and sources:
 /// then the text is plain polygons. Returns false with `error` when the text is not GeoJSON,
-/// or when some features carry them and the file is not such output (a feature without them,
+/// or when some feature carries them and the file is not such output (a feature without them,
 /// a malformed property, a geometry that is not a valid Polygon / MultiPolygon).
 bool readLevelsGeoJsonText(const std::string& text, std::vector<LevelAggregateRecord>& out, bool& isLevels,
                            std::string& error);

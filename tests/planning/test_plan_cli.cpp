@@ -338,6 +338,17 @@ TEST(PlanCli, TwoDAggregate2DMismatchesAreRefused) {
     r = run("plan " + tmp("mm_plain.geojson") + " --originals " + wkt + query);
     EXPECT_EQ(r.code, 2) << r.output;
     EXPECT_NE(r.output.find("not the GeoJSON of `aggrelod aggregate2d`"), std::string::npos) << r.output;
+    // Plain polygons with a property of one of its names stay plain polygons.
+    {
+        std::ofstream(tmp("mm_plain_level.geojson"))
+            << "{\"type\": \"FeatureCollection\", \"features\": [\n{\"type\": \"Feature\", \"properties\": {\"level\": 2}, "
+               "\"geometry\": {\"type\": \"Polygon\", \"coordinates\": [[[0,0],[1,0],[1,1],[0,1],[0,0]]]}},\n"
+               "{\"type\": \"Feature\", \"properties\": {\"level\": 3}, "
+               "\"geometry\": {\"type\": \"Polygon\", \"coordinates\": [[[3,0],[4,0],[4,1],[3,1],[3,0]]]}}]}\n";
+    }
+    r = run("plan " + tmp("mm_plain_level.geojson") + " --from 2,0.2 --to 2,0.8 --radius 0.1 --delta 0.5");
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("polygons aggregated here"), std::string::npos) << r.output;
     // ... nor one whose features lack some of its properties.
     {
         std::string text = readFile(levels);
