@@ -878,8 +878,13 @@ CLI::App* addPlanCommand(CLI::App& app, cli::PlanOptions& o) {
         "plan", "Plan a collision-free path for a round agent with the aggregation hierarchy (OMPL LazyPRM, coarse to "
                 "fine); exit 0 solved, 3 no path within the time limit");
     cmd->add_option("baked", o.input,
-                    "OUTDIR/scene.aglod (3D) or 2D polygons (.wkt, .geojson, .json; aggregated here, see --levels)")
+                    "OUTDIR/scene.aglod (3D), the GeoJSON written by aggregate2d (with --originals), or 2D polygons "
+                    "(.wkt, .geojson, .json; aggregated here, see --levels)")
         ->required();
+    cmd->add_option("--originals", o.originalsPath,
+                    "aggregate2d GeoJSON: the polygons aggregate2d read (required; the original obstacles)");
+    cmd->add_option("--links", o.linksPath,
+                    "aggregate2d GeoJSON: its link table (aggregate2d --links); checked row by row against the GeoJSON");
     cmd->add_option("--from", o.from, "Start x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
     cmd->add_option("--to", o.to, "Goal x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
     cmd->add_option("--radius", o.radius, "Agent radius (disc in 2D, ball in 3D), scene units, > 0")->required();

@@ -572,6 +572,31 @@ TEST(RuntimeScenes, DrawCostsNeverDrawMoreThanThePlainRule) {
             EXPECT_LE(withCosts, without) << s.label << " camera " << camera;
             lighter += withCosts < without;
         }
+        // With hysteresis, along a flight from far to near and back: incremental = full.
+        runtime::Selector flightFull(f), flightIncremental(f);
+        flightFull.setDrawCosts(originalTriangles.data(), perDraw);
+        flightIncremental.setDrawCosts(originalTriangles.data(), perDraw);
+        runtime::SelectionSettings hysteresis;
+        hysteresis.pixelTolerance = 1.0f;
+        hysteresis.coarsenRatio = 0.75f;
+        for (int frame = 0; frame < 400; ++frame) {
+            const double t = frame < 200 ? frame / 200.0 : (400 - frame) / 200.0;  // 0 -> 1 -> 0
+            const double distance = s.radius * std::pow(200.0, 1.0 - t) * 0.5;
+            const double angle = 0.01 * frame;
+            runtime::Camera c;
+            c.position[0] = float(s.center[0] + distance * std::cos(angle));
+            c.position[1] = float(s.center[1] + 0.3 * distance);
+            c.position[2] = float(s.center[2] + distance * std::sin(angle));
+            c.fovY = float(60 * M_PI / 180);
+            c.viewportHeight = 1080.0f;
+            flightFull.selectFull(c, hysteresis);
+            flightIncremental.select(c, hysteresis);
+            std::vector<uint32_t> a(flightFull.cut().begin(), flightFull.cut().end()),
+                b(flightIncremental.cut().begin(), flightIncremental.cut().end());
+            std::sort(a.begin(), a.end());
+            std::sort(b.begin(), b.end());
+            ASSERT_EQ(a, b) << s.label << " flight frame " << frame << ": incremental differs from full";
+        }
         std::printf("%-10s %u of %u nodes never worth drawing\n", s.label.c_str(), costed.skippedNodeCount(), f.nodeCount());
     }
     std::printf("cameras where the cut got lighter: %zu\n", lighter);
