@@ -859,8 +859,11 @@ TEST(RuntimeScenes, ProxiesGlbMirrorsTheRuntimeTreeAndIsValid) {
                 EXPECT_NEAR(int(c[4 * size_t(t[i]) + k]), int(expected[k]), 1) << n.name << " corner " << i;
         }
     }
-    for (uint32_t i = 0; i < s.file.nodeCount(); ++i)
-        if (s.file.triangles(i).size > 0) EXPECT_GE(gltfOf[i], 0) << "runtime node " << i << " is missing";
+    for (uint32_t i = 0; i < s.file.nodeCount(); ++i) {
+        if (s.file.triangles(i).size > 0) {
+            EXPECT_GE(gltfOf[i], 0) << "runtime node " << i << " is missing";
+        }
+    }
     EXPECT_EQ(defaultSceneTriangles, originalTriangles);
 
     // MSFT_lod: each LOD0 node lists its coarser stand-ins, finest to coarsest, up its chain of
@@ -880,7 +883,9 @@ TEST(RuntimeScenes, ProxiesGlbMirrorsTheRuntimeTreeAndIsValid) {
         for (size_t k = 0; k < n.screenCoverage.size(); ++k) {
             EXPECT_GE(n.screenCoverage[k], 0.0) << n.name;
             EXPECT_LE(n.screenCoverage[k], 1.0) << n.name;
-            if (k) EXPECT_LE(n.screenCoverage[k], n.screenCoverage[k - 1]) << n.name;
+            if (k) {
+                EXPECT_LE(n.screenCoverage[k], n.screenCoverage[k - 1]) << n.name;
+            }
         }
         // The first stand-in: the merge's own proxy, or the leaf's parent.
         uint32_t previous = n.node >= 0 ? uint32_t(n.node) : runtime::kNoIndex;
