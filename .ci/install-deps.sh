@@ -22,7 +22,9 @@ packages=(
   chromium clang libclang-rt-14-dev python3
   mingw-w64 wine wine64
   libglfw3-dev libgl1-mesa-dri xvfb
+  libbullet-dev
 )
+# libbullet-dev: a real physics engine for the test of collision.glb (tests/physics); tests only.
 # mingw-w64: the Windows cross build of the runtime (tests/windows); wine, wine64: run its unit
 # tests there.
 # libglfw3-dev, libgl1-mesa-dri, xvfb: the OpenGL viewer (samples/viewer), tested headless on llvmpipe.

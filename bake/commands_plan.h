@@ -17,14 +17,16 @@ class RuntimeFile;
 namespace aggrelod::cli {
 
 struct PlanOptions {
-    std::string input;                 ///< scene.aglod (3D) or a 2D polygon file (.wkt, .geojson, .json)
+    std::string input;                 ///< scene.aglod (3D), aggregate2d's levels GeoJSON, or 2D polygons (.wkt, .geojson, .json)
+    std::string originalsPath;         ///< aggregate2d GeoJSON: the polygons aggregate2d read (required)
+    std::string linksPath;             ///< aggregate2d GeoJSON: its link table (optional; checked against it)
     std::vector<double> from, to;      ///< x,y or x,y,z
     double radius = 0;                 ///< agent radius, scene units, > 0
     std::string strategy = "hierarchy";  ///< hierarchy | originals | level:K
     double timeLimit = 10;             ///< seconds
     unsigned seed = 1;
     int levelSamples = 500;            ///< hierarchy: new roadmap vertices per level before descending
-    int levels = 6;                    ///< 2D polygon input: automatic levels of the in-process aggregation
+    int levels = 0;                    ///< 2D polygon input: automatic levels of the in-process aggregation (0: 6)
     std::vector<double> deltas;        ///< 2D polygon input: explicit thresholds
     std::string pngPath, svgPath, statsPath;
     bool quiet = false;
@@ -52,16 +54,24 @@ struct PlanScene {
     std::vector<planning::PlanPolygon> originals2D;           ///< 2D only
     std::vector<std::vector<planning::PlanPolygon>> levels2D; ///< 2D only, ascending delta
     std::unique_ptr<planning::PlanningWorld> world;
+    std::string description;                                  ///< what was read, for the summary line
+    std::vector<std::string> notes;                           ///< e.g. input features in no aggregate
     ~PlanScene();
     PlanScene();
     PlanScene(PlanScene&&) noexcept;
 };
 
-/// Reads `path` (.aglod: 3D; .wkt/.geojson/.json: 2D polygons aggregated here with
-/// `levels` automatic levels or the explicit `deltas`) and builds the world for `radius`.
-/// Returns false with a message (wrong kind, unreadable, radius <= 0).
+/// Reads `path` and builds the world for `radius`:
+///  - .aglod: 3D runtime file;
+///  - .geojson/.json written by `aggrelod aggregate2d`: its levels as they are, the originals
+///    from `originalsPath` (required), checked (every aggregate contains its sources) and, when
+///    `linksPath` is given, checked against its link table;
+///  - other .wkt/.geojson/.json: 2D polygons aggregated here with `levels` automatic levels (0: 6)
+///    or the explicit `deltas`.
+/// Returns false with a message (wrong kind, unreadable, mismatched, not containing, radius <= 0).
 bool loadPlanScene(const std::string& path, double radius, int levels, const std::vector<double>& deltas,
-                   PlanScene& out, std::string& error);
+                   PlanScene& out, std::string& error, const std::string& originalsPath = "",
+                   const std::string& linksPath = "");
 
 /// Builds a world on 2D polygons already in memory.
 bool makePlanScene2D(std::vector<planning::PlanPolygon> originals, std::vector<std::vector<planning::PlanPolygon>> levels,

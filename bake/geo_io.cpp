@@ -640,6 +640,226 @@ bool readPolygonFile(const std::string& path, GeoReadResult& out, std::string& e
     return true;
 }
 
+namespace {
+
+/// A JSON number that is a non-negative integer below 2^31.
+bool asIndex(const JsonValue* v, int64_t limit, int64_t& out) {
+    if (!v || v->type != JsonValue::Type::Number || !std::isfinite(v->number) || v->number < 0 ||
+        v->number >= double(limit) || v->number != std::floor(v->number))
+        return false;
+    out = static_cast<int64_t>(v->number);
+    return true;
+}
+
+std::string slurp(const std::string& path, bool& ok) {
+    std::ifstream file(path, std::ios::binary);
+    ok = bool(file);
+    std::stringstream buffer;
+    if (ok) buffer << file.rdbuf();
+    return buffer.str();
+}
+
+}  // namespace
+
+bool readLevelsGeoJsonText(const std::string& text, std::vector<LevelAggregateRecord>& out, bool& isLevels,
+                           std::string& error) {
+    out.clear();
+    isLevels = false;
+    JsonValue root;
+    JsonParser parser(text);
+    if (!parser.parse(root, error)) {
+        error = "malformed JSON: " + error;
+        return false;
+    }
+    const JsonValue* type = root.type == JsonValue::Type::Object ? root.get("type") : nullptr;
+    if (!type || type->type != JsonValue::Type::String) {
+        error = "not GeoJSON: the top level is not an object with a \"type\"";
+        return false;
+    }
+    const JsonValue* features = root.get("features");
+    if (type->string != "FeatureCollection" || !features || features->type != JsonValue::Type::Array) return true;
+    static const char* const kKeys[] = {"level", "delta", "aggregate", "sources"};
+    auto propertiesOf = [](const JsonValue& f) -> const JsonValue* {
+        const JsonValue* p = f.type == JsonValue::Type::Object ? f.get("properties") : nullptr;
+        return p && p->type == JsonValue::Type::Object ? p : nullptr;
+    };
+    // Plain polygons may well carry one of these names (a building's "level"): only a feature
+    // with all four marks the file as aggregate2d's output.
+    size_t marked = 0;
+    for (const JsonValue& f : features->items)
+        if (const JsonValue* p = propertiesOf(f))
+            if (std::all_of(std::begin(kKeys), std::end(kKeys), [&](const char* key) { return p->get(key) != nullptr; }))
+                ++marked;
+    if (marked == 0) return true;
+    isLevels = true;
+    const std::string notOutput = ": not the GeoJSON of `aggrelod aggregate2d` (each of its features has the properties "
+                                  "level, delta, aggregate and sources)";
+    for (size_t i = 0; i < features->items.size(); ++i) {
+        const JsonValue& f = features->items[i];
+        const std::string name = "feature " + std::to_string(i + 1) + " at line " + std::to_string(f.line);
+        const JsonValue* p = propertiesOf(f);
+        if (!p) {
+            error = name + " has no properties" + notOutput;
+            return false;
+        }
+        for (const char* key : kKeys)
+            if (!p->get(key)) {
+                error = name + " has no \"" + key + "\" property" + notOutput;
+                return false;
+            }
+        LevelAggregateRecord r;
+        r.name = name;
+        int64_t value = 0;
+        if (!asIndex(p->get("level"), 1 << 20, value)) {
+            error = name + ": \"level\" is not a level number (an integer >= 0)" + notOutput;
+            return false;
+        }
+        r.level = int(value);
+        if (!asIndex(p->get("aggregate"), int64_t(1) << 31, value)) {
+            error = name + ": \"aggregate\" is not an aggregate index (an integer >= 0)" + notOutput;
+            return false;
+        }
+        r.aggregate = int(value);
+        const JsonValue* delta = p->get("delta");
+        if (delta->type != JsonValue::Type::Number || !std::isfinite(delta->number) || delta->number < 0) {
+            error = name + ": \"delta\" is not a finite number >= 0" + notOutput;
+            return false;
+        }
+        r.delta = delta->number;
+        const JsonValue* sources = p->get("sources");
+        if (sources->type != JsonValue::Type::Array || sources->items.empty()) {
+            error = name + ": \"sources\" is not a non-empty array of input feature ids" + notOutput;
+            return false;
+        }
+        for (const JsonValue& s : sources->items) {
+            if (!asIndex(&s, int64_t(1) << 32, value)) {
+                error = name + ": \"sources\" holds something that is not an input feature id (an integer >= 0)" + notOutput;
+                return false;
+            }
+            r.sources.push_back(static_cast<uint32_t>(value));
+        }
+        std::vector<uint32_t> sorted = r.sources;
+        std::sort(sorted.begin(), sorted.end());
+        if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+            error = name + ": \"sources\" lists an input feature twice";
+            return false;
+        }
+        // The geometry, read as for plain polygons; here a problem refuses the file: a missing
+        // aggregate would leave its originals uncovered.
+        GeoReadResult one;
+        readGeoJsonFeature(f.get("geometry"), name, 0, one);
+        if (one.features.size() != 1) {
+            error = name + ": " + (one.diagnostics.empty() ? std::string("no usable geometry") : one.diagnostics[0].message);
+            const size_t skipped = error.rfind("; feature skipped");
+            if (skipped != std::string::npos) error.erase(skipped);
+            return false;
+        }
+        r.polygons = std::move(one.features[0].polygons);
+        out.push_back(std::move(r));
+    }
+    if (out.empty()) {
+        error = "no aggregates";
+        return false;
+    }
+    return true;
+}
+
+bool readLevelsGeoJsonFile(const std::string& path, std::vector<LevelAggregateRecord>& out, bool& isLevels,
+                           std::string& error) {
+    bool ok = false;
+    const std::string text = slurp(path, ok);
+    if (!ok) {
+        error = path + ": cannot open";
+        return false;
+    }
+    if (!readLevelsGeoJsonText(text, out, isLevels, error)) {
+        error = path + ": " + error;
+        return false;
+    }
+    return true;
+}
+
+bool readLinksCsvText(const std::string& text, std::vector<LinkRow>& out, std::string& error) {
+    out.clear();
+    std::istringstream stream(text);
+    std::string line;
+    int lineNumber = 0;
+    const std::string header = "input_id,level,delta,output_id";
+    while (std::getline(stream, line)) {
+        ++lineNumber;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (lineNumber == 1) {
+            if (line != header) {
+                error = "line 1: expected the header \"" + header +
+                        "\" (the link table of `aggrelod aggregate2d --links`), found \"" + line.substr(0, 80) + "\"";
+                return false;
+            }
+            continue;
+        }
+        if (line.empty()) continue;
+        std::vector<std::string> fields;
+        size_t start = 0;
+        for (;;) {
+            const size_t comma = line.find(',', start);
+            fields.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+            if (comma == std::string::npos) break;
+            start = comma + 1;
+        }
+        const std::string where = "line " + std::to_string(lineNumber) + ": ";
+        if (fields.size() != 4) {
+            error = where + "expected 4 fields (input_id,level,delta,output_id), found " + std::to_string(fields.size());
+            return false;
+        }
+        auto integer = [&](const std::string& field, int64_t limit, int64_t& v) {
+            const auto r = std::from_chars(field.data(), field.data() + field.size(), v);
+            return r.ec == std::errc() && r.ptr == field.data() + field.size() && v >= 0 && v < limit;
+        };
+        LinkRow row;
+        row.line = lineNumber;
+        int64_t v = 0;
+        if (!integer(fields[0], int64_t(1) << 32, v)) {
+            error = where + "input_id \"" + fields[0] + "\" is not an integer >= 0";
+            return false;
+        }
+        row.input = static_cast<uint32_t>(v);
+        if (!integer(fields[1], 1 << 20, v)) {
+            error = where + "level \"" + fields[1] + "\" is not an integer >= 0";
+            return false;
+        }
+        row.level = int(v);
+        const auto r = std::from_chars(fields[2].data(), fields[2].data() + fields[2].size(), row.delta);
+        if (r.ec != std::errc() || r.ptr != fields[2].data() + fields[2].size() || !std::isfinite(row.delta) || row.delta < 0) {
+            error = where + "delta \"" + fields[2] + "\" is not a finite number >= 0";
+            return false;
+        }
+        if (!integer(fields[3], int64_t(1) << 31, v)) {
+            error = where + "output_id \"" + fields[3] + "\" is not an integer >= 0";
+            return false;
+        }
+        row.output = int(v);
+        out.push_back(row);
+    }
+    if (lineNumber == 0) {
+        error = "empty file (expected the header \"" + header + "\")";
+        return false;
+    }
+    return true;
+}
+
+bool readLinksCsvFile(const std::string& path, std::vector<LinkRow>& out, std::string& error) {
+    bool ok = false;
+    const std::string text = slurp(path, ok);
+    if (!ok) {
+        error = path + ": cannot open";
+        return false;
+    }
+    if (!readLinksCsvText(text, out, error)) {
+        error = path + ": " + error;
+        return false;
+    }
+    return true;
+}
+
 std::string formatLevelsGeoJson(const Hierarchy2D& h, const std::vector<Feature2D>& features) {
     std::string out = "{\"type\": \"FeatureCollection\", \"features\": [\n";
     bool first = true;

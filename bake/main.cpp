@@ -17,6 +17,8 @@
 #include "terminal.h"
 #include "tiles_export.h"
 
+#include <aggrelod/collision.h>
+#include <aggrelod/collision_shapes.h>
 #include <aggrelod/runtime_file.h>
 
 #include <CLI/CLI.hpp>
@@ -98,6 +100,7 @@ struct BakeOptions {
     int threads = 0;
     double proxyError = 0.25;
     bool tiles = false;
+    bool collision = false;
     bool constantBaseline = false;
     bool quiet = false;
     std::string solidify = "wrap";      ///< wrap | hull | off
@@ -189,6 +192,10 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
     cmd->add_flag("--tiles", o.tiles,
                   "Also write OUTDIR/tiles/: a 3D Tiles 1.1 tileset (tileset.json, one GLB per hierarchy node) "
                   "for CesiumJS or 3DTilesRendererJS");
+    cmd->add_flag("--collision", o.collision,
+                  "Also write OUTDIR/collision.glb: static collision shapes per hierarchy node for physics engines "
+                  "(KHR_physics_rigid_bodies and OMI_physics_body/OMI_physics_shape: triangle meshes of the proxies and, "
+                  "where it fits the node's error, a convex hull per shell; one scene per level)");
     cmd->add_flag("-q,--quiet", o.quiet, "No progress, notes, warnings or table (errors only)");
     return cmd;
 }
@@ -203,6 +210,52 @@ bool writeTilesInto(const HierarchyNodes& nodes, const std::vector<InputObject>&
         return false;
     }
     return io::writeTileset(nodes, objects, dir.string(), summary, error);
+}
+
+struct CollisionSummary {
+    size_t colliders = 0, convexNodes = 0, convexParts = 0, scenes = 0;
+    double largestConvexError = 0;
+};
+
+/// Writes collision.glb: its scenes are the cuts of the runtime file just written (every
+/// aggregate level, the per-object LODs when there are any, the originals), taken with the
+/// runtime's own cutAtLevel.
+bool writeCollisionInto(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                        const std::vector<NodeCollisionShapes>& shapes, const fs::path& runtimeFile, const fs::path& path,
+                        CollisionSummary& summary, std::string& error) {
+    runtime::RuntimeFile file;
+    std::string message;
+    const runtime::FileStatus status = runtime::RuntimeFile::openFile(runtimeFile.string(), file, message);
+    if (status != runtime::FileStatus::Ok) {
+        error = runtimeFile.string() + ": " + runtime::toString(status) + ": " + message;
+        return false;
+    }
+    // The aggregate levels first, finest first (the default scene is the first), then the
+    // per-object LODs and the originals.
+    std::vector<io::CollisionCut> cuts;
+    for (uint32_t level : runtime::levelsOf(file)) {
+        cuts.push_back({"level" + std::to_string(level), {}});
+        runtime::cutAtLevel(file, level, cuts.back().nodes);
+    }
+    bool anyObjectLod = false;
+    for (uint32_t i = 0; i < file.nodeCount(); ++i) anyObjectLod = anyObjectLod || file.isObjectLod(i);
+    if (anyObjectLod) {
+        cuts.push_back({"object_lods", {}});
+        runtime::cutAtLevel(file, runtime::kObjectLodLevel, cuts.back().nodes);
+    }
+    cuts.push_back({"originals", {}});
+    runtime::cutAtLevel(file, runtime::kLeafLevel, cuts.back().nodes);
+    if (!io::writeCollisionGlb(nodes, objects, shapes, cuts, path.string(), error)) return false;
+    summary.scenes = 2 * cuts.size() + 1;
+    for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+        if (nodes.nodes[i].indices.empty()) continue;
+        ++summary.colliders;
+        if (shapes[i].convexParts.empty()) continue;
+        ++summary.convexNodes;
+        summary.convexParts += shapes[i].convexParts.size();
+        summary.largestConvexError = std::max(summary.largestConvexError, shapes[i].convexError);
+    }
+    return true;
 }
 
 int runBake(BakeOptions o) {
@@ -244,6 +297,7 @@ int runBake(BakeOptions o) {
         std::vector<std::pair<std::string, fs::path>> outputs = {
             {"levels.glb", outDir / "levels.glb"}, {"proxies.glb", outDir / "proxies.glb"}, {"scene.aglod", outDir / "scene.aglod"},
             {io::kSetManifestName, outDir / io::kSetManifestName}};
+        if (o.collision) outputs.emplace_back("collision.glb", outDir / "collision.glb");
         if (!o.statsPath.empty()) outputs.emplace_back("--stats", fs::path(o.statsPath));
         for (size_t i = 0; i < outputs.size(); ++i) {
             if (samePlace(outputs[i].second, o.scene)) {
@@ -288,7 +342,8 @@ int runBake(BakeOptions o) {
     for (const std::string& buffer : scene.externalFiles) {
         const fs::path outDir(o.outDir);
         for (const fs::path& output : {outDir / "levels.glb", outDir / "proxies.glb", outDir / "scene.aglod",
-                                       outDir / io::kSetManifestName, fs::path(o.statsPath)}) {
+                                       outDir / io::kSetManifestName, fs::path(o.statsPath),
+                                       o.collision ? outDir / "collision.glb" : fs::path()}) {
             if (output.empty() || !samePlace(output, buffer)) continue;
             printError("output " + output.string() + " is the buffer file " + buffer + " of the input " + o.scene +
                        ": it would be overwritten; choose another output");
@@ -351,6 +406,16 @@ int runBake(BakeOptions o) {
         nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
         hierarchy.timings.emplace_back("proxies", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
+    std::vector<NodeCollisionShapes> collisionShapes;
+    if (ok && nodesOk && o.collision) {
+        // Convex decompositions where they fit each node's error (collision_shapes.h).
+        progress.update("collision", 0.0);
+        CollisionShapeSettings collisionSettings;
+        collisionSettings.threadCount = o.threads;
+        const auto start = std::chrono::steady_clock::now();
+        nodesOk = buildCollisionShapes(nodes, scene.objects, collisionSettings, collisionShapes, nodeError);
+        hierarchy.timings.emplace_back("collision", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
     progress.finish();
     cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
     if (!ok) {
@@ -382,14 +447,19 @@ int runBake(BakeOptions o) {
     io::OutputSet set;
     if (!set.begin(outDir, error)) return fail(error);
     if (!statsPath.empty() && statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
-    fs::path levelsTmp, proxiesTmp, runtimeTmp, statsTmp;
+    fs::path levelsTmp, proxiesTmp, runtimeTmp, statsTmp, collisionTmp;
+    const fs::path collisionPath = outDir / "collision.glb";
     if (!set.addFile(levelsPath, levelsTmp, error) || !set.addFile(proxiesPath, proxiesTmp, error) ||
-        !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)))
+        !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)) ||
+        (o.collision && !set.addFile(collisionPath, collisionTmp, error)))
         return fail(error);
     if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes)) return fail(error);
     if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) return fail(error);
     if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
                                runtimeTmp.string(), error))
+        return fail(error);
+    CollisionSummary collision;
+    if (o.collision && !writeCollisionInto(nodes, scene.objects, collisionShapes, runtimeTmp, collisionTmp, collision, error))
         return fail(error);
     io::TilesetSummary tiles;
     if (o.tiles && !writeTilesInto(nodes, scene.objects, set.folderTemporary(outDir / "tiles"), tiles, error))
@@ -417,6 +487,12 @@ int runBake(BakeOptions o) {
         std::printf("wrote %s, %s, %s%s%s\n", levelsPath.string().c_str(), proxiesPath.string().c_str(),
                     runtimePath.string().c_str(),
                     statsPath.empty() ? "" : " and ", statsPath.string().c_str());
+        if (o.collision) {
+            std::printf("wrote %s: %zu colliders (triangle meshes), %zu nodes with a convex decomposition (%zu hulls, "
+                        "largest certified hull error %s), %zu scenes\n",
+                        collisionPath.string().c_str(), collision.colliders, collision.convexNodes, collision.convexParts,
+                        cli::formatNumber(collision.largestConvexError).c_str(), collision.scenes);
+        }
         if (o.tiles) {
             std::printf("wrote %s: %zu tiles (%zu GLB contents), tileset geometric error %s\n",
                         (outDir / "tiles" / "tileset.json").string().c_str(), tiles.tileCount, tiles.contentCount,
@@ -633,8 +709,13 @@ CLI::App* addPlanCommand(CLI::App& app, cli::PlanOptions& o) {
         "plan", "Plan a collision-free path for a round agent with the aggregation hierarchy (OMPL LazyPRM, coarse to "
                 "fine); exit 0 solved, 3 no path within the time limit");
     cmd->add_option("baked", o.input,
-                    "OUTDIR/scene.aglod (3D) or 2D polygons (.wkt, .geojson, .json; aggregated here, see --levels)")
+                    "OUTDIR/scene.aglod (3D), the GeoJSON written by aggregate2d (with --originals), or 2D polygons "
+                    "(.wkt, .geojson, .json; aggregated here, see --levels)")
         ->required();
+    cmd->add_option("--originals", o.originalsPath,
+                    "aggregate2d GeoJSON: the polygons aggregate2d read (required; the original obstacles)");
+    cmd->add_option("--links", o.linksPath,
+                    "aggregate2d GeoJSON: its link table (aggregate2d --links); checked row by row against the GeoJSON");
     cmd->add_option("--from", o.from, "Start x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
     cmd->add_option("--to", o.to, "Goal x,y (2D) or x,y,z (3D), scene units")->delimiter(',')->required();
     cmd->add_option("--radius", o.radius, "Agent radius (disc in 2D, ball in 3D), scene units, > 0")->required();

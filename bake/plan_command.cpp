@@ -280,7 +280,7 @@ bool makePlanScene2D(std::vector<planning::PlanPolygon> originals, std::vector<s
 }
 
 bool loadPlanScene(const std::string& path, double radius, int levels, const std::vector<double>& deltas,
-                   PlanScene& out, std::string& error) {
+                   PlanScene& out, std::string& error, const std::string& originalsPath, const std::string& linksPath) {
     namespace fs = std::filesystem;
     if (!(radius > 0)) {
         error = "--radius must be > 0 (the agent radius in scene units)";
@@ -292,6 +292,51 @@ bool loadPlanScene(const std::string& path, double radius, int levels, const std
         return false;
     }
     const std::string ext = lower(fs::path(path).extension().string());
+    if (ext == ".geojson" || ext == ".json") {
+        // aggregate2d's output: the levels as they are, the originals from --originals.
+        std::vector<io::LevelAggregateRecord> records;
+        bool isLevels = false;
+        if (!io::readLevelsGeoJsonFile(path, records, isLevels, error)) return false;
+        if (isLevels) {
+            if (originalsPath.empty()) {
+                error = path + ": the GeoJSON of `aggrelod aggregate2d` holds the aggregate levels but not the original "
+                               "polygons: give the file aggregate2d read with --originals FILE";
+                return false;
+            }
+            if (levels > 0 || !deltas.empty()) {
+                error = path + ": the levels of `aggrelod aggregate2d` output are fixed; --levels and --delta apply only "
+                               "to plain polygons (use --strategy level:K to plan on one level)";
+                return false;
+            }
+            io::Aggregate2DOutput input;
+            if (!io::checkAggregate2DOutput(std::move(records), path, originalsPath, linksPath, input, error)) return false;
+            std::vector<planning::PlanPolygon> originals;
+            for (const Feature2D& f : input.originals)
+                for (const Polygon2D& p : f.polygons) originals.push_back(toPlan(p));
+            std::vector<std::vector<planning::PlanPolygon>> levelPolygons;
+            std::vector<double> levelDeltas;
+            for (const io::Aggregate2DOutput::Level& level : input.levels) {
+                levelPolygons.emplace_back();
+                levelDeltas.push_back(level.delta);
+                for (const io::LevelAggregateRecord& a : level.aggregates)
+                    for (const Polygon2D& p : a.polygons) levelPolygons.back().push_back(toPlan(p));
+            }
+            out.notes = input.notes;
+            auto count = [](size_t n, const char* what) { return std::to_string(n) + " " + what + (n == 1 ? "" : "s"); };
+            out.description = "aggregate2d output, " + count(input.levels.size(), "level") + " over " +
+                              count(input.originals.size(), "input feature") + " of " + originalsPath +
+                              " (each aggregate contains its sources" +
+                              (linksPath.empty() ? std::string()
+                                                 : "; link table " + linksPath + ": " + count(input.linkRows, "row") + ", all match") +
+                              ")";
+            return makePlanScene2D(std::move(originals), std::move(levelPolygons), levelDeltas, radius, out, error);
+        }
+    }
+    if (!originalsPath.empty() || !linksPath.empty()) {
+        error = path + ": not the GeoJSON of `aggrelod aggregate2d` (no feature has its level, delta, aggregate and "
+                       "sources properties); --originals and --links apply only to that";
+        return false;
+    }
     if (ext == ".wkt" || ext == ".geojson" || ext == ".json") {
         io::GeoReadResult input;
         if (!io::readPolygonFile(path, input, error)) {
@@ -304,17 +349,21 @@ bool loadPlanScene(const std::string& path, double radius, int levels, const std
         }
         Settings2D settings;
         settings.deltas = deltas;
-        settings.automaticLevelCount = levels;
+        settings.automaticLevelCount = levels > 0 ? levels : 6;
         settings.computeBaselines = false;
         Hierarchy2D h;
         if (!buildHierarchy2D(input.features, settings, h)) {
             error = path + ": the polygons could not be aggregated";
             return false;
         }
+        // The obstacles are the polygons the hierarchy was built on: without those the input
+        // checks drop (invalid polygons of a multipolygon), which no aggregate contains.
+        std::vector<Diagnostic> checks;
+        const std::vector<std::vector<Polygon2D>> accepted = acceptedPolygons2D(input.features, checks);
         std::vector<planning::PlanPolygon> originals;
         for (size_t i = 0; i < input.features.size(); ++i)
             if (h.featureModel[i] >= 0)
-                for (const Polygon2D& p : input.features[i].polygons) originals.push_back(toPlan(p));
+                for (const Polygon2D& p : accepted[i]) originals.push_back(toPlan(p));
         std::vector<std::vector<planning::PlanPolygon>> levelPolygons;
         std::vector<double> levelDeltas;
         for (const Level2D& level : h.levels) {
@@ -323,6 +372,7 @@ bool loadPlanScene(const std::string& path, double radius, int levels, const std
             for (const Aggregate2D& a : level.aggregates)
                 for (const Polygon2D& p : a.polygons) levelPolygons.back().push_back(toPlan(p));
         }
+        out.description = "polygons aggregated here, " + std::to_string(levelPolygons.size()) + " levels";
         return makePlanScene2D(std::move(originals), std::move(levelPolygons), levelDeltas, radius, out, error);
     }
     auto file = std::make_unique<runtime::RuntimeFile>();
@@ -331,7 +381,8 @@ bool loadPlanScene(const std::string& path, double radius, int levels, const std
     if (status != runtime::FileStatus::Ok) {
         error = path + ": not a baked runtime file (" + std::string(runtime::toString(status)) +
                 (message.empty() ? "" : ": " + message) +
-                "); `aggrelod plan` reads OUTDIR/scene.aglod (3D) or 2D polygons (.wkt, .geojson, .json)";
+                "); `aggrelod plan` reads OUTDIR/scene.aglod (3D), the GeoJSON of `aggrelod aggregate2d` (with "
+                "--originals) or 2D polygons (.wkt, .geojson, .json)";
         return false;
     }
     try {
@@ -409,7 +460,10 @@ int runPlan(const PlanOptions& o) {
 
     PlanScene scene;
     std::string error;
-    if (!loadPlanScene(o.input, o.radius, o.levels, o.deltas, scene, error)) return fail(2, error);
+    if (!loadPlanScene(o.input, o.radius, o.levels, o.deltas, scene, error, o.originalsPath, o.linksPath))
+        return fail(2, error);
+    if (!o.quiet)
+        for (const std::string& note : scene.notes) std::fprintf(stderr, "aggrelod: note: %s\n", note.c_str());
     const int dim = scene.world->dimension();
     auto point = [&](const std::vector<double>& v, const char* name, planning::Point& p) {
         if (int(v.size()) != dim) {
@@ -442,6 +496,7 @@ int runPlan(const PlanOptions& o) {
     if (!o.quiet) {
         std::string levels;
         for (int l : r.levelsUsed) levels += (levels.empty() ? "" : " -> ") + levelLabel(*scene.world, l);
+        if (!scene.description.empty()) std::printf("%s: %s\n", o.input.c_str(), scene.description.c_str());
         std::printf("%s: %s in %.3f s; levels %s; %llu collision checks; roadmap %zu vertices, %zu edges",
                     o.input.c_str(), r.solved() ? "solved" : "no path found", r.seconds, levels.c_str(),
                     static_cast<unsigned long long>(r.collisionChecks()), r.roadmapVertices, r.roadmapEdges);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/collision_shapes.h>
 #include <aggrelod/hierarchy_nodes.h>
 
 #include <string>
@@ -34,6 +35,10 @@ struct SceneReadOptions {
     /// External files (buffer uris) may lie outside the input's folder. Off by default: a
     /// uri such as "../../etc/passwd" is refused, so a file cannot pull in other data.
     bool allowExternalUris = false;
+    /// Read every scene of the file (in order; a node that is a root of several scenes is
+    /// read once) instead of the default scene only. levels.glb has one scene per level and
+    /// proxies.glb keeps its coarser stand-ins in a second scene (docs/engines.md).
+    bool allScenes = false;
 };
 
 struct SceneReadResult {
@@ -63,6 +68,28 @@ struct LevelsGlbNode {
 /// node lacks extras.level (not a levels.glb). Never throws.
 bool readLevelsGlb(const std::string& path, std::vector<LevelsGlbNode>& out, std::string& error);
 
+/// One glTF node of a proxies.glb file (written by writeProxiesGlb; layout in docs/engines.md).
+struct ProxiesGlbNode {
+    std::string name;                ///< e.g. "sphere03_LOD0", "node140_LOD2"
+    int gltfNode = -1;               ///< index in the file's nodes
+    int node = -1;                   ///< extras.node: the hierarchy (runtime) node; -1 for a group node
+    int lod = -1;                    ///< extras.lod: place in its LOD group, 0 = finest
+    int childrenOf = -1;             ///< extras.children_of of a group node (LOD0 of a merge), else -1
+    bool leaf = false;               ///< extras.leaf: an original object
+    bool inDefaultScene = false;     ///< reached from the default scene
+    std::vector<int> children;       ///< glTF node indices
+    std::vector<int> lodIds;         ///< MSFT_lod ids (glTF node indices), coarser first to coarsest
+    std::vector<double> screenCoverage;  ///< extras.MSFT_screencoverage
+    bool hasNormals = false, hasColors = false;  ///< every primitive of its mesh has NORMAL / COLOR_0
+    std::vector<double> positions;   ///< world space, 3 per vertex (empty without a mesh)
+    std::vector<uint32_t> indices;   ///< 3 per triangle
+    std::vector<float> triangleColors;  ///< as InputObject::triangleColors
+};
+
+/// Reads every node of a proxies.glb (index order), its extras, MSFT_lod and geometry.
+/// False with a message when the file cannot be read. Never throws.
+bool readProxiesGlb(const std::string& path, std::vector<ProxiesGlbNode>& out, std::string& error);
+
 /// Writes objects as a GLB, one node (with extras.id) per object. For samples and tests.
 /// An object with triangleColors gets one material of that colour when all its triangles
 /// share it, else COLOR_0 vertex colours (so reading the file back gives the same colours).
@@ -91,6 +118,25 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
 /// bounding_sphere, sources, source_ids}. World units.
 bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                      const std::string& path, std::string& error);
+
+/// A named set of hierarchy nodes that covers every object once (a scene of collision.glb).
+struct CollisionCut {
+    std::string name;              ///< e.g. "level0", "originals", "object_lods"
+    std::vector<uint32_t> nodes;   ///< hierarchy node indices
+};
+
+/// Writes OUTDIR/collision.glb (docs/engines.md): per hierarchy node with geometry a static
+/// collider node "<stem>_collider" with its mesh as a triangle-mesh shape, and, when
+/// shapes[i] has a convex decomposition, a node "<stem>_convex" whose children are one convex
+/// collider each (stem: the object's name for a leaf, "node<i>" otherwise). Colliders carry
+/// KHR_physics_rigid_bodies {collider: {geometry: {node: itself, convexHull}}} and
+/// OMI_physics_body {collider: {shape}} over the document's OMI_physics_shape shapes (trimesh /
+/// convex, the same mesh). Scenes: per cut its trimesh colliders and "<cut>_convex" (convex
+/// decompositions where present), then "all_nodes"; the first is the default scene. Collision
+/// meshes have POSITION and indices only. World units.
+bool writeCollisionGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                       const std::vector<NodeCollisionShapes>& shapes, const std::vector<CollisionCut>& cuts,
+                       const std::string& path, std::string& error);
 
 /// The base colour (linear RGBA, 4 values) of level `level` of `levelCount` in levels.glb and
 /// proxies.glb: warm for fine levels, cool for coarse ones.

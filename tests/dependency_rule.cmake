@@ -5,13 +5,19 @@
 # - no file under runtime/ includes TetGen, CGAL, tinygltf, meshoptimizer, GEOS, GLM or any
 #   header of module/;
 # - no file under module/ includes tinygltf or any header of runtime/;
+# - no file under planning/ includes TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS,
+#   GLM, CLI11, stb or any header of module/, bake/ or samples/ (it may use the runtime with
+#   its collision part, OMPL and the standard library);
 # - (when samples/viewer exists) no file of the OpenGL viewer includes anything but the runtime's
 #   C API among the project's headers: no header of module/ or bake/, no C++ runtime header
 #   (aggrelod/...), none of the bake-side libraries or Embree;
 # - (with LINK_INFO, written by tests/CMakeLists.txt at generate time) no target defined under
 #   runtime/ links TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS, GLM or the module, no
-#   target under module/ links tinygltf or the runtime, and the viewer (TARGETS_viewer) links
-#   none of the bake-side libraries, the module, the bake's or the samples' libraries, or Embree.
+#   target under module/ links tinygltf or the runtime, no target under planning/ links
+#   TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS, GLM, CLI11, stb, the module, the
+#   bake's libraries or executable or the samples' library, and the viewer (TARGETS_viewer)
+#   links none of the bake-side libraries, the module, the bake's or the samples' libraries,
+#   or Embree.
 # Prints every violation and fails (FATAL_ERROR) when there is one.
 cmake_minimum_required(VERSION 3.22)
 
@@ -93,19 +99,34 @@ if(module_headers AND runtime_headers)
   list(REMOVE_ITEM runtime_only ${module_headers})
 endif()
 
+# Bare names of the bake's and the samples' headers (bake/*.h, samples/include/aggrelod/*.h).
+set(bake_headers "")
+file(GLOB _bake_headers "${SOURCE_DIR}/bake/*.h")
+foreach(h IN LISTS _bake_headers)
+  get_filename_component(base "${h}" NAME)
+  list(APPEND bake_headers "${base}")
+endforeach()
+collect_header_names(samples samples_headers)
+
 check_includes(runtime
   "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|(^|/)module/"
   "${module_only}")
 check_includes(module
   "(^|/)tiny_gltf\\.h$|(^|/)runtime/"
   "${runtime_only}")
+if(EXISTS "${SOURCE_DIR}/planning")
+  # planning/ may use the runtime (with its collision part), OMPL and the standard library.
+  # A name that is also a runtime or planning header cannot be told apart: leave it out.
+  collect_header_names(planning planning_headers)
+  set(_planning_forbidden_names ${module_only} ${bake_headers} ${samples_headers})
+  if(_planning_forbidden_names AND (runtime_headers OR planning_headers))
+    list(REMOVE_ITEM _planning_forbidden_names ${runtime_headers} ${planning_headers})
+  endif()
+  check_includes(planning
+    "(^|/)tetgen\\.h$|^CGAL/|^gmp|^mpfr|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|^CLI/|(^|/)stb_[a-z_]*\\.h$|(^|/)module/|(^|/)bake/|(^|/)samples/"
+    "${_planning_forbidden_names}")
+endif()
 if(EXISTS "${SOURCE_DIR}/samples/viewer")
-  set(bake_headers "")
-  file(GLOB _bake_headers "${SOURCE_DIR}/bake/*.h")
-  foreach(h IN LISTS _bake_headers)
-    get_filename_component(base "${h}" NAME)
-    list(APPEND bake_headers "${base}")
-  endforeach()
   check_includes(samples/viewer
     "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|^embree|(^|/)module/|(^|/)bake/|^aggrelod/"
     "${module_only};${bake_headers}")
@@ -118,8 +139,9 @@ if(LINK_INFO)
   include("${LINK_INFO}")
   set(_forbidden_runtime "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples")
   set(_forbidden_module "tinygltf|aggrelod_runtime|aggrelod::runtime|aggrelod_io")
+  set(_forbidden_planning "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|cli11|pkgconfig::stb|stb_image|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_render|aggrelod_samples|aggrelod::samples|^aggrelod$|^aggrelod_asan$")
   set(_forbidden_viewer "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|embree|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples|aggrelod_render|aggrelod_planning|aggrelod_runtime_collision")
-  foreach(part runtime module viewer)
+  foreach(part runtime module planning viewer)
     set(count 0)
     foreach(t IN LISTS TARGETS_${part})
       set(links "${LINKS_${t}}")

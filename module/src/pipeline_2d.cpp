@@ -787,6 +787,15 @@ SegmentSplits connectionSplits(const InputVertices& in, const FreeSpace2D& space
 
 }  // namespace
 
+std::vector<std::vector<Polygon2D>> acceptedPolygons2D(const std::vector<Feature2D>& features,
+                                                       std::vector<Diagnostic>& diagnostics) {
+    CheckedPolygons checked;
+    checkPolygons(features, checked, diagnostics);
+    std::vector<std::vector<Polygon2D>> out(features.size());
+    for (size_t p = 0; p < checked.parts.size(); ++p) out[checked.partFeature[p]].push_back(std::move(checked.parts[p]));
+    return out;
+}
+
 bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& settings, Hierarchy2D& out) {
     out = Hierarchy2D{};
     out.featureModel.assign(features.size(), -1);

@@ -93,7 +93,8 @@ int aglod_node_normals(const aglod_file* file, uint32_t node, const float** norm
 int aglod_node_colors(const aglod_file* file, uint32_t node, const uint8_t** colors, uint32_t* vertex_count);
 /* The linear RGBA in [0, 1] (glTF COLOR_0 / baseColorFactor meaning) of 4 colour bytes. */
 void aglod_color_to_linear(const uint8_t rgba[4], float linear[4]);
-/* Box of the whole scene (union of the roots' boxes), world units. 0 when file is NULL. */
+/* Box of the original objects (union of the leaves' boxes; the roots' when no leaf has one),
+ * world units. 0 when file is NULL. */
 int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]);
 /* Name of an original object, NUL-terminated copy into buffer (capacity bytes); returns the
  * full length of the name (excluding NUL), or 0 when out of range. */

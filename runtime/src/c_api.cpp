@@ -158,13 +158,26 @@ int aglod_scene_bounds(const aglod_file* file, float min[3], float max[3]) {
         min[k] = 3.4e38f;
         max[k] = -3.4e38f;
     }
-    for (uint32_t root : file->file.roots()) {
-        const NodeRecord& r = file->file.node(root);
+    // The originals' boxes: coarse versions near the roots may reach well beyond them.
+    const RuntimeFile& f = file->file;
+    for (uint32_t i = 0; i < f.nodeCount(); ++i) {
+        if (!f.isLeaf(i)) continue;
+        const NodeRecord& r = f.node(i);
+        if (!(r.boundsMin[0] <= r.boundsMax[0] && r.boundsMin[1] <= r.boundsMax[1] && r.boundsMin[2] <= r.boundsMax[2]))
+            continue;  // an object without geometry
         for (int k = 0; k < 3; ++k) {
             min[k] = std::min(min[k], r.boundsMin[k]);
             max[k] = std::max(max[k], r.boundsMax[k]);
         }
     }
+    if (min[0] > max[0])  // no leaf with a box: the roots'
+        for (uint32_t root : f.roots()) {
+            const NodeRecord& r = f.node(root);
+            for (int k = 0; k < 3; ++k) {
+                min[k] = std::min(min[k], r.boundsMin[k]);
+                max[k] = std::max(max[k], r.boundsMax[k]);
+            }
+        }
     return 1;
 }
 

@@ -53,7 +53,9 @@ std::vector<InputObject> readLevels(const fs::path& levelsGlb) {
     std::string error;
     EXPECT_TRUE(io::readLevelsGlb(levelsGlb.string(), nodes, error)) << levelsGlb << ": " << error;
     io::SceneReadResult scene;
-    EXPECT_TRUE(io::readGltfScene(levelsGlb.string(), io::SceneReadOptions{}, scene, error)) << levelsGlb << ": " << error;
+    io::SceneReadOptions everyLevel;
+    everyLevel.allScenes = true;  // one scene per level
+    EXPECT_TRUE(io::readGltfScene(levelsGlb.string(), everyLevel, scene, error)) << levelsGlb << ": " << error;
     size_t support = 0;
     for (const auto& o : scene.objects) support += o.name.rfind("support_", 0) == 0;
     EXPECT_EQ(scene.objects.size(), nodes.size() + support) << levelsGlb << ": mesh nodes that are neither aggregates nor support surfaces";

@@ -341,7 +341,9 @@ void checkForestColours(const std::vector<InputObject>& generated, const fs::pat
     validateGltf({dir / "levels.glb", dir / "proxies.glb"}, dir);
     // levels.glb carries the aggregates' face colours (COLOR_0), read back exactly.
     io::SceneReadResult levels;
-    ASSERT_TRUE(io::readGltfScene((dir / "levels.glb").string(), {}, levels, error)) << error;
+    io::SceneReadOptions everyLevel;
+    everyLevel.allScenes = true;  // one scene per level
+    ASSERT_TRUE(io::readGltfScene((dir / "levels.glb").string(), everyLevel, levels, error)) << error;
     size_t checked = 0;
     for (size_t k = 0, o = 0; k < h.levels.size(); ++k)
         for (const Aggregate& agg : h.levels[k].aggregates) {

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <set>
@@ -46,7 +47,9 @@ const Baked& bakedAsGiven(const std::string& relative) {
         std::string error;
         EXPECT_TRUE(io::readLevelsGlb((b.dir / "out" / "levels.glb").string(), b.levels, error)) << error;
         io::SceneReadResult all;
-        EXPECT_TRUE(io::readGltfScene((b.dir / "out" / "levels.glb").string(), {}, all, error)) << error;
+        io::SceneReadOptions everyLevel;
+        everyLevel.allScenes = true;  // one scene per level, each with the support surfaces
+        EXPECT_TRUE(io::readGltfScene((b.dir / "out" / "levels.glb").string(), everyLevel, all, error)) << error;
         for (const InputObject& o : all.objects)
             if (o.name.rfind("support_", 0) == 0) b.support.insert(o.name.substr(8));
         b.stats = readFile(b.dir / "stats.json");
@@ -397,4 +400,47 @@ TEST(RealArtChoosing, ObjectDepthMakesAssemblies) {
     EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Terrain@0"}));
     options.objectDepth = 1;
     EXPECT_EQ(readNames(dir / "scene.gltf", options), (std::vector<std::string>{"Terrain@0", "Box@0/0", "Tower"}));
+}
+
+// Every shared real scene, baked as given by the AddressSanitizer + UBSan build of the CLI
+// (runtime instrumented too): no report, a clean exit, a complete output set. MetalRoughSpheresNoTextures (a million triangles of fine spheres) takes minutes even
+// in the release build; it runs under the sanitizers only when AGGRELOD_SANITIZE_SLOW_SCENES is
+// set (`AGGRELOD_SANITIZE_SLOW_SCENES=1 ctest -R RealArtSanitized`).
+namespace {
+void expectCleanUnderSanitizers(const std::string& relative) {
+    REQUIRE_DATA(relative);
+#ifndef AGGRELOD_CLI_ASAN
+    GTEST_SKIP() << "built without the sanitizer CLI (AGGRELOD_ASAN=OFF)";
+#else
+    constexpr int kSanitizerExitCode = 86;
+    ::setenv("ASAN_OPTIONS", "detect_leaks=0:abort_on_error=0:exitcode=86", 1);
+    ::setenv("UBSAN_OPTIONS", "halt_on_error=1:print_stacktrace=1:exitcode=86", 1);
+    const fs::path dir = freshTestDir("real_art_asan_" + fs::path(relative).stem().string());
+    const RunResult r = runProgram({AGGRELOD_CLI_ASAN, "bake", sharedData(relative).string(), "-o", (dir / "out").string(),
+                                    "--stats", (dir / "stats.json").string()},
+                                   dir);
+    ASSERT_TRUE(r.started) << r.describe();
+    EXPECT_FALSE(r.signaled) << r.describe();
+    EXPECT_EQ(r.err.find("ERROR: AddressSanitizer"), std::string::npos) << r.describe();
+    EXPECT_EQ(r.err.find("runtime error:"), std::string::npos) << "undefined behaviour\n" << r.describe();
+    EXPECT_NE(r.exitCode, kSanitizerExitCode) << r.describe();
+    ASSERT_TRUE(r.exited && r.exitCode == 0) << r.describe();
+    for (const char* file : {"levels.glb", "proxies.glb", "scene.aglod"})
+        EXPECT_FALSE(readFile(dir / "out" / file).empty()) << relative << ": " << file << " missing";
+#endif
+}
+}  // namespace
+
+TEST(RealArtSanitized, TruckTown) { expectCleanUnderSanitizers("3d/truck_town/town_model.gltf"); }
+TEST(RealArtSanitized, CollisionWorld) { expectCleanUnderSanitizers("3d/collision-world/collision-world.glb"); }
+TEST(RealArtSanitized, GodotOcclusionRoom) { expectCleanUnderSanitizers("3d/godot_occlusion_room/room.glb"); }
+TEST(RealArtSanitized, TwoCylinderEngine) { expectCleanUnderSanitizers("3d/2CylinderEngine/2CylinderEngine.glb"); }
+TEST(RealArtSanitized, DeccerCubes) {
+    expectCleanUnderSanitizers("3d/deccer-cubes/SM_Deccer_Cubes.glb");
+    expectCleanUnderSanitizers("3d/deccer-cubes/SM_Deccer_Cubes_With_Rotation.glb");
+}
+TEST(RealArtSanitized, OrientationTest) { expectCleanUnderSanitizers("3d/OrientationTest/OrientationTest.glb"); }
+TEST(RealArtSanitized, MetalRoughSpheresWhenAsked) {
+    if (!std::getenv("AGGRELOD_SANITIZE_SLOW_SCENES")) GTEST_SKIP() << "set AGGRELOD_SANITIZE_SLOW_SCENES=1 to run it";
+    expectCleanUnderSanitizers("3d/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb");
 }

@@ -193,7 +193,9 @@ TEST(Render, SheetHasOnePanelPerLevel) {
     // levels.glb has every level of the bake; the runtime file only those with a group of
     // several objects (objects alone are stood in for by their per-object LOD chains).
     aggrelod::io::SceneReadResult glb;
-    ASSERT_TRUE(aggrelod::io::readGltfScene(levelsPath().string(), {}, glb, message)) << message;
+    aggrelod::io::SceneReadOptions everyLevel;
+    everyLevel.allScenes = true;  // one scene per level
+    ASSERT_TRUE(aggrelod::io::readGltfScene(levelsPath().string(), everyLevel, glb, message)) << message;
     std::set<std::string> glbLevels;
     for (const aggrelod::InputObject& o : glb.objects) glbLevels.insert(o.name.substr(0, o.name.find('_')));
 

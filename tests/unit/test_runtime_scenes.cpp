@@ -153,7 +153,9 @@ std::unique_ptr<BakedScene> bakeScene(const std::string& label, const fs::path& 
     }
     s->originals = std::move(originals.objects);
     io::SceneReadResult levels;
-    if (!io::readGltfScene((s->dir / "out" / "levels.glb").string(), {}, levels, error)) {
+    io::SceneReadOptions everyLevel;
+    everyLevel.allScenes = true;  // levels.glb has one scene per level
+    if (!io::readGltfScene((s->dir / "out" / "levels.glb").string(), everyLevel, levels, error)) {
         s->problem = error;
         return s;
     }
@@ -570,6 +572,31 @@ TEST(RuntimeScenes, DrawCostsNeverDrawMoreThanThePlainRule) {
             EXPECT_LE(withCosts, without) << s.label << " camera " << camera;
             lighter += withCosts < without;
         }
+        // With hysteresis, along a flight from far to near and back: incremental = full.
+        runtime::Selector flightFull(f), flightIncremental(f);
+        flightFull.setDrawCosts(originalTriangles.data(), perDraw);
+        flightIncremental.setDrawCosts(originalTriangles.data(), perDraw);
+        runtime::SelectionSettings hysteresis;
+        hysteresis.pixelTolerance = 1.0f;
+        hysteresis.coarsenRatio = 0.75f;
+        for (int frame = 0; frame < 400; ++frame) {
+            const double t = frame < 200 ? frame / 200.0 : (400 - frame) / 200.0;  // 0 -> 1 -> 0
+            const double distance = s.radius * std::pow(200.0, 1.0 - t) * 0.5;
+            const double angle = 0.01 * frame;
+            runtime::Camera c;
+            c.position[0] = float(s.center[0] + distance * std::cos(angle));
+            c.position[1] = float(s.center[1] + 0.3 * distance);
+            c.position[2] = float(s.center[2] + distance * std::sin(angle));
+            c.fovY = float(60 * M_PI / 180);
+            c.viewportHeight = 1080.0f;
+            flightFull.selectFull(c, hysteresis);
+            flightIncremental.select(c, hysteresis);
+            std::vector<uint32_t> a(flightFull.cut().begin(), flightFull.cut().end()),
+                b(flightIncremental.cut().begin(), flightIncremental.cut().end());
+            std::sort(a.begin(), a.end());
+            std::sort(b.begin(), b.end());
+            ASSERT_EQ(a, b) << s.label << " flight frame " << frame << ": incremental differs from full";
+        }
         std::printf("%-10s %u of %u nodes never worth drawing\n", s.label.c_str(), costed.skippedNodeCount(), f.nodeCount());
     }
     std::printf("cameras where the cut got lighter: %zu\n", lighter);
@@ -786,35 +813,104 @@ TEST(RuntimeScenes, ProxiesGlbMirrorsTheRuntimeTreeAndIsValid) {
     BakedScene& s = scene(SceneId::Spheres15);
     REQUIRE_SCENE(s);
     const fs::path proxies = s.dir / "out" / "proxies.glb";
-    io::SceneReadResult back;
+    std::vector<io::ProxiesGlbNode> back;
     std::string error;
-    ASSERT_TRUE(io::readGltfScene(proxies.string(), {}, back, error)) << error;
-    // One mesh object per aggregate node ("node<i>_level<k>"), the same triangles as the file
-    // (corner by corner: the file splits vertices at creases as well as at colour changes)
-    // and the same colours (the file's are sRGB-encoded bytes of the glb's linear ones; a
-    // scene without colours has white in the file and per-level tints in the glb).
+    ASSERT_TRUE(io::readProxiesGlb(proxies.string(), back, error)) << error;
+    // Every runtime node with triangles is the mesh of exactly one glTF node (extras.node): the
+    // same triangles as the file, corner by corner (the file splits vertices at creases as
+    // well as at colour changes), and the same colours (the file's are sRGB-encoded bytes of
+    // the glb's linear ones; a scene without colours has white in the file and per-level tints
+    // in the glb), with normals and colours on every mesh.
     bool sceneHasColours = false;
     for (const InputObject& o : s.originals) sceneHasColours = sceneHasColours || !o.triangleColors.empty();
-    size_t aggregates = 0;
-    for (uint32_t i = 0; i < s.file.nodeCount(); ++i) aggregates += s.file.node(i).level != runtime::kLeafLevel;
-    EXPECT_EQ(back.objects.size(), aggregates);
-    for (const InputObject& o : back.objects) {
-        ASSERT_EQ(o.name.rfind("node", 0), 0u) << o.name;
-        const uint32_t node = uint32_t(std::stoul(o.name.substr(4)));
-        ASSERT_LT(node, s.file.nodeCount());
+    std::vector<int> gltfOf(s.file.nodeCount(), -1);
+    size_t defaultSceneTriangles = 0, originalTriangles = 0;
+    for (const io::ProxiesGlbNode& n : back) {
+        if (n.node < 0) {  // the LOD0 of a merge: holds its children's LOD groups, no mesh
+            EXPECT_TRUE(n.positions.empty()) << n.name;
+            ASSERT_GE(n.childrenOf, 0) << n.name;
+            ASSERT_LT(uint32_t(n.childrenOf), s.file.nodeCount()) << n.name;
+            EXPECT_EQ(n.children.size(), s.file.node(uint32_t(n.childrenOf)).childCount) << n.name;
+            EXPECT_EQ(n.lod, 0) << n.name;
+            continue;
+        }
+        const uint32_t node = uint32_t(n.node);
+        ASSERT_LT(node, s.file.nodeCount()) << n.name;
         const auto v = s.file.vertices(node);
         const auto t = s.file.triangles(node);
         const auto c = s.file.colors(node);
-        ASSERT_EQ(o.indices.size(), t.size) << o.name;
-        const bool coloured = sceneHasColours && o.triangleColors.size() == 4 * (t.size / 3);
+        if (t.size == 0) continue;
+        EXPECT_EQ(gltfOf[node], -1) << "node " << node << " appears twice: " << n.name;
+        gltfOf[node] = n.gltfNode;
+        EXPECT_TRUE(n.hasNormals && n.hasColors) << n.name << ": NORMAL and COLOR_0 expected";
+        // The default scene shows one level, the finest: the originals, once each.
+        EXPECT_EQ(n.inDefaultScene, s.file.isLeaf(node)) << n.name;
+        EXPECT_EQ(n.lod == 0, s.file.isLeaf(node)) << n.name;
+        if (n.inDefaultScene) defaultSceneTriangles += n.indices.size() / 3;
+        if (s.file.isLeaf(node)) originalTriangles += t.size / 3;
+        ASSERT_EQ(n.indices.size(), t.size) << n.name;
+        const bool coloured = sceneHasColours && n.triangleColors.size() == 4 * (t.size / 3);
         for (size_t i = 0; i < t.size; ++i) {
             for (int k = 0; k < 3; ++k)
-                ASSERT_EQ(float(o.positions[3 * size_t(o.indices[i]) + k]), v[3 * size_t(t[i]) + k]) << o.name << " corner " << i;
+                ASSERT_EQ(float(n.positions[3 * size_t(n.indices[i]) + k]), v[3 * size_t(t[i]) + k]) << n.name << " corner " << i;
             uint8_t expected[4] = {255, 255, 255, 255};
-            if (coloured) runtime::encodeColorSrgb8(&o.triangleColors[4 * (i / 3)], expected);
+            if (coloured) runtime::encodeColorSrgb8(&n.triangleColors[4 * (i / 3)], expected);
             for (int k = 0; k < 4; ++k)
-                EXPECT_NEAR(int(c[4 * size_t(t[i]) + k]), int(expected[k]), 1) << o.name << " corner " << i;
+                EXPECT_NEAR(int(c[4 * size_t(t[i]) + k]), int(expected[k]), 1) << n.name << " corner " << i;
         }
     }
+    for (uint32_t i = 0; i < s.file.nodeCount(); ++i) {
+        if (s.file.triangles(i).size > 0) {
+            EXPECT_GE(gltfOf[i], 0) << "runtime node " << i << " is missing";
+        }
+    }
+    EXPECT_EQ(defaultSceneTriangles, originalTriangles);
+
+    // MSFT_lod: each LOD0 node lists its coarser stand-ins, finest to coarsest, up its chain of
+    // single children to the top of its group; one screen coverage per level, non-increasing,
+    // ending at 0. Names: <stem>_LOD0, <stem>_LOD1, ...
+    size_t groups = 0, standIns = 0;
+    for (const io::ProxiesGlbNode& n : back) {
+        if (n.lod != 0) continue;
+        ++groups;
+        EXPECT_TRUE(n.inDefaultScene) << n.name;
+        ASSERT_GE(n.name.size(), 5u);
+        EXPECT_EQ(n.name.substr(n.name.size() - 5), "_LOD0") << n.name;
+        const std::string stem = n.name.substr(0, n.name.size() - 5);
+        if (n.lodIds.empty()) continue;
+        ASSERT_EQ(n.screenCoverage.size(), n.lodIds.size() + 1) << n.name;
+        EXPECT_EQ(n.screenCoverage.back(), 0.0) << n.name;
+        for (size_t k = 0; k < n.screenCoverage.size(); ++k) {
+            EXPECT_GE(n.screenCoverage[k], 0.0) << n.name;
+            EXPECT_LE(n.screenCoverage[k], 1.0) << n.name;
+            if (k) {
+                EXPECT_LE(n.screenCoverage[k], n.screenCoverage[k - 1]) << n.name;
+            }
+        }
+        // The first stand-in: the merge's own proxy, or the leaf's parent.
+        uint32_t previous = n.node >= 0 ? uint32_t(n.node) : runtime::kNoIndex;
+        for (size_t k = 0; k < n.lodIds.size(); ++k) {
+            ASSERT_GE(n.lodIds[k], 0);
+            ASSERT_LT(size_t(n.lodIds[k]), back.size());
+            const io::ProxiesGlbNode& lod = back[size_t(n.lodIds[k])];
+            ++standIns;
+            EXPECT_FALSE(lod.inDefaultScene) << lod.name;
+            EXPECT_EQ(lod.lod, int(k + 1)) << lod.name;
+            EXPECT_EQ(lod.name, stem + "_LOD" + std::to_string(k + 1));
+            ASSERT_GE(lod.node, 0) << lod.name;
+            if (k == 0 && n.node < 0) {
+                EXPECT_EQ(lod.node, n.childrenOf) << lod.name;
+            } else {
+                ASSERT_EQ(s.file.node(uint32_t(lod.node)).childCount, 1u) << lod.name;
+                EXPECT_EQ(s.file.children(uint32_t(lod.node))[0], previous) << lod.name;
+            }
+            previous = uint32_t(lod.node);
+        }
+    }
+    EXPECT_GT(groups, 0u);
+    EXPECT_GT(standIns, 0u);
+    size_t aggregates = 0;
+    for (uint32_t i = 0; i < s.file.nodeCount(); ++i) aggregates += !s.file.isLeaf(i) && s.file.triangles(i).size > 0;
+    EXPECT_EQ(standIns, aggregates) << "every node above the originals is a stand-in of exactly one LOD group";
     validateGltf({proxies}, s.dir);
 }

@@ -15,6 +15,7 @@ import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { Cdp, findChromium } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const webDir = path.resolve(here, '..', '..', 'samples', 'web');
@@ -32,54 +33,6 @@ function parseArgs() {
   }
   if (!o.tileset || !o.out) throw new Error('usage: --tileset DIR --out DIR [--chromium PATH]');
   return o;
-}
-
-function findChromium(explicit) {
-  const candidates = explicit ? [explicit] : ['/usr/bin/chromium', '/usr/bin/chromium-browser', '/usr/bin/google-chrome'];
-  return candidates.find((c) => fs.existsSync(c)) || null;
-}
-
-/** Minimal DevTools-protocol client over --remote-debugging-pipe (fd 3: to Chromium, fd 4: from it). */
-class Cdp {
-  constructor(child) {
-    this.nextId = 1;
-    this.pending = new Map();
-    this.listeners = [];
-    this.writer = child.stdio[3];
-    const failAll = (e) => {
-      for (const { reject, method } of this.pending.values()) reject(new Error(`${method}: ${e.message}`));
-      this.pending.clear();
-    };
-    this.writer.on('error', failAll);
-    child.stdio[4].on('error', failAll);
-    let buffer = '';
-    child.stdio[4].on('data', (chunk) => {
-      buffer += chunk.toString('utf8');
-      let end;
-      while ((end = buffer.indexOf('\0')) >= 0) {
-        const message = JSON.parse(buffer.slice(0, end));
-        buffer = buffer.slice(end + 1);
-        if (message.id !== undefined && this.pending.has(message.id)) {
-          const { resolve, reject, method } = this.pending.get(message.id);
-          this.pending.delete(message.id);
-          if (message.error) reject(new Error(`${method}: ${message.error.message}`));
-          else resolve(message.result);
-        } else if (message.method) {
-          for (const l of this.listeners) l(message);
-        }
-      }
-    });
-  }
-
-  send(method, params = {}, sessionId = undefined) {
-    const id = this.nextId++;
-    const message = { id, method, params };
-    if (sessionId) message.sessionId = sessionId;
-    return new Promise((resolve, reject) => {
-      this.pending.set(id, { resolve, reject, method });
-      this.writer.write(JSON.stringify(message) + '\0');
-    });
-  }
 }
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));

@@ -96,6 +96,14 @@ Measures2D normalizedMeasures(const Measures2D& m, const Measures2D& originals);
 /// 4 pi A / P^2, 0 when P == 0.
 double circularity(double area, double perimeter);
 
+/// The polygons buildHierarchy2D aggregates, found without aggregating: the same input checks
+/// (rings cleaned of repeated vertices and oriented, exterior CCW and holes CW; degenerate holes
+/// dropped; polygons with a bad ring dropped), per input feature its accepted polygons in input
+/// order (empty when the feature is rejected). Diagnostics as buildHierarchy2D's input checks
+/// give them. No triangulation: near-linear time.
+std::vector<std::vector<Polygon2D>> acceptedPolygons2D(const std::vector<Feature2D>& features,
+                                                       std::vector<Diagnostic>& diagnostics);
+
 /// Builds the whole hierarchy. Bad features (self-intersecting ring, NaN, fewer than 3
 /// distinct vertices, zero area) get an Error diagnostic and are left out; touching or
 /// overlapping polygons are merged into one model (Note). Returns false only when no

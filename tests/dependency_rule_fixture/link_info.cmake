@@ -1,0 +1,6 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+# Link interfaces as tests/CMakeLists.txt writes them (dependency_rule_links.cmake), for a
+# planning target that links what it may (the runtime's collision part, OMPL) and two things
+# it may not (CGAL, the module).
+list(APPEND TARGETS_planning fixture_planning)
+set("LINKS_fixture_planning" "aggrelod_runtime_collision;/usr/lib/x86_64-linux-gnu/libompl.so;CGAL::CGAL;aggrelod::module")
