@@ -233,12 +233,13 @@ TEST(OutputSet, ABakeKilledAtAnyMomentLeavesTheOldOrTheNewSet) {
 TEST(OutputSet, ManifestNamesEveryFileOfTheSet) {
     const fs::path dir = freshTestDir(currentTestName());
     writeFile(dir / "in.glb", threeCubes());
-    const RunResult r = bake(dir / "in.glb", dir / "out", dir, {"--levels", "2", "--tiles", "--stats", (dir / "out" / "stats.json").string()});
+    const RunResult r = bake(dir / "in.glb", dir / "out", dir,
+                             {"--levels", "2", "--tiles", "--collision", "--stats", (dir / "out" / "stats.json").string()});
     ASSERT_EQ(r.exitCode, 0) << r.describe();
     const SeenSet seen = readThroughManifest(dir / "out");
     ASSERT_EQ(seen.check.status, io::SetCheck::Status::Complete) << seen.check.problem;
     EXPECT_FALSE(seen.check.moved);
-    for (const char* name : {"levels.glb", "proxies.glb", "scene.aglod", "stats.json", "tiles/tileset.json"})
+    for (const char* name : {"levels.glb", "proxies.glb", "scene.aglod", "collision.glb", "stats.json", "tiles/tileset.json"})
         EXPECT_EQ(seen.files.count(name), 1u) << name;
     size_t tiles = 0;
     for (const auto& [name, bytes] : seen.files) {
@@ -296,7 +297,8 @@ TEST(OutputSet, AKillAfterEveryStepOfTheCommitLeavesTheOldOrTheNewSet) {
         std::vector<std::string> newOptions;
     };
     const std::vector<Scenario> scenarios = {
-        {"tiles and stats", {"--levels", "2", "--tiles", statsInside}, {"--levels", "3", "--tiles", statsInside}},
+        {"tiles, collision and stats", {"--levels", "2", "--tiles", "--collision", statsInside},
+         {"--levels", "3", "--tiles", "--collision", statsInside}},
         {"fresh OUTDIR", {}, {"--levels", "3", "--tiles"}},
         {"tiles added, stats elsewhere", {"--levels", "2"}, {"--levels", "3", "--tiles", "--stats", (dir / "stats.json").string()}},
     };
