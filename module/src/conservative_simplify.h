@@ -23,7 +23,9 @@ struct ConservativeSimplifyResult {
 /// Collapses run cheapest first while their accumulated estimate stays <= maxError (world
 /// units) and the mesh has more than minTriangles triangles. Collapses that would make the
 /// mesh non-manifold, fold a face over (normal turned by more than ~70 degrees) or reduce a
-/// shell below a tetrahedron are skipped; vertices that share their position with another
+/// shell below a tetrahedron are skipped, and so are collapses that would give a vertex
+/// more than 24 neighbours (flat regions would otherwise become fans, whose cost grows with
+/// every collapse near them); vertices that share their position with another
 /// vertex (a solid touching itself at a point or edge) never move.
 /// positions: 3 * vertexCount doubles; indices: 3 * triangleCount, each < vertexCount.
 /// Output: the used vertices only, numbered by first use. Deterministic, single thread.

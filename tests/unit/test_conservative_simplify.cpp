@@ -3,11 +3,15 @@
 // encloses its input and really is coarser (module/src/conservative_simplify.cpp).
 #include "conservative_simplify.h"
 #include "mesh_distance.h"
+#include "solidify.h"
 #include "test_support.h"
 
 #include <aggrelod/samples.h>
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
 
 namespace aggrelod::testing {
 namespace {
@@ -111,6 +115,34 @@ TEST(ConservativeSimplify, SeriesSnapshotsAreNestedAndCoarsening) {
         EXPECT_EQ(pos, snapshots[i].positions);
         EXPECT_EQ(idx, snapshots[i].indices);
     }
+}
+
+// An alpha wrap has thousands of nearly coplanar triangles on every flat side of what it
+// wraps. Collapsing them cheapest first would end in fans around single vertices, and every
+// collapse near a fan costs in proportion to it; no vertex the simplifier moves gets more
+// than 24 neighbours, and the result still encloses the wrap.
+TEST(ConservativeSimplify, FlatSidesOfAWrapDoNotBecomeFans) {
+    InputObject openBox = samples::makeBox("box", {0, 0, 0}, {1, 1, 1});
+    openBox.indices.resize(openBox.indices.size() - 3);  // one triangle missing: open
+    std::vector<double> wrap;
+    std::vector<uint32_t> wrapIdx;
+    std::string error;
+    ASSERT_TRUE(detail::alphaWrap(openBox.positions, openBox.indices, 0.05, 0.01, wrap, wrapIdx, error)) << error;
+    ASSERT_GT(wrapIdx.size() / 3, 5000u);
+    std::vector<double> pos;
+    std::vector<uint32_t> idx;
+    detail::simplifyConservative(wrap, wrapIdx, 0.005, 0, pos, idx);
+    EXPECT_LT(idx.size(), wrapIdx.size() / 3);
+    std::vector<std::set<uint32_t>> neighbours(pos.size() / 3);
+    for (size_t t = 0; t < idx.size(); t += 3)
+        for (int k = 0; k < 3; ++k) {
+            neighbours[idx[t + k]].insert(idx[t + (k + 1) % 3]);
+            neighbours[idx[t + (k + 1) % 3]].insert(idx[t + k]);
+        }
+    size_t most = 0;
+    for (const auto& n : neighbours) most = std::max(most, n.size());
+    EXPECT_LE(most, 24u);
+    expectValidEnclosure(asObject(wrap, wrapIdx), pos, idx);
 }
 
 TEST(ConservativeSimplify, ZeroErrorKeepsTheMesh) {
