@@ -163,7 +163,7 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
         ->check(CLI::Range(0, 1000));
     cmd->add_option("--solidify", o.solidify,
                     "What stands in for objects that are not closed solids (open, non-manifold, self-intersecting, "
-                    "touching): wrap (default: a tight watertight alpha wrap), hull (convex hull) or off (left out)")
+                    "touching): wrap (default: the exact union of touching closed solids, else a tight watertight alpha wrap), hull (convex hull) or off (left out)")
         ->transform(CLI::IsMember({"wrap", "hull", "off"}, CLI::ignore_case));
     cmd->add_option("--wrap-offset", o.wrapOffset,
                     "Distance of the wrap from the original surface, in scene units (default: automatic, see "

@@ -259,7 +259,9 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
         std::string names;
         for (size_t i = 0; i < r.objects.size(); ++i) names += (i ? ", " : "") + objects[r.objects[i]].name;
         w.fieldStr("objects", names);
-        w.fieldStr("method", r.method == SolidifyMethod::Wrap ? "alpha_wrap" : "convex_hull");
+        w.fieldStr("method", r.method == SolidifyMethod::Wrap    ? "alpha_wrap"
+                            : r.method == SolidifyMethod::Union ? "boolean_union"
+                                                                : "convex_hull");
         w.fieldStr("reason", r.reason);
         w.field("alpha", r.alpha);
         w.field("offset", r.offset);

@@ -113,7 +113,7 @@ struct Model {
     std::vector<uint32_t> objects;    ///< ascending input indices
     /// What the surface given to the triangulator is: the objects' own faces, or a solid
     /// standing in for them (DESIGN 2.0).
-    enum class Kind { Original, Wrap, Hull } kind = Kind::Original;
+    enum class Kind { Original, Union, Wrap, Hull } kind = Kind::Original;
     bool standIn() const { return kind != Kind::Original; }
     std::string reason;               ///< why it is solidified
     double alpha = 0, offset = 0;     ///< wrap parameters
@@ -225,6 +225,7 @@ private:
     void solidifyNestedLast(const std::vector<size_t>& which, const std::vector<std::string>& why);
     void objectsBounds(const std::vector<uint32_t>& objects, double box[6]) const;
     double nearestGap(const Model& m, double limit) const;
+    bool uniteClosedParts(Model& m) const;
     void detectSupport();
     void measureSolids();
     std::vector<TriangleBvh> objectBvh_;  ///< per prepared object (built in buildModels)
@@ -395,7 +396,9 @@ void Baker::measureSolids() {
         const Model& m = models_[which[k]];
         SolidReport& r = reports[k];
         r.objects = m.objects;
-        r.method = m.kind == Model::Kind::Wrap ? SolidifyMethod::Wrap : SolidifyMethod::Hull;
+        r.method = m.kind == Model::Kind::Union ? SolidifyMethod::Union
+                   : m.kind == Model::Kind::Wrap ? SolidifyMethod::Wrap
+                                                 : SolidifyMethod::Hull;
         r.reason = m.reason;
         r.alpha = m.alpha;
         r.offset = m.offset;
@@ -421,7 +424,7 @@ void Baker::measureSolids() {
         std::vector<Diagnostic> ignored;
         detail::prepareObject(solid, 0.0, check, ignored);
         r.closedManifold = check.validSolid();
-        if (settings_.computeHullBaseline && r.method == SolidifyMethod::Wrap) {
+        if (settings_.computeHullBaseline && r.method != SolidifyMethod::Hull) {
             std::vector<double> hp;
             std::vector<uint32_t> ht;
             if (detail::convexHull3(pts, hp, ht)) {
@@ -460,6 +463,42 @@ double windingNumber(const std::vector<double>& p, const std::vector<uint32_t>& 
         total += 2.0 * std::atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
     }
     return total / (4.0 * M_PI);
+}
+
+// Objects that are valid solids alone but touch or cross each other: their exact union as
+// the model's surface when it is one closed, edge-manifold shell that does not cross itself
+// after rounding (the tightest solid: its surface lies on theirs). False leaves m unchanged.
+bool Baker::uniteClosedParts(Model& m) const {
+    std::vector<const std::vector<double>*> positions;
+    std::vector<const std::vector<uint32_t>*> triangles;
+    for (uint32_t o : m.objects) {
+        positions.push_back(&prepared_[o].positions);
+        triangles.push_back(&prepared_[o].triangles);
+    }
+    std::vector<double> p;
+    std::vector<uint32_t> t;
+    std::string error;
+    if (!detail::exactUnion(positions, triangles, p, t, error)) return false;
+    InputObject united;
+    united.positions = std::move(p);
+    united.indices = std::move(t);
+    PreparedObject check;
+    std::vector<Diagnostic> ignored;
+    detail::prepareObject(united, 0.0, check, ignored);
+    if (!check.validSolid() || check.positions.size() != united.positions.size() ||
+        check.triangles.size() != united.indices.size() || detail::selfIntersects(check.positions, check.triangles))
+        return false;
+    // One shell: parts that only come near each other stay for the wrap to join.
+    DisjointSets shells(check.positions.size() / 3);
+    size_t pieces = check.positions.size() / 3;
+    for (size_t i = 0; i + 2 < check.triangles.size(); i += 3)
+        for (int k = 1; k < 3; ++k) pieces -= shells.unite(check.triangles[i], check.triangles[i + k]) ? 1 : 0;
+    if (pieces != 1) return false;
+    m.positions = std::move(check.positions);
+    m.triangles = std::move(check.triangles);
+    m.kind = Model::Kind::Union;
+    m.alpha = m.offset = 0;
+    return true;
 }
 
 // Distance from the original surfaces of m's objects to the nearest other model's objects,
@@ -519,6 +558,8 @@ void Baker::solidifyModels(const std::vector<size_t>& which, const std::vector<s
         std::vector<double> pts;
         std::vector<uint32_t> tris;
         concatenateMeshes(prepared_, m.objects, pts, tris);
+        const bool closed = std::all_of(m.objects.begin(), m.objects.end(), [&](uint32_t o) { return prepared_[o].validSolid(); });
+        if (settings_.solidify == SolidifyMethod::Wrap && closed && m.objects.size() > 1 && uniteClosedParts(m)) return;
         if (settings_.solidify == SolidifyMethod::Wrap) {
             double b[6];
             computeBounds(pts, b);
@@ -536,7 +577,6 @@ void Baker::solidifyModels(const std::vector<size_t>& which, const std::vector<s
             // themselves or each other have their shape in their own faces: the wrap only has
             // to join them, and 3 % keeps it within about 0.6 % (truck_town's ramps) at a
             // quarter of the cost.
-            const bool closed = std::all_of(m.objects.begin(), m.objects.end(), [&](uint32_t o) { return prepared_[o].validSolid(); });
             const double alpha = std::max((closed ? 0.03 : 0.015) * size, 2 * offset);
             std::string error;
             if (size > 0 && detail::alphaWrap(pts, tris, alpha, offset, m.positions, m.triangles, error)) {
@@ -583,7 +623,10 @@ void Baker::solidifyModels(const std::vector<size_t>& which, const std::vector<s
             m.objects.clear();
             continue;
         }
-        if (m.kind == Model::Kind::Wrap)
+        if (m.kind == Model::Kind::Union)
+            diag(out_, Diagnostic::Severity::Note, names,
+                 why[k] + "; solidified by their exact boolean union for the triangulation");
+        else if (m.kind == Model::Kind::Wrap)
             diag(out_, Diagnostic::Severity::Note, names,
                  why[k] + "; solidified by an alpha wrap (alpha " + fmt(m.alpha) + ", offset " + fmt(m.offset) +
                      ") for the triangulation");
@@ -705,7 +748,7 @@ void Baker::solidifyNestedLast(const std::vector<size_t>& which, const std::vect
         objectsBounds(inner.objects, b);
         for (size_t f : first) {
             const Model& outer = models_[f];
-            if (outer.kind != Model::Kind::Wrap || outer.objects.empty()) continue;
+            if ((outer.kind != Model::Kind::Wrap && outer.kind != Model::Kind::Union) || outer.objects.empty()) continue;
             double ob[6];
             computeBounds(outer.positions, ob);
             bool boxInside = true;

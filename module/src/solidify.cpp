@@ -1,10 +1,17 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Solidification by CGAL 3D Alpha Wrapping (Portaneri et al., "Alpha Wrapping with an
-// Offset", ACM TOG 41(4), 2022; CGAL 5.5 `CGAL::alpha_wrap_3`). The only translation unit
-// that includes the alpha-wrap headers (they are heavy: keep them here).
+// Offset", ACM TOG 41(4), 2022; CGAL 5.5 `CGAL::alpha_wrap_3`) and by the exact boolean union
+// of closed parts (CGAL Polygon Mesh Processing corefinement, Loriot, Tournois, Yaz, "Polygon
+// mesh processing", CGAL 5.5 manual). The only translation unit that includes these headers
+// (they are heavy: keep them here).
 #include "solidify.h"
 
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/alpha_wrap_3.h>
 
@@ -13,6 +20,41 @@
 #include <exception>
 
 namespace aggrelod::detail {
+
+namespace {
+
+/// Vertices and triangles of a triangle Surface_mesh without removed elements, in index
+/// order (deterministic: the order the algorithm created them). False on a face that is not
+/// a triangle.
+template <class Mesh>
+bool meshToArrays(const Mesh& mesh, std::vector<double>& outPositions, std::vector<uint32_t>& outTriangles) {
+    outPositions.clear();
+    outTriangles.clear();
+    outPositions.reserve(3 * mesh.number_of_vertices());
+    std::vector<uint32_t> index(mesh.num_vertices(), UINT32_MAX);
+    uint32_t next = 0;
+    for (typename Mesh::Vertex_index v : mesh.vertices()) {
+        const auto& p = mesh.point(v);
+        index[v.idx()] = next++;
+        outPositions.push_back(CGAL::to_double(p.x()));
+        outPositions.push_back(CGAL::to_double(p.y()));
+        outPositions.push_back(CGAL::to_double(p.z()));
+    }
+    outTriangles.reserve(3 * mesh.number_of_faces());
+    for (typename Mesh::Face_index f : mesh.faces()) {
+        size_t corners = 0;
+        for (typename Mesh::Vertex_index v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            if (corners++ < 3) outTriangles.push_back(index[v.idx()]);
+        if (corners != 3) {
+            outPositions.clear();
+            outTriangles.clear();
+            return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace
 
 bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double alpha,
                double offset, std::vector<double>& outPositions, std::vector<uint32_t>& outTriangles,
@@ -62,28 +104,82 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
     }
     // Surface_mesh indices are dense after a fresh build (no removed elements), in the order
     // the wrap created them: deterministic.
-    outPositions.reserve(3 * wrap.number_of_vertices());
-    std::vector<uint32_t> index(wrap.num_vertices(), UINT32_MAX);
-    uint32_t next = 0;
-    for (Mesh::Vertex_index v : wrap.vertices()) {
-        const Point& p = wrap.point(v);
-        index[v.idx()] = next++;
-        outPositions.push_back(p.x());
-        outPositions.push_back(p.y());
-        outPositions.push_back(p.z());
+    if (!meshToArrays(wrap, outPositions, outTriangles)) {
+        error = "alpha wrap gave a non-triangle face";
+        return false;
     }
-    outTriangles.reserve(3 * wrap.number_of_faces());
-    for (Mesh::Face_index f : wrap.faces()) {
-        size_t corners = 0;
-        for (Mesh::Vertex_index v : CGAL::vertices_around_face(wrap.halfedge(f), wrap)) {
-            if (corners++ < 3) outTriangles.push_back(index[v.idx()]);
+    return true;
+}
+
+bool exactUnion(const std::vector<const std::vector<double>*>& positions,
+                const std::vector<const std::vector<uint32_t>*>& triangles, std::vector<double>& outPositions,
+                std::vector<uint32_t>& outTriangles, std::string& error) {
+    namespace PMP = CGAL::Polygon_mesh_processing;
+    using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
+    using Point = Kernel::Point_3;
+    using Mesh = CGAL::Surface_mesh<Point>;
+    outPositions.clear();
+    outTriangles.clear();
+    if (positions.empty() || positions.size() != triangles.size()) {
+        error = "no parts to unite";
+        return false;
+    }
+    try {
+        Mesh result;
+        for (size_t part = 0; part < positions.size(); ++part) {
+            const std::vector<double>& p = *positions[part];
+            const std::vector<uint32_t>& t = *triangles[part];
+            const size_t n = p.size() / 3;
+            std::vector<Point> points;
+            points.reserve(n);
+            for (size_t i = 0; i < n; ++i) {
+                if (!std::isfinite(p[3 * i]) || !std::isfinite(p[3 * i + 1]) || !std::isfinite(p[3 * i + 2])) {
+                    error = "a coordinate is not finite";
+                    return false;
+                }
+                points.emplace_back(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+            }
+            std::vector<std::array<size_t, 3>> faces;
+            faces.reserve(t.size() / 3);
+            for (size_t k = 0; k + 2 < t.size(); k += 3) {
+                if (t[k] >= n || t[k + 1] >= n || t[k + 2] >= n) {
+                    error = "triangle index out of range";
+                    return false;
+                }
+                faces.push_back({t[k], t[k + 1], t[k + 2]});
+            }
+            Mesh mesh;
+            if (!PMP::is_polygon_soup_a_polygon_mesh(faces)) {
+                error = "part " + std::to_string(part) + " is not a manifold mesh";
+                return false;
+            }
+            PMP::polygon_soup_to_polygon_mesh(points, faces, mesh);
+            // Corefinement needs parts that bound a volume and do not cross themselves.
+            if (!CGAL::is_closed(mesh) || PMP::does_self_intersect(mesh) || !PMP::does_bound_a_volume(mesh)) {
+                error = "part " + std::to_string(part) + " crosses itself or bounds no volume";
+                return false;
+            }
+            if (part == 0) {
+                result = std::move(mesh);
+                continue;
+            }
+            Mesh united;
+            if (!PMP::corefine_and_compute_union(result, mesh, united)) {
+                error = "the union is not a manifold surface (parts touch along an edge or at a point)";
+                return false;
+            }
+            result = std::move(united);
         }
-        if (corners != 3) {
-            error = "alpha wrap gave a non-triangle face";
-            outPositions.clear();
-            outTriangles.clear();
+        result.collect_garbage();
+        if (!meshToArrays(result, outPositions, outTriangles)) {
+            error = "the union has a non-triangle face";
             return false;
         }
+    } catch (const std::exception& e) {
+        error = std::string("boolean union failed: ") + e.what();
+        outPositions.clear();
+        outTriangles.clear();
+        return false;
     }
     return true;
 }

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Solidification of objects that are not valid closed solids (DESIGN 2.0 "Solidify"):
-// CGAL 3D Alpha Wrapping (Portaneri, Rouxel-Labbé, Hemmer, Cohen-Steiner, Alliez,
-// "Alpha Wrapping with an Offset", ACM TOG 41(4), 2022), CGAL 5.5 `alpha_wrap_3`, GPL-3+:
+// the exact union of touching closed parts (CGAL corefinement), and CGAL 3D Alpha Wrapping
+// (Portaneri, Rouxel-Labbé, Hemmer, Cohen-Steiner, Alliez, "Alpha Wrapping with an Offset",
+// ACM TOG 41(4), 2022), CGAL 5.5 `alpha_wrap_3`, GPL-3+:
 // bake side only. This header keeps CGAL out of its users; solidify.cpp is the one
 // translation unit that includes it.
 #pragma once
@@ -23,5 +24,18 @@ namespace aggrelod::detail {
 bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double alpha,
                double offset, std::vector<double>& outPositions, std::vector<uint32_t>& outTriangles,
                std::string& error);
+
+/// The exact boolean union of closed parts (CGAL corefinement in exact arithmetic, rounded to
+/// doubles at the end): for objects that are valid solids on their own but touch or cross
+/// each other, the tightest solid there is (its surface lies on theirs).
+/// positions[i], triangles[i]: part i, as alphaWrap's input; each must be closed,
+/// edge-manifold, free of self-intersections and bound a volume. Output as alphaWrap's, in
+/// the order the corefinement made it (deterministic). Returns false with a reason in
+/// `error` (never throws) when a part is not such a solid or the union is not a manifold
+/// surface (parts meeting along an edge or at a point). The rounding of new vertices can
+/// leave the output crossing itself: the caller checks it.
+bool exactUnion(const std::vector<const std::vector<double>*>& positions,
+                const std::vector<const std::vector<uint32_t>*>& triangles, std::vector<double>& outPositions,
+                std::vector<uint32_t>& outTriangles, std::string& error);
 
 }  // namespace aggrelod::detail

@@ -8,6 +8,7 @@
 #include "test_support.h"
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/samples.h>
 
 #include <gtest/gtest.h>
 
@@ -167,6 +168,37 @@ TEST(RealArt, TruckTownSolidsAreTightAndClosed) {
         }
     }
     EXPECT_EQ(houses, 10u);
+}
+
+// Closed solids that cross each other (boxes pushed into one another, as stacked crates or
+// CAD parts are): their exact union, which adds no volume and whose surface lies on theirs;
+// a box apart stays its own model. Parts that only meet along an edge go to the wrap.
+TEST(RealArt, CrossingClosedSolidsBecomeTheirExactUnion) {
+    std::vector<InputObject> objects = {samples::makeBox("a", {0, 0, 0}, {1, 1, 1}, 0.25),
+                                        samples::makeBox("b", {0.5, 0.5, 0.5}, {1.5, 1.5, 1.5}, 0.25),
+                                        samples::makeBox("c", {4, 0, 0}, {5, 1, 1}),
+                                        samples::makeBox("d", {8, 0, 0}, {9, 1, 1}),
+                                        samples::makeBox("e", {9, 1, 0}, {10, 2, 1})};
+    Settings3D settings;
+    settings.automaticLevelCount = 2;
+    Hierarchy3D h;
+    ASSERT_TRUE(buildHierarchy3D(objects, settings, h));
+    ASSERT_EQ(h.solids.size(), 2u);
+    const SolidReport& united = h.solids[0];
+    EXPECT_EQ(united.objects, (std::vector<uint32_t>{0, 1}));
+    EXPECT_EQ(united.method, SolidifyMethod::Union);
+    EXPECT_TRUE(united.closedManifold);
+    EXPECT_NEAR(united.volumeSolid, 2 - 0.125, 1e-9);
+    EXPECT_LE(united.distanceSolidToOriginal, 1e-12);
+    InputObject solid;
+    solid.positions = united.positions;
+    solid.indices = united.triangles;
+    EXPECT_EQ(checkClosedAfterWeld(solid).problem, "");
+    // The edge-touching pair is not a manifold union: wrapped.
+    EXPECT_EQ(h.solids[1].objects, (std::vector<uint32_t>{3, 4}));
+    EXPECT_EQ(h.solids[1].method, SolidifyMethod::Wrap);
+    EXPECT_EQ(h.objectModel[0], h.objectModel[1]);
+    EXPECT_NE(h.objectModel[0], h.objectModel[2]);
 }
 
 TEST(RealArt, HullOnlyWhenAsked) {

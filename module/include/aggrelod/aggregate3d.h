@@ -46,7 +46,10 @@ enum class DistanceMode {
 enum class SolidifyMethod {
     Wrap,  ///< a tight watertight wrap containing it (CGAL alpha wrap; default)
     Hull,  ///< its convex hull
-    Off    ///< nothing: such objects are left out of aggregation (passed through as support)
+    Off,   ///< nothing: such objects are left out of aggregation (passed through as support)
+    /// (reported in SolidReport only) the exact boolean union of objects that are closed
+    /// solids alone but touch or cross each other; Wrap tries it first for them.
+    Union
 };
 
 /// How support surfaces (ground, terrain, sky dome, road network, room shell) are found.
