@@ -156,6 +156,11 @@ inline bool segmentCrossesTriangle(const Vec3& p, const Vec3& q, const Vec3& t0,
     double sp = dot(n, p - t0), sq = dot(n, q - t0);
     if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0)) return false;
     if (sp == 0 && sq == 0) return false;  // in the plane, or degenerate triangle (n = 0)
+    // In the plane up to rounding (as nearPlane): the signs below would be noise and would
+    // see a crossing wherever the segment's line passes near the triangle in its plane.
+    const double L2 = std::max({dist2(p, q), dist2(t0, t1), dist2(t1, t2), dist2(t2, t0)});
+    const double tolerance2 = 1e-24 * dot(n, n) * L2;
+    if (sp * sp <= tolerance2 && sq * sq <= tolerance2) return false;
     Vec3 d = q - p;
     Vec3 a = t0 - p, b = t1 - p, c = t2 - p;
     double o0 = dot(d, cross(a, b)), o1 = dot(d, cross(b, c)), o2 = dot(d, cross(c, a));
@@ -223,10 +228,22 @@ inline bool nearPlane(const Vec3 P[3], const Vec3& t0, const Vec3& n, double L2)
 double triangleTriangle2(const Vec3 A[3], const Vec3 B[3], Vec3& outA, Vec3& outB) {
     Vec3 nA = cross(A[1] - A[0], A[2] - A[0]);
     Vec3 nB = cross(B[1] - B[0], B[2] - B[0]);
-
-    // 1. An edge of one triangle crossing the other.
-    Vec3 x;
+    double L2 = 0;
     for (int i = 0; i < 3; ++i) {
+        L2 = std::max(L2, dist2(A[i], A[(i + 1) % 3]));
+        L2 = std::max(L2, dist2(B[i], B[(i + 1) % 3]));
+    }
+    int coplanarAxis = -1;  // >= 0: both in one plane (up to rounding), the axis to drop
+    if (nearPlane(A, B[0], nB, L2))
+        coplanarAxis = dominantAxis(nB);
+    else if (nearPlane(B, A[0], nA, L2))
+        coplanarAxis = dominantAxis(nA);
+
+    // 1. An edge of one triangle crossing the other. Not for coplanar triangles: there the
+    // signs of the side and orientation tests are rounding noise, and would see crossings
+    // between triangles that lie apart in their common plane.
+    Vec3 x;
+    for (int i = 0; i < 3 && coplanarAxis < 0; ++i) {
         if (segmentCrossesTriangle(A[i], A[(i + 1) % 3], B[0], B[1], B[2], nB, x) ||
             segmentCrossesTriangle(B[i], B[(i + 1) % 3], A[0], A[1], A[2], nA, x)) {
             outA = outB = x;
@@ -272,17 +289,7 @@ double triangleTriangle2(const Vec3 A[3], const Vec3 B[3], Vec3& outA, Vec3& out
     }
 
     // 3. Coplanar overlap (crossings inside the common plane are not seen by step 1).
-    double L2 = 0;
-    for (int i = 0; i < 3; ++i) {
-        L2 = std::max(L2, dist2(A[i], A[(i + 1) % 3]));
-        L2 = std::max(L2, dist2(B[i], B[(i + 1) % 3]));
-    }
-    int axis = -1;
-    if (nearPlane(A, B[0], nB, L2))
-        axis = dominantAxis(nB);
-    else if (nearPlane(B, A[0], nA, L2))
-        axis = dominantAxis(nA);
-    if (axis >= 0 && overlap2D(A, B, axis)) {
+    if (coplanarAxis >= 0 && overlap2D(A, B, coplanarAxis)) {
         outB = outA;
         return 0;
     }

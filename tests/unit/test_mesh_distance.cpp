@@ -300,6 +300,38 @@ TEST(MeshDistancePrimitives, TriangleTriangleRotatedCoplanarOverlap) {
     EXPECT_TRUE(inter);
 }
 
+// Pairs from the side and top faces of a rotated generated box (a mesh that does not cross
+// itself): an edge of one triangle lies in the plane of the other, on the line of its edge,
+// and the rounding noise of the side tests used to count that as a crossing.
+TEST(MeshDistancePrimitives, TriangleTriangleEdgeInTheOtherPlaneIsNoCrossing) {
+    const double side[9] = {12.39478509518012, -6.2757406528578841, 4.3551169703244552,
+                            12.186235661723968, -6.1722718991705534, 4.3551169703244552,
+                            12.186235661723968, -6.1722718991705534, 4.5893663581302215};
+    const double top[9] = {11.977686228267817, -6.0688031454832236, 4.5893663581302215,
+                           11.769136794811665, -5.965334391795893, 4.5893663581302215,
+                           11.664184656698058, -6.1768737035551355, 4.5893663581302215};
+    double pa[3], pb[3];
+    bool inter = true;
+    const double d = triangleTriangleDistance(side, side + 3, side + 6, top, top + 3, top + 6, pa, pb, &inter);
+    EXPECT_FALSE(inter);
+    EXPECT_NEAR(d, 0.232806, 1e-6);
+    inter = true;
+    EXPECT_NEAR(triangleTriangleDistance(top, top + 3, top + 6, side, side + 3, side + 6, pa, pb, &inter), d, 1e-12);
+    EXPECT_FALSE(inter);
+    // Two triangles of one vertical face, apart in their common plane.
+    const double low[9] = {13.24986546348652, -3.0300803290803318, 1.543487077459887,
+                           13.244200621978434, -2.7160081806265213, 1.543487077459887,
+                           13.244200621978434, -2.7160081806265213, 1.8473885164430843};
+    const double high[9] = {13.24986546348652, -3.0300803290803318, 2.4551913944094794,
+                            13.244200621978434, -2.7160081806265213, 2.7590928333926765,
+                            13.24986546348652, -3.0300803290803318, 2.7590928333926765};
+    inter = true;
+    // At least their gap in z apart.
+    EXPECT_GT(triangleTriangleDistance(low, low + 3, low + 6, high, high + 3, high + 6, pa, pb, &inter),
+              2.4551913944094794 - 1.8473885164430843);
+    EXPECT_FALSE(inter);
+}
+
 TEST(MeshDistancePrimitives, TriangleTriangleDegenerate) {
     double pa[3], pb[3];
     bool inter = false;
