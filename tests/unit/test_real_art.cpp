@@ -40,7 +40,9 @@ const Baked& bakedAsGiven(const std::string& relative) {
     auto found = cache.find(relative);
     if (found != cache.end()) return found->second;
     Baked& b = cache[relative];
-    b.dir = freshTestDir("real_art_" + fs::path(relative).stem().string());
+    // One folder per test: CTest runs each test in a process of its own, two at a time, and
+    // several tests bake the same scene.
+    b.dir = freshTestDir("real_art_" + fs::path(relative).stem().string() + "_" + currentTestName());
     b.run = runProgram({AGGRELOD_CLI, "bake", sharedData(relative).string(), "-o", (b.dir / "out").string(), "--stats",
                         (b.dir / "stats.json").string()},
                        b.dir);
