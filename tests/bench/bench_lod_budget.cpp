@@ -19,7 +19,7 @@
 //
 // Usage: bench_lod_budget [--scenes random,forest,village,truck_town] [--seed 1]
 //          [--objects 400] [--triangles 200000] [--levels 8] [--threads 2] [--elevation 25]
-//          [--data DIR (holds 3d/truck_town/town_model.gltf)]
+//          [--data DIR (holds 3d/truck_town/town_model.gltf)] [--breakdown (the cut by node kind)]
 //        bench_lod_budget --cut-for FILE.aglod --cameras FRAMES.csv   (the cut per given camera,
 //          see lod_budget_cut_for.h)
 #include "acceptance_scenes.h"
@@ -64,6 +64,7 @@ struct Options {
     uint32_t seed = 1;
     int objects = 400, triangles = 200000, levels = 8, threads = 2;
     double elevationDegrees = 25;
+    bool breakdown = false;
     std::string data = AGGRELOD_SHARED_DATA;
 };
 
@@ -169,6 +170,11 @@ struct Row {
     int distance = 0;
     Cost originals, perObject, cut;
     double cutProxies = 0, cutLeaves = 0;
+    // --breakdown: the cut's triangles by node kind, beside (b)'s triangles for the same objects.
+    // [0] leaves, [1] per-object LOD, [2] one-object aggregates, [3] aggregates of several
+    // objects, [4] coarser versions.
+    double kindNodes[5] = {}, kindTriangles[5] = {}, kindPerObject[5] = {};
+    std::map<uint32_t, double> excess;  ///< --breakdown: (c) - (b) triangles per drawn node (leaf: ~object)
 };
 
 double median(std::vector<double> v) {
@@ -305,6 +311,7 @@ bool runScene(const Options& o, const std::string& name) {
             for (int c = 0; c < 3; ++c) camera.position[c] = float(eye[c]);
             camera.fovY = float(kFovY);
             camera.viewportHeight = kViewportHeight;
+            std::vector<double> perObjectChoice(objects.size(), 0.0);
             for (size_t i = 0; i < objects.size(); ++i) {
                 const size_t t = objects[i].indices.size() / 3;
                 row.originals.triangles += double(t);
@@ -317,6 +324,7 @@ bool runScene(const Options& o, const std::string& name) {
                     if (level.error * k / d <= kTau) best = std::min(best, level.triangles);
                 row.perObject.triangles += double(best);
                 row.perObject.drawCalls += t ? 1 : 0;
+                perObjectChoice[i] = double(best);
             }
             selector.reset();
             selector.selectFull(camera, settings);
@@ -324,6 +332,25 @@ bool runScene(const Options& o, const std::string& name) {
             for (uint32_t obj : selector.originalObjects()) row.cut.triangles += double(objects[obj].indices.size() / 3);
             row.cutProxies += double(selector.proxyNodes().size);
             row.cutLeaves += double(selector.originalObjects().size);
+            for (uint32_t n : selector.proxyNodes()) {
+                const runtime::NodeRecord& r = file.node(n);
+                const int kind = r.level == runtime::kObjectLodLevel ? 1
+                                 : r.level == runtime::kCoarserLevel ? 4
+                                 : r.sourceCount == 1               ? 2
+                                                                    : 3;
+                row.kindNodes[kind] += 1;
+                row.kindTriangles[kind] += double(file.triangles(n).size / 3);
+                double b = 0;
+                for (uint32_t obj : file.sources(n)) b += perObjectChoice[obj];
+                row.kindPerObject[kind] += b;
+                row.excess[n] += double(file.triangles(n).size / 3) - b;
+            }
+            for (uint32_t obj : selector.originalObjects()) {
+                row.kindNodes[0] += 1;
+                row.kindTriangles[0] += double(objects[obj].indices.size() / 3);
+                row.kindPerObject[0] += perObjectChoice[obj];
+                row.excess[~obj] += double(objects[obj].indices.size() / 3) - perObjectChoice[obj];
+            }
         }
         for (Cost* c : {&row.originals, &row.perObject, &row.cut}) {
             c->triangles /= kAzimuths;
@@ -332,6 +359,11 @@ bool runScene(const Options& o, const std::string& name) {
         row.cutProxies /= kAzimuths;
         row.cutLeaves /= kAzimuths;
         row.cut.drawCalls = row.cutProxies + row.cutLeaves;
+        for (int kind = 0; kind < 5; ++kind) {
+            row.kindNodes[kind] /= kAzimuths;
+            row.kindTriangles[kind] /= kAzimuths;
+            row.kindPerObject[kind] /= kAzimuths;
+        }
         rows.push_back(row);
     }
     std::printf("\nmeans per camera over %d azimuths, elevation %.0f deg, %d x %d px, fov 60 deg, tau %.0f px:\n",
@@ -344,6 +376,37 @@ bool runScene(const Options& o, const std::string& name) {
                     r.originals.triangles, r.originals.drawCalls, r.perObject.triangles, r.perObject.drawCalls,
                     r.cut.triangles, r.cut.drawCalls, r.cutProxies, r.cutLeaves, r.cut.triangles / r.perObject.triangles,
                     r.cut.drawCalls / r.originals.drawCalls);
+    if (o.breakdown) {
+        std::printf("\nthe cut by node kind: nodes, (c) triangles / (b) triangles of the same objects:\n");
+        std::printf("| distance | leaves | per-object LOD | one-object aggregates | aggregates | coarser versions |\n");
+        std::printf("|---:|---:|---:|---:|---:|---:|\n");
+        for (const Row& r : rows) {
+            std::printf("| %d |", r.distance);
+            for (int kind = 0; kind < 5; ++kind)
+                std::printf(" %.1f: %.0f / %.0f |", r.kindNodes[kind], r.kindTriangles[kind], r.kindPerObject[kind]);
+            std::printf("\n");
+        }
+        std::printf("\nnodes costing the most triangles over (b) for the same objects (mean per camera):\n");
+        const char* kindName[] = {"original", "per-object LOD", "aggregate", "coarser version"};
+        for (const Row& r : rows) {
+            std::vector<std::pair<double, uint32_t>> worst;
+            for (const auto& [node, e] : r.excess) worst.push_back({-e, node});
+            std::sort(worst.begin(), worst.end());
+            std::printf("%d diameters:", r.distance);
+            for (size_t j = 0; j < std::min<size_t>(worst.size(), 4); ++j) {
+                const uint32_t node = worst[j].second;
+                const bool leaf = node > file.nodeCount();
+                const uint32_t first = leaf ? ~node : file.sources(node)[0];
+                const uint32_t level = leaf ? 0 : file.node(node).level;
+                const int kind = leaf ? 0 : level == runtime::kObjectLodLevel ? 1 : level == runtime::kCoarserLevel ? 3 : 2;
+                std::printf(" %s %s (%u objects, %zu triangles, error %.3g) +%.0f;", kindName[kind],
+                            objects[first].name.c_str(), leaf ? 1u : file.node(node).sourceCount,
+                            leaf ? objects[first].indices.size() / 3 : file.triangles(node).size / 3,
+                            leaf ? 0.0 : double(file.node(node).geometricError), -worst[j].first / kAzimuths);
+            }
+            std::printf("\n");
+        }
+    }
     int pass = 0, fail = 0;
     auto goal = [&](bool ok, const std::string& text) {
         std::printf("%s  %s\n", ok ? "PASS" : "FAIL", text.c_str());
@@ -396,6 +459,10 @@ int main(int argc, char** argv) {
     std::string cutFor, cameras;  // --cut-for / --cameras (lod_budget_cut_for.h)
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
+        if (arg == "--breakdown") {
+            o.breakdown = true;
+            continue;
+        }
         const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
         if (!value) {
             std::fprintf(stderr, "%s: missing value\n", arg.c_str());
