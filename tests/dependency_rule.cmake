@@ -8,6 +8,8 @@
 # - no file under planning/ includes TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS,
 #   GLM, CLI11, stb or any header of module/, bake/ or samples/ (it may use the runtime with
 #   its collision part, OMPL and the standard library);
+# - no file under samples/ includes tinygltf, CLI11 or any header of bake/ (bake/ uses the
+#   samples' generators; the way back would make a cycle);
 # - (when samples/viewer exists) no file of the OpenGL viewer includes anything but the runtime's
 #   C API among the project's headers: no header of module/ or bake/, no C++ runtime header
 #   (aggrelod/...), none of the bake-side libraries or Embree;
@@ -17,7 +19,8 @@
 #   TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS, GLM, CLI11, stb, the module, the
 #   bake's libraries or executable or the samples' library, and the viewer (TARGETS_viewer)
 #   links none of the bake-side libraries, the module, the bake's or the samples' libraries,
-#   or Embree.
+#   or Embree; no target under samples/ links the bake's libraries or executables, CLI11 or
+#   tinygltf.
 # Prints every violation and fails (FATAL_ERROR) when there is one.
 cmake_minimum_required(VERSION 3.22)
 
@@ -126,6 +129,14 @@ if(EXISTS "${SOURCE_DIR}/planning")
     "(^|/)tetgen\\.h$|^CGAL/|^gmp|^mpfr|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|^CLI/|(^|/)stb_[a-z_]*\\.h$|(^|/)module/|(^|/)bake/|(^|/)samples/"
     "${_planning_forbidden_names}")
 endif()
+if(EXISTS "${SOURCE_DIR}/samples")
+  # A name that is also a samples header cannot be told apart: leave it out.
+  set(_samples_forbidden_names ${bake_headers})
+  if(_samples_forbidden_names AND samples_headers)
+    list(REMOVE_ITEM _samples_forbidden_names ${samples_headers})
+  endif()
+  check_includes(samples "(^|/)tiny_gltf\\.h$|^CLI/|(^|/)bake/" "${_samples_forbidden_names}")
+endif()
 if(EXISTS "${SOURCE_DIR}/samples/viewer")
   check_includes(samples/viewer
     "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|^embree|(^|/)module/|(^|/)bake/|^aggrelod/"
@@ -141,7 +152,8 @@ if(LINK_INFO)
   set(_forbidden_module "tinygltf|aggrelod_runtime|aggrelod::runtime|aggrelod_io")
   set(_forbidden_planning "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|cli11|pkgconfig::stb|stb_image|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_render|aggrelod_samples|aggrelod::samples|^aggrelod$|^aggrelod_asan$")
   set(_forbidden_viewer "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|embree|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples|aggrelod_render|aggrelod_planning|aggrelod_runtime_collision")
-  foreach(part runtime module planning viewer)
+  set(_forbidden_samples "tinygltf|cli11|aggrelod_io|aggrelod_render|^aggrelod$|^aggrelod_asan$|^aggrelod_make_sample$")
+  foreach(part runtime module planning samples viewer)
     set(count 0)
     foreach(t IN LISTS TARGETS_${part})
       set(links "${LINKS_${t}}")

@@ -289,12 +289,19 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
     }
 }
 
-/// Snapshot i of a chain's series when it is clean and at most 80 % of finerTriangles (else
-/// not worth a node), else null.
+/// A version is worth a node of its own when it has at most this share of the triangles of
+/// the finer one it would replace (a cut drawing it saves at least the rest).
+constexpr size_t kWorthNumerator = 9, kWorthDenominator = 10;
+bool lighterEnough(size_t triangles, size_t finerTriangles) {
+    return kWorthDenominator * triangles <= kWorthNumerator * finerTriangles;
+}
+
+/// Snapshot i of a chain's series when it is clean and lighter enough than finerTriangles
+/// (else not worth a node), else null.
 const detail::ConservativeSnapshot* lighterCleanSnapshot(EnclosureSeries& series, size_t i, size_t finerTriangles) {
-    if (5 * series.triangleCount(i) > 4 * finerTriangles) return nullptr;
+    if (!lighterEnough(series.triangleCount(i), finerTriangles)) return nullptr;
     const detail::ConservativeSnapshot* clean = series.clean(i);
-    if (!clean || 5 * (clean->indices.size() / 3) > 4 * finerTriangles) return nullptr;
+    if (!clean || !lighterEnough(clean->indices.size() / 3, finerTriangles)) return nullptr;
     return clean;
 }
 
@@ -316,8 +323,8 @@ size_t shellCount(size_t vertexCount, const std::vector<uint32_t>& triangles) {
 }
 
 /// The lightest chain through candidate versions of one node, finest first: by ascending
-/// certified error, a candidate is kept when it has at most 80 % of the triangles of the one
-/// kept before it (the first: of finerTriangles, the node's own), at most maxCount of them.
+/// certified error, a candidate is kept when it is lighter enough than the one kept before it
+/// (the first: than finerTriangles, the node's own), at most maxCount of them.
 /// A version with a larger error is selectable only from farther away, so of two errors the
 /// chain keeps both when the coarser one is lighter enough to be worth a node.
 std::vector<HierarchyNode> lightestChain(std::vector<HierarchyNode> candidates, size_t finerTriangles, int maxCount) {
@@ -331,7 +338,7 @@ std::vector<HierarchyNode> lightestChain(std::vector<HierarchyNode> candidates, 
     for (size_t i : order) {
         if (int(chain.size()) >= maxCount) break;
         const size_t triangles = candidates[i].indices.size() / 3;
-        if (5 * triangles > 4 * finerTriangles) continue;
+        if (!lighterEnough(triangles, finerTriangles)) continue;
         finerTriangles = triangles;
         chain.push_back(std::move(candidates[i]));
     }
@@ -382,8 +389,8 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
     for (size_t i = 0; i < series.size(); ++i) {
         const double budget = 2 * targets[i], tolerance = settings.toleranceFraction * targets[i];
         HierarchyNode p;
-        if (polytopes && polytopes->coarsestWithin(std::min(budget, std::nextafter(ceiling, 0.0)), 4 * objectTriangles / 5,
-                                                   tolerance, p)) {
+        if (polytopes && polytopes->coarsestWithin(std::min(budget, std::nextafter(ceiling, 0.0)),
+                                                   kWorthNumerator * objectTriangles / kWorthDenominator, tolerance, p)) {
             p.budget = budget;
             candidates.push_back(std::move(p));
         }
@@ -455,7 +462,7 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
         const double budget = own + 2 * allowances[i], tolerance = settings.toleranceFraction * (own + allowances[i]);
         HierarchyNode p;
         if (polytopes && polytopes->coarsestWithin(std::min(budget, std::nextafter(ceiling, 0.0)),
-                                                   4 * (proxy.indices.size() / 3) / 5, tolerance, p)) {
+                                                   kWorthNumerator * (proxy.indices.size() / 3) / kWorthDenominator, tolerance, p)) {
             p.budget = budget;
             candidates.push_back(std::move(p));
         }

@@ -111,6 +111,10 @@ struct CollisionWorld::Impl {
         }
         rtcSetDeviceErrorFunction(device, &Impl::onError, this);
         scene = rtcNewScene(device);
+        // Watertight ray/triangle tests: in the fast default mode a ray through the shared
+        // edge or corner of two triangles can miss both and pass through a closed proxy,
+        // which breaks the promise that nothing reaches an original without touching it.
+        if (scene) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
     }
     ~Impl() {
         if (geometry) rtcReleaseGeometry(geometry);

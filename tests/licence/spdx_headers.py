@@ -42,6 +42,7 @@ MIT_FILES = {
     "tests/unit/test_runtime_format.cpp",
     "tests/unit/test_runtime_mapped_file.cpp",
     "tests/unit/test_runtime_selection.cpp",
+    "tests/unit/test_selection_allocations.cpp",
 }
 # Source files everywhere in these folders (and the top-level CMakeLists.txt) carry the line.
 SCOPE = ("runtime/", "module/", "bake/", "planning/", "samples/", "tests/", "cmake/")

@@ -4,6 +4,8 @@
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/samples.h>
 
+#include "mesh_checks.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,36 +20,13 @@ namespace {
 // Every undirected edge used exactly twice, once in each direction (closed, edge-manifold,
 // consistently oriented), and positive volume (outward).
 ::testing::AssertionResult isClosedManifoldOutward(const Aggregate& a) {
-    std::map<std::pair<uint32_t, uint32_t>, int> directed;
-    for (size_t t = 0; t < a.indices.size(); t += 3)
-        for (int k = 0; k < 3; ++k) {
-            uint32_t u = a.indices[t + k], v = a.indices[t + (k + 1) % 3];
-            if (u == v) return ::testing::AssertionFailure() << "degenerate triangle " << t / 3;
-            if (++directed[{u, v}] > 1) return ::testing::AssertionFailure() << "directed edge used twice";
-        }
-    for (const auto& [e, n] : directed)
-        if (!directed.count({e.second, e.first})) return ::testing::AssertionFailure() << "open edge " << e.first << "-" << e.second;
+    const std::string problem = aggrelod::testing::edgeManifoldProblem(a.indices);
+    if (!problem.empty()) return ::testing::AssertionFailure() << problem;
     if (!(a.measures.volume > 0)) return ::testing::AssertionFailure() << "volume " << a.measures.volume;
     return ::testing::AssertionSuccess();
 }
 
-// Generalized winding number of a closed mesh at q (1 inside, 0 outside).
-double windingNumber(const Aggregate& a, const double* q) {
-    double total = 0;
-    for (size_t t = 0; t < a.indices.size(); t += 3) {
-        double r[3][3], len[3];
-        for (int k = 0; k < 3; ++k) {
-            for (int d = 0; d < 3; ++d) r[k][d] = a.positions[3 * a.indices[t + k] + d] - q[d];
-            len[k] = std::sqrt(r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2]);
-        }
-        double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-                     r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-        auto dot = [&](int i, int j) { return r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2]; };
-        double den = len[0] * len[1] * len[2] + dot(0, 1) * len[2] + dot(1, 2) * len[0] + dot(2, 0) * len[1];
-        total += 2 * std::atan2(det, den);
-    }
-    return total / (4 * M_PI);
-}
+double windingNumber(const Aggregate& a, const double* q) { return aggrelod::testing::windingNumber(a.positions, a.indices, q); }
 
 // Distance from q to the nearest vertex-plane of the aggregate is hard; use: q is inside
 // (winding >= 0.5) or lies on one of the aggregate's triangles (within eps).

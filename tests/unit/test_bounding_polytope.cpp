@@ -19,20 +19,7 @@ namespace {
 
 /// Every directed edge once and its reverse once, and a positive volume.
 bool closedOutward(const std::vector<double>& positions, const std::vector<uint32_t>& triangles) {
-    std::map<std::pair<uint32_t, uint32_t>, int> uses;
-    for (size_t t = 0; t < triangles.size(); t += 3)
-        for (int k = 0; k < 3; ++k) ++uses[{triangles[t + k], triangles[t + (k + 1) % 3]}];
-    for (const auto& [edge, count] : uses)
-        if (count != 1 || uses.count({edge.second, edge.first}) != 1) return false;
-    double volume = 0;
-    for (size_t t = 0; t < triangles.size(); t += 3) {
-        const double* a = &positions[3 * triangles[t]];
-        const double* b = &positions[3 * triangles[t + 1]];
-        const double* c = &positions[3 * triangles[t + 2]];
-        volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                   a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
-    }
-    return !triangles.empty() && volume > 0;
+    return edgeManifoldProblem(triangles).empty() && signedVolume(positions, triangles) > 0;
 }
 
 /// Checks every polytope of the series of `points`' convex hull; returns the fewest triangles

@@ -7,13 +7,13 @@
 //    object) a ray-cast of a coarse level's proxies, per-pixel base colour of the hit face,
 //    differs from the same ray-cast of the originals by a bounded mean colour distance;
 //    levels.glb and proxies.glb carry COLOR_0 and pass the glTF validator.
+#include "ray_scene.h"
 #include "scene_io.h"
 #include "test_support.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 #include <aggrelod/samples.h>
 
-#include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -70,36 +70,19 @@ std::vector<InputObject> makeForestLike(uint32_t seed, int side) {
     return objects;
 }
 
-/// Colour ray-caster: per pixel, the base colour of the face hit first (Embree 3).
+/// Colour ray-caster: per pixel, the base colour of the face hit first (ray_scene.h).
 class ColourCaster {
 public:
-    ColourCaster() : device_(rtcNewDevice(nullptr)), scene_(rtcNewScene(device_)) {}
-    ~ColourCaster() {
-        rtcReleaseScene(scene_);
-        rtcReleaseDevice(device_);
-    }
-    ColourCaster(const ColourCaster&) = delete;
-    ColourCaster& operator=(const ColourCaster&) = delete;
-
     /// positions 3 * vertexCount (world units), indices 3 * triangleCount, colours 4 per
     /// triangle (empty: white).
     template <typename Real>
     void add(const std::vector<Real>& positions, const std::vector<uint32_t>& indices, const std::vector<float>& colours) {
         if (indices.empty()) return;
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                              3 * sizeof(float), positions.size() / 3));
-        for (size_t i = 0; i < positions.size(); ++i) v[i] = float(positions[i]);
-        auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                  3 * sizeof(uint32_t), indices.size() / 3));
-        std::copy(indices.begin(), indices.end(), ix);
-        rtcCommitGeometry(g);
-        const unsigned id = rtcAttachGeometry(scene_, g);
-        rtcReleaseGeometry(g);
+        const uint32_t id = scene_.addMesh(positions, indices);
         if (colours_.size() <= id) colours_.resize(id + 1);
         colours_[id] = colours.size() == 4 * (indices.size() / 3) ? colours : std::vector<float>(4 * (indices.size() / 3), 1.0f);
     }
-    void commit() { rtcCommitScene(scene_); }
+    void commit() { scene_.commit(); }
 
     /// width x height pixels, RGB linear per pixel (3 floats); covered[i] = 1 when a ray hit.
     /// Pinhole camera at `eye` looking at `target`, +z up, vertical field of view `fovDeg`.
@@ -118,23 +101,12 @@ public:
         for (int py = 0; py < height; ++py)
             for (int px = 0; px < width; ++px) {
                 const double sx = (2.0 * (px + 0.5) / width - 1) * w, sy = (1 - 2.0 * (py + 0.5) / height) * h;
-                RTCIntersectContext context;
-                rtcInitIntersectContext(&context);
-                RTCRayHit rh{};
-                rh.ray.org_x = float(eye[0]);
-                rh.ray.org_y = float(eye[1]);
-                rh.ray.org_z = float(eye[2]);
-                rh.ray.dir_x = float(f[0] + sx * r[0] + sy * u[0]);
-                rh.ray.dir_y = float(f[1] + sx * r[1] + sy * u[1]);
-                rh.ray.dir_z = float(f[2] + sx * r[2] + sy * u[2]);
-                rh.ray.tfar = INFINITY;
-                rh.ray.mask = 0xFFFFFFFFu;
-                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                rtcIntersect1(scene_, &context, &rh);
-                if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+                const double d[3] = {f[0] + sx * r[0] + sy * u[0], f[1] + sx * r[1] + sy * u[1], f[2] + sx * r[2] + sy * u[2]};
+                const RayHit hit = scene_.first(eye, d);
+                if (!hit.hit()) continue;
                 const size_t pixel = size_t(py) * width + px;
                 covered[pixel] = 1;
-                std::copy_n(&colours_[rh.hit.geomID][4 * size_t(rh.hit.primID)], 3, &rgb[3 * pixel]);
+                std::copy_n(&colours_[hit.mesh][4 * size_t(hit.triangle)], 3, &rgb[3 * pixel]);
             }
     }
 
@@ -148,8 +120,7 @@ private:
         out[1] = a[2] * b[0] - a[0] * b[2];
         out[2] = a[0] * b[1] - a[1] * b[0];
     }
-    RTCDevice device_;
-    RTCScene scene_;
+    RayScene scene_;
     std::vector<std::vector<float>> colours_;
 };
 

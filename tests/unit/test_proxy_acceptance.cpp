@@ -17,11 +17,11 @@
 #include "acceptance_scenes.h"
 #include "grid_measure.h"
 #include "mesh_distance.h"
+#include "ray_scene.h"
 #include "test_support.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 
-#include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -77,169 +77,8 @@ const AcceptanceScene& acceptanceScene(const std::string& name) {
         ASSERT_TRUE((s).baked.ok) << (s).input.label << ": " << (s).baked.problem;                 \
     } while (0)
 
-// ------------------------------------------------------------------------------------------
-// Topology.
-
-/// Edge-connected shells of an indexed mesh (triangles sharing an undirected index edge).
-int shellCount(const std::vector<uint32_t>& indices) {
-    const size_t triangles = indices.size() / 3;
-    std::vector<uint32_t> parent(triangles);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> firstUse;
-    for (size_t t = 0; t < triangles; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t a = indices[3 * t + k], b = indices[3 * t + (k + 1) % 3];
-            const auto [it, fresh] = firstUse.emplace(std::make_pair(std::min(a, b), std::max(a, b)), uint32_t(t));
-            if (!fresh) parent[find(uint32_t(t))] = find(it->second);
-        }
-    int shells = 0;
-    for (size_t t = 0; t < triangles; ++t) shells += find(uint32_t(t)) == t ? 1 : 0;
-    return shells;
-}
-
-/// Empty when every undirected index edge is used by exactly two triangles, once in each
-/// direction; else what the first offending edge does.
-std::string edgeManifoldProblem(const std::vector<uint32_t>& indices) {
-    if (indices.empty()) return "no triangles";
-    std::map<std::pair<uint32_t, uint32_t>, int> directed;
-    for (size_t t = 0; t + 2 < indices.size(); t += 3)
-        for (int k = 0; k < 3; ++k) ++directed[{indices[t + k], indices[t + (k + 1) % 3]}];
-    for (const auto& [edge, uses] : directed) {
-        const auto back = directed.find({edge.second, edge.first});
-        const int backUses = back == directed.end() ? 0 : back->second;
-        if (uses != 1 || backUses != 1)
-            return "index edge " + std::to_string(edge.first) + "-" + std::to_string(edge.second) + " used " +
-                   std::to_string(uses) + " + " + std::to_string(backUses) + " times in the two directions";
-    }
-    return {};
-}
-
 /// The object's shells after welding equal positions (glTF art repeats vertices at seams).
-int objectShells(const InputObject& o) {
-    std::map<std::array<double, 3>, uint32_t> ids;
-    std::vector<uint32_t> weld(o.positions.size() / 3);
-    for (size_t i = 0; i < weld.size(); ++i)
-        weld[i] = ids.emplace(std::array<double, 3>{o.positions[3 * i], o.positions[3 * i + 1], o.positions[3 * i + 2]},
-                              uint32_t(ids.size()))
-                      .first->second;
-    std::vector<uint32_t> welded;
-    for (uint32_t i : o.indices) welded.push_back(weld[i]);
-    return shellCount(welded);
-}
-
-// ------------------------------------------------------------------------------------------
-// Embree: per-object scenes, instanced into one scene per node; proxies with an all-hits mode.
-
-struct RayContext {
-    RTCIntersectContext base;      // first member: Embree hands this pointer to the filter
-    std::vector<float>* hits = nullptr;  // non-null: collect every hit distance and go on
-};
-
-void collectEveryHit(const RTCFilterFunctionNArguments* args) {
-    const RayContext* context = reinterpret_cast<const RayContext*>(args->context);
-    if (!context->hits) return;
-    context->hits->push_back(RTCRayN_tfar(args->ray, args->N, 0));
-    args->valid[0] = 0;
-}
-
-class Embree {
-public:
-    Embree() : device_(rtcNewDevice(nullptr)) {}
-    ~Embree() {
-        for (RTCScene s : scenes_) rtcReleaseScene(s);
-        rtcReleaseDevice(device_);
-    }
-    Embree(const Embree&) = delete;
-    Embree& operator=(const Embree&) = delete;
-
-    /// A committed scene of one triangle mesh (float xyz, 3 indices per triangle); null when empty.
-    RTCScene mesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices, bool collectFilter) {
-        if (indices.empty()) return nullptr;
-        RTCScene scene = rtcNewScene(device_);
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                              3 * sizeof(float), positions.size() / 3));
-        std::copy(positions.begin(), positions.end(), v);
-        auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                  3 * sizeof(uint32_t), indices.size() / 3));
-        std::copy(indices.begin(), indices.end(), ix);
-        if (collectFilter) rtcSetGeometryIntersectFilterFunction(g, collectEveryHit);
-        attach(scene, g);
-        return committed(scene);
-    }
-
-    /// A committed scene instancing `parts` (null entries skipped) with identity transforms.
-    RTCScene instances(const std::vector<RTCScene>& parts) {
-        RTCScene scene = rtcNewScene(device_);
-        const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-        for (RTCScene part : parts) {
-            if (!part) continue;
-            RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
-            rtcSetGeometryInstancedScene(g, part);
-            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
-            attach(scene, g);
-        }
-        return committed(scene);
-    }
-
-    void release(RTCScene scene) {
-        if (!scene) return;
-        scenes_.erase(std::find(scenes_.begin(), scenes_.end(), scene));
-        rtcReleaseScene(scene);
-    }
-
-private:
-    static void attach(RTCScene scene, RTCGeometry g) {
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(scene, g);
-        rtcReleaseGeometry(g);
-    }
-    RTCScene committed(RTCScene scene) {
-        rtcCommitScene(scene);
-        scenes_.push_back(scene);
-        return scene;
-    }
-
-    RTCDevice device_;
-    std::vector<RTCScene> scenes_;
-};
-
-/// First hit distance along o + t d (t >= 0), INFINITY when none; with `hits`, every hit
-/// distance goes there instead (for scenes built with collectFilter).
-float castRay(RTCScene scene, const double o[3], const double d[3], std::vector<float>* hits = nullptr) {
-    if (!scene) return INFINITY;
-    RayContext context;
-    rtcInitIntersectContext(&context.base);
-    context.hits = hits;
-    RTCRayHit rh{};
-    // org, tnear, dir, time, tfar, mask, id, flags
-    rh.ray = {float(o[0]), float(o[1]), float(o[2]), 0.0f, float(d[0]), float(d[1]), float(d[2]), 0.0f, INFINITY, ~0u, 0, 0};
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene, &context.base, &rh);
-    return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
-}
-
-/// Inside a closed mesh by ray parity: majority over three fixed, oblique directions; hits at
-/// (nearly) equal distances (a ray through an edge) count once.
-bool insideByParity(RTCScene proxy, const double p[3], double mergeDistance) {
-    static const double kDirections[3][3] = {{0.5383, 0.6221, 0.5686}, {-0.7071, 0.3162, -0.6325}, {0.2673, -0.8018, 0.5345}};
-    int inside = 0;
-    std::vector<float> hits;
-    for (const auto& d : kDirections) {
-        hits.clear();
-        castRay(proxy, p, d, &hits);
-        std::sort(hits.begin(), hits.end());
-        int crossings = 0;
-        for (size_t i = 0; i < hits.size(); ++i)
-            if (i == 0 || hits[i] - hits[i - 1] > mergeDistance) ++crossings;
-        inside += crossings % 2;
-    }
-    return inside >= 2;
-}
+int objectShells(const InputObject& o) { return shellCount(weldedIndices(o.positions, o.indices)); }
 
 /// Uniform double in [0, 1) from the raw engine output (portable across standard libraries).
 double uniform01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
@@ -294,11 +133,13 @@ struct Figures {
 Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vector<InputObject>& objects,
                      double tolerance, size_t raysPerScene) {
     Figures f;
-    Embree embree;
-    std::vector<RTCScene> objectScene(objects.size(), nullptr);
-    for (size_t o = 0; o < objects.size(); ++o)
-        objectScene[o] = embree.mesh(std::vector<float>(objects[o].positions.begin(), objects[o].positions.end()),
-                                     objects[o].indices, false);
+    const auto device = std::make_shared<RayDevice>();
+    std::vector<std::unique_ptr<RayScene>> objectScene;
+    for (const InputObject& o : objects) {
+        objectScene.push_back(std::make_unique<RayScene>(device));
+        objectScene.back()->addMesh(o.positions, o.indices);
+        objectScene.back()->commit();
+    }
     const size_t raysPerProxy = std::max<size_t>(64, (raysPerScene + proxies.size() - 1) / std::max<size_t>(1, proxies.size()));
     std::mt19937_64 rng(20240601);
     for (const ProxyUnderTest& p : proxies) {
@@ -331,7 +172,9 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
         }
 
         // Every original vertex inside or within tolerance of the proxy surface.
-        RTCScene proxyScene = embree.mesh(*p.positions, *p.indices, true);
+        RayScene proxyScene(device);
+        proxyScene.addMesh(*p.positions, *p.indices);
+        proxyScene.commit();
         detail::TriangleBvh proxyBvh;
         proxyBvh.build(mesh.positions.data(), mesh.positions.size() / 3, mesh.indices.data(), mesh.indices.size() / 3);
         size_t outside = 0;
@@ -345,7 +188,7 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
                 const double* q = &objects[s].positions[v];
                 grow(q);
                 ++f.verticesChecked;
-                if (insideByParity(proxyScene, q, 0.1 * tolerance)) continue;
+                if (proxyScene.insideByParity(q, 0.1 * tolerance)) continue;
                 const double d = mesh.indices.empty() ? INFINITY : detail::closestPoint(proxyBvh, q).distance;
                 if (d <= tolerance) continue;
                 ++outside;
@@ -355,9 +198,9 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
                 name + ": " + std::to_string(outside) + " original vertices outside the proxy");
 
         // Rays from a sphere around the proxy and its originals, aimed at points of their box.
-        std::vector<RTCScene> parts;
-        for (uint32_t s : p.sources) parts.push_back(objectScene[s]);
-        RTCScene originalsScene = embree.instances(parts);
+        RayScene originalsScene(device);
+        for (uint32_t s : p.sources) originalsScene.addInstance(*objectScene[s]);
+        originalsScene.commit();
         double center[3], radius = 0;
         for (int k = 0; k < 3; ++k) {
             center[k] = 0.5 * (lo[k] + hi[k]);
@@ -379,10 +222,10 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
             len = std::sqrt(len);
             for (double& c : dir) c /= len;
             ++f.rays;
-            const float tOriginal = castRay(originalsScene, origin, dir);
+            const float tOriginal = originalsScene.first(origin, dir).t;
             if (!std::isfinite(tOriginal)) continue;
             ++f.raysHittingOriginals;
-            const float tProxy = castRay(proxyScene, origin, dir);
+            const float tProxy = proxyScene.first(origin, dir).t;
             if (double(tProxy) <= double(tOriginal) + tolerance) continue;
             // Later along the ray: a violation when the original point hit lies farther than
             // the tolerance outside the proxy (along a grazing ray a tiny offset gets long).
@@ -398,8 +241,6 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
         }
         f.tally(violations, f.proxiesWithRayViolations, f.rayViolations, "rays",
                 name + ": " + std::to_string(violations) + " rays reach an original first");
-        embree.release(originalsScene);
-        embree.release(proxyScene);
     }
     return f;
 }

@@ -235,6 +235,59 @@ TEST(RuntimeCollision, CutAtLevelRanksPerObjectLodsBetweenLeavesAndLevelZero) {
     world.useLevel(kObjectLodLevel);
     EXPECT_EQ(world.currentCut(), lods);
 }
+
+TEST(RuntimeCollision, RaysThroughSharedEdgesAndCornersDoNotSlipThrough) {
+    // Each ray enters a leaf box exactly through one of its corners or through a point of an
+    // edge, where two or more triangles meet, and goes on towards a point inside the box: a
+    // watertight intersector hits one of those triangles. Embree's fast mode tests each
+    // triangle on its own in float and can miss both sides of a shared edge, letting a
+    // collision query pass through a closed proxy.
+    Fixture f(150, 24);
+    CollisionWorld world(f.file, 1);
+    ASSERT_TRUE(world.ok()) << world.error();
+    world.useLevel(kLeafLevel);
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<double> unit(0, 1);
+    size_t rays = 0, slipped = 0;
+    for (uint32_t n : world.currentCut()) {
+        const Span<float> v = f.file.vertices(n);
+        const Span<uint32_t> t = f.file.triangles(n);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < v.size; ++i) {
+            lo[i % 3] = std::min(lo[i % 3], double(v[i]));
+            hi[i % 3] = std::max(hi[i % 3], double(v[i]));
+        }
+        for (size_t i = 0; i < t.size; ++i) {
+            // Corner i of its triangle, then a point on the edge to the next corner.
+            const float* a = &v[3 * t[i]];
+            const float* b = &v[3 * t[i - i % 3 + (i + 1) % 3]];
+            for (int kind = 0; kind < 2; ++kind) {
+                const double s = kind == 0 ? 0.0 : unit(rng);
+                // Entry point on the surface; inner point in the middle half of the (convex) box.
+                double entry[3], inner[3], d[3], len = 0;
+                for (int k = 0; k < 3; ++k) {
+                    entry[k] = a[k] + s * (double(b[k]) - a[k]);
+                    inner[k] = lo[k] + (0.25 + 0.5 * unit(rng)) * (hi[k] - lo[k]);
+                    d[k] = inner[k] - entry[k];
+                    len += d[k] * d[k];
+                }
+                len = std::sqrt(len);
+                float o[3], df[3];
+                for (int k = 0; k < 3; ++k) {
+                    df[k] = float(d[k] / len);
+                    o[k] = float(entry[k] - 20.0 * d[k] / len);
+                }
+                // Hit before the entry point (another box in the way) or at it: fine. None, or
+                // only later (the far side of the box): the ray slipped through.
+                CollisionHit hit;
+                ++rays;
+                if (!world.raycast(o, df, 1e6f, hit) || hit.distance > 20.0f + 1e-3f) ++slipped;
+            }
+        }
+    }
+    EXPECT_GT(rays, 10000u);
+    EXPECT_EQ(slipped, 0u) << slipped << " of " << rays << " rays entering through an edge or corner passed it";
+}
 #else
 TEST(RuntimeCollision, NotBuilt) { GTEST_SKIP() << "Embree 3 not found: aggrelod_runtime_collision not built"; }
 #endif

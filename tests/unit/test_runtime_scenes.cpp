@@ -9,13 +9,13 @@
 // Each scene is baked once per test binary (a static cache), with --levels 4.
 #include "mesh_distance.h"
 #include "scene_io.h"
+#include "ray_scene.h"
 #include "test_support.h"
 
 #include <aggrelod/runtime_file.h>
 #include <aggrelod/selection.h>
 #include <aggrelod/samples.h>
 
-#include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -34,86 +34,6 @@ using namespace aggrelod;
 using namespace aggrelod::testing;
 
 namespace {
-
-// ------------------------------------------------------------------------------------------
-// Embree: one scene of triangle meshes, geometry id = mesh index.
-
-struct RayHit {
-    float t = INFINITY;
-    uint32_t mesh = RTC_INVALID_GEOMETRY_ID;
-    bool hit() const { return mesh != RTC_INVALID_GEOMETRY_ID; }
-};
-
-class RayScene {
-public:
-    RayScene() : device_(rtcNewDevice(nullptr)), scene_(rtcNewScene(device_)) {}
-    ~RayScene() {
-        rtcReleaseScene(scene_);
-        rtcReleaseDevice(device_);
-    }
-    RayScene(const RayScene&) = delete;
-    RayScene& operator=(const RayScene&) = delete;
-
-    /// Adds one mesh (float xyz, 3 indices per triangle); returns its id. Empty meshes get an
-    /// id too (never hit).
-    uint32_t add(const float* positions, size_t vertexCount, const uint32_t* indices, size_t triangleCount) {
-        const uint32_t id = count_++;
-        if (triangleCount == 0) {
-            ids_.push_back(RTC_INVALID_GEOMETRY_ID);
-            return id;
-        }
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                              3 * sizeof(float), vertexCount));
-        std::copy(positions, positions + 3 * vertexCount, v);
-        auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                  3 * sizeof(uint32_t), triangleCount));
-        std::copy(indices, indices + 3 * triangleCount, ix);
-        rtcCommitGeometry(g);
-        ids_.push_back(rtcAttachGeometry(scene_, g));
-        rtcReleaseGeometry(g);
-        return id;
-    }
-    uint32_t add(const InputObject& o) {
-        std::vector<float> p(o.positions.begin(), o.positions.end());
-        return add(p.data(), p.size() / 3, o.indices.data(), o.indices.size() / 3);
-    }
-    void commit() {
-        rtcCommitScene(scene_);
-        for (uint32_t i = 0; i < ids_.size(); ++i)
-            if (ids_[i] != RTC_INVALID_GEOMETRY_ID) meshOfGeometry_[ids_[i]] = i;
-    }
-    RayHit intersect(const double o[3], const double d[3]) const {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        RTCRayHit rh{};
-        rh.ray.org_x = float(o[0]);
-        rh.ray.org_y = float(o[1]);
-        rh.ray.org_z = float(o[2]);
-        rh.ray.dir_x = float(d[0]);
-        rh.ray.dir_y = float(d[1]);
-        rh.ray.dir_z = float(d[2]);
-        rh.ray.tnear = 0;
-        rh.ray.tfar = INFINITY;
-        rh.ray.mask = 0xFFFFFFFFu;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(scene_, &context, &rh);
-        RayHit h;
-        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-            h.t = rh.ray.tfar;
-            h.mesh = meshOfGeometry_.at(rh.hit.geomID);
-        }
-        return h;
-    }
-
-private:
-    RTCDevice device_;
-    RTCScene scene_;
-    uint32_t count_ = 0;
-    std::vector<uint32_t> ids_;
-    std::map<uint32_t, uint32_t> meshOfGeometry_;
-};
 
 // ------------------------------------------------------------------------------------------
 // Baked scenes (once per binary).
@@ -279,7 +199,7 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
     const uint32_t levelCount = uint32_t(s.levels.size());
     ASSERT_GT(levelCount, 0u);
     RayScene originals;
-    for (const InputObject& o : s.originals) originals.add(o);
+    for (const InputObject& o : s.originals) originals.addMesh(o.positions, o.indices);
     originals.commit();
     // Leaf node of each object (leaves may come in any order in the file).
     std::vector<uint32_t> leafOf(s.originals.size(), runtime::kNoIndex);
@@ -301,7 +221,7 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
         std::vector<detail::TriangleBvh> exactBvh(s.levels[level].size());
         for (size_t a = 0; a < s.levels[level].size(); ++a) {
             const InputObject& mesh = s.levels[level][a];
-            exact.add(mesh);
+            exact.addMesh(mesh.positions, mesh.indices);
             exactBvh[a].build(mesh.positions.data(), mesh.positions.size() / 3, mesh.indices.data(), mesh.indices.size() / 3);
         }
         exact.commit();
@@ -315,7 +235,7 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
             if (level < first || level > last) continue;
             const auto v = f.vertices(i);
             const auto t = f.triangles(i);
-            proxies.add(v.data, v.size / 3, t.data, t.size / 3);
+            proxies.addMesh(v.data, v.size / 3, t.data, t.size / 3);
             proxyNode.push_back(i);
             for (uint32_t o : f.sources(i)) nodeAtLevel[o] = i;
             std::vector<double> p(v.begin(), v.end());
@@ -340,11 +260,11 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
             }
             const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             for (double& x : d) x /= len;
-            const RayHit ho = originals.intersect(o, d);
+            const RayHit ho = originals.first(o, d);
             // Support surfaces (ground) are no level's and have no proxy: rays onto them say nothing.
             if (!ho.hit() || nodeAtLevel[ho.mesh] == runtime::kNoIndex) continue;
             ++hits;
-            const RayHit he = exact.intersect(o, d);
+            const RayHit he = exact.first(o, d);
             double excess = he.hit() ? double(he.t) - double(ho.t) : INFINITY;
             if (excess > eps) {
                 // A later hit by more than eps along the ray. At grazing incidence on a face
@@ -362,7 +282,7 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
             maxExcess = std::max(maxExcess, excess);
             // Proxies: a later hit (or none) leaves the original's hit point outside the
             // proxy; its depth is that point's distance to the proxy of the object's node.
-            const RayHit hp = proxies.intersect(o, d);
+            const RayHit hp = proxies.first(o, d);
             if (!hp.hit() || double(hp.t) > double(ho.t) + eps) {
                 ++proxyViolations;
                 const uint32_t node = nodeAtLevel[ho.mesh];
@@ -648,7 +568,7 @@ std::vector<float> renderDepth(const RayScene& scene, const PinholeCamera& cam) 
         for (int x = 0; x < cam.width; ++x) {
             double d[3];
             cam.ray(x, y, d);
-            depth[size_t(y) * cam.width + x] = scene.intersect(cam.eye, d).t;
+            depth[size_t(y) * cam.width + x] = scene.first(cam.eye, d).t;
         }
     return depth;
 }
@@ -688,7 +608,7 @@ TEST(RuntimeScenes, ScreenSpacePromiseAtOnePixel) {
         ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
         const runtime::RuntimeFile& f = s.file;
         RayScene originals;
-        for (const InputObject& o : s.originals) originals.add(o);
+        for (const InputObject& o : s.originals) originals.addMesh(o.positions, o.indices);
         originals.commit();
         runtime::Selector selector(f);
         std::mt19937_64 rng(4242);
@@ -707,9 +627,9 @@ TEST(RuntimeScenes, ScreenSpacePromiseAtOnePixel) {
             for (uint32_t node : selector.proxyNodes()) {
                 const auto v = f.vertices(node);
                 const auto t = f.triangles(node);
-                cut.add(v.data, v.size / 3, t.data, t.size / 3);
+                cut.addMesh(v.data, v.size / 3, t.data, t.size / 3);
             }
-            for (uint32_t o : selector.originalObjects()) cut.add(s.originals[o]);
+            for (uint32_t o : selector.originalObjects()) cut.addMesh(s.originals[o].positions, s.originals[o].indices);
             cut.commit();
             proxiesDrawn += selector.proxyNodes().size;
             const PinholeCamera cam(c.position, s.center, fovY, size, size);

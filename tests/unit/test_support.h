@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Helpers shared by the integration tests: running the CLI, temporary directories, shared
-// test data, mesh checks on read-back outputs, hand-made GLB files and the glTF validator.
+// test data, hand-made GLB files and the glTF validator (mesh checks: mesh_checks.h).
 // Header-only (tests/unit/*.cpp are globbed into one executable).
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+
+#include "mesh_checks.h"
 
 #include <gtest/gtest.h>
 
@@ -148,93 +150,6 @@ inline RunResult runProgram(const std::vector<std::string>& argv, const fs::path
 
 // --- mesh checks on read-back outputs ---------------------------------------------------
 
-/// Result of checking a triangle soup for closedness after welding equal positions.
-struct ClosedCheck {
-    std::string problem;            ///< empty when closed and consistently oriented
-    size_t weldedVertices = 0;
-    size_t edges = 0;               ///< undirected, after welding
-    size_t edgesUsedMoreThanTwice = 0; ///< non-manifold after welding (e.g. shells touching along an edge)
-    int components = 0;             ///< connected pieces (through shared welded vertices)
-};
-
-/// Welds vertices with bit-identical positions, then checks that every undirected edge is
-/// used by triangles as often in one direction as in the other (and at least once each way):
-/// the surface is closed and consistently oriented.
-inline ClosedCheck checkClosedAfterWeld(const InputObject& o) {
-    ClosedCheck c;
-    const size_t n = o.positions.size() / 3;
-    std::map<std::array<double, 3>, uint32_t> ids;
-    std::vector<uint32_t> weld(n);
-    for (size_t i = 0; i < n; ++i) {
-        const std::array<double, 3> p = {o.positions[3 * i], o.positions[3 * i + 1], o.positions[3 * i + 2]};
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-            c.problem = "non-finite vertex " + std::to_string(i);
-            return c;
-        }
-        weld[i] = ids.emplace(p, uint32_t(ids.size())).first->second;
-    }
-    c.weldedVertices = ids.size();
-    if (o.indices.empty() || o.indices.size() % 3 != 0) {
-        c.problem = "no triangles or index count not a multiple of 3";
-        return c;
-    }
-    std::vector<uint32_t> parent(ids.size());
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
-    std::map<std::pair<uint32_t, uint32_t>, std::array<int, 2>> edges;  // (lo, hi) -> uses lo->hi, hi->lo
-    for (size_t t = 0; t < o.indices.size(); t += 3) {
-        uint32_t v[3];
-        for (int k = 0; k < 3; ++k) {
-            if (o.indices[t + size_t(k)] >= n) {
-                c.problem = "index out of range in triangle " + std::to_string(t / 3);
-                return c;
-            }
-            v[k] = weld[o.indices[t + size_t(k)]];
-        }
-        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
-            c.problem = "triangle " + std::to_string(t / 3) + " has two corners at one position";
-            return c;
-        }
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t a = v[k], b = v[(k + 1) % 3];
-            auto& uses = edges[{std::min(a, b), std::max(a, b)}];
-            ++uses[a < b ? 0 : 1];
-            parent[find(a)] = find(b);
-        }
-    }
-    c.edges = edges.size();
-    for (const auto& [edge, uses] : edges) {
-        if (uses[0] != uses[1]) {
-            c.problem = "edge between vertices " + std::to_string(edge.first) + " and " + std::to_string(edge.second) +
-                        " used " + std::to_string(uses[0]) + " + " + std::to_string(uses[1]) +
-                        " times in the two directions (open or inconsistently oriented)";
-            return c;
-        }
-        if (uses[0] + uses[1] > 2) ++c.edgesUsedMoreThanTwice;
-    }
-    std::vector<bool> used(ids.size(), false);
-    for (uint32_t i : o.indices) used[weld[i]] = true;
-    for (uint32_t i = 0; i < ids.size(); ++i)
-        if (used[i] && find(i) == i) ++c.components;
-    return c;
-}
-
-/// Signed volume (positive for an outward-oriented closed mesh).
-inline double signedVolumeOf(const InputObject& o) {
-    double v = 0;
-    for (size_t t = 0; t + 2 < o.indices.size(); t += 3) {
-        const double* a = &o.positions[3 * size_t(o.indices[t])];
-        const double* b = &o.positions[3 * size_t(o.indices[t + 1])];
-        const double* c = &o.positions[3 * size_t(o.indices[t + 2])];
-        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-             a[2] * (b[0] * c[1] - b[1] * c[0]);
-    }
-    return v / 6.0;
-}
-
 // --- hand-made GLB files (for malformed input) ----------------------------------------------
 
 /// One mesh node of a hand-made GLB: float32 positions, uint32 indices, written as given
@@ -344,13 +259,28 @@ inline RunResult runValidator(const std::vector<fs::path>& files, const fs::path
 #endif
 }
 
-/// Validates `files`; adds a test failure (never a skip) when the validator reports errors or
-/// when node or the validator are missing: CI installs them (.ci/install-deps.sh).
-/// Returns true when it ran and reported no errors.
+/// The one test that fails when node or the validator are missing; the others skip their
+/// validation and point there, so a missing tool is one failure, not one per test.
+constexpr const char* kValidatorCheck = "CliSamples.ValidatorHarnessCatchesErrors";
+
+/// Skips the calling test when the validator is missing (see kValidatorCheck).
+#define AGGRELOD_REQUIRE_VALIDATOR()                                                              \
+    do {                                                                                          \
+        const std::string missing_ = ::aggrelod::testing::validatorMissing();                     \
+        if (!missing_.empty())                                                                    \
+            GTEST_SKIP() << "glTF validator missing (reported by "                                \
+                         << ::aggrelod::testing::kValidatorCheck << "): " << missing_;           \
+    } while (0)
+
+/// Validates `files`; adds a test failure when the validator reports errors. When node or the
+/// validator are missing the test is marked skipped (kValidatorCheck fails for it; CI installs
+/// them with .ci/install-deps.sh). Returns true when it ran and reported no errors.
 inline bool validateGltf(const std::vector<fs::path>& files, const fs::path& workDir) {
     const std::string missing = validatorMissing();
     if (!missing.empty()) {
-        ADD_FAILURE() << missing;
+        const std::string message =
+            "glTF validator missing (reported by " + std::string(kValidatorCheck) + "): " + missing;
+        GTEST_MESSAGE_AT_(__FILE__, __LINE__, message.c_str(), ::testing::TestPartResult::kSkip);
         return false;
     }
     const RunResult r = runValidator(files, workDir);
@@ -359,26 +289,6 @@ inline bool validateGltf(const std::vector<fs::path>& files, const fs::path& wor
         return false;
     }
     return true;
-}
-
-/// Generalized winding number of a closed mesh at q (about 1 inside, 0 outside): an inside
-/// test independent of ray casting. pos: xyz per vertex; idx: 3 per triangle.
-template <class Real>
-double windingNumber(const std::vector<Real>& pos, const std::vector<uint32_t>& idx, const double* q) {
-    double total = 0;
-    for (size_t t = 0; t + 2 < idx.size(); t += 3) {
-        double r[3][3], len[3];
-        for (int k = 0; k < 3; ++k) {
-            for (int d = 0; d < 3; ++d) r[k][d] = double(pos[3 * size_t(idx[t + k]) + d]) - q[d];
-            len[k] = std::sqrt(r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2]);
-        }
-        const double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-                           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-        auto dot = [&](int i, int j) { return r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2]; };
-        const double den = len[0] * len[1] * len[2] + dot(0, 1) * len[2] + dot(1, 2) * len[0] + dot(2, 0) * len[1];
-        total += 2 * std::atan2(det, den);
-    }
-    return total / (4 * 3.14159265358979323846);
 }
 
 }  // namespace aggrelod::testing
