@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod aggregate2d: polygons (WKT / GeoJSON) in, one GeoJSON of every level out, with
-// optional link table, pictures and stats (paper Sections 3-4 in 2D; DESIGN 4 "2D").
+// optional link table, pictures and stats (paper Sections 3-4 in 2D; docs/design.md §4 "2D").
 #include "commands_2d.h"
 #include "geo_io.h"
 #include "terminal.h"

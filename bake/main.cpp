@@ -151,8 +151,10 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "(shortest triangulation edge, as in the paper)")
         ->transform(CLI::IsMember({"exact", "cdt"}, CLI::ignore_case));
     cmd->add_option("--exclude", o.exclude,
-                    "Leave out nodes whose name matches this ECMAScript regex (with their subtree), "
-                    "e.g. 'Ground|Sky'");
+                    "Leave out nodes (with their subtree) whose name or index path ('@0/3/1': root "
+                    "position, then child positions) matches this ECMAScript regex, e.g. 'Ground|Sky'; "
+                    "'mesh:NAME', or a name or path followed by '/mesh' (e.g. '^Terrain/mesh$'), drops "
+                    "only that node's own mesh and keeps its children");
     cmd->add_option("--object", o.objectUnit,
                     "What one object is: node (default: each node with a mesh) or subtree "
                     "(each child of a scene root, with all meshes below it)")
@@ -397,7 +399,7 @@ int runBake(BakeOptions o) {
     std::string nodeError;
     bool nodesOk = false;
     if (ok) {
-        // Proxies, their errors and the node tree for the runtime (DESIGN 2.6).
+        // Proxies, their errors and the node tree for the runtime (docs/design.md §2.6).
         ProxySettings proxySettings;
         proxySettings.simplifyFraction = o.proxyError;
         proxySettings.threadCount = o.threads;

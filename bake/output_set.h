@@ -4,7 +4,7 @@
 // SHA-256 of every file of the set. A reader that goes through the manifest never sees a mixed
 // set: while a bake moves its files into place (or after one was killed while doing so) the
 // manifest names the previous set's files, kept in the bake's temporary folder; the new set
-// is switched in by one rename of the manifest. See bake/CLI.md, "Outputs".
+// is switched in by one rename of the manifest. See docs/outputs.md, "The output set and its manifest".
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: hierarchy nodes -> runtime BuildParams -> scene.aglod (DESIGN section 4).
+// aggrelod bake: hierarchy nodes -> runtime BuildParams -> scene.aglod (docs/design.md §4).
 #include "runtime_export.h"
+
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <array>
@@ -29,16 +31,6 @@ Vec3 cross(const Vec3& a, const Vec3& b) {
 }
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double length(const Vec3& a) { return std::sqrt(dot(a, a)); }
-
-uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-}
-void unite(std::vector<uint32_t>& parent, uint32_t a, uint32_t b) {
-    a = findRoot(parent, a);
-    b = findRoot(parent, b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the smaller corner stays the root
-}
 
 }  // namespace
 
@@ -78,8 +70,7 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
         return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.corner < y.corner;
     });
     const double cosCrease = std::cos(kCreaseAngleDegrees * 3.14159265358979323846 / 180.0);
-    std::vector<uint32_t> group(cornerCount);
-    std::iota(group.begin(), group.end(), 0u);
+    DisjointSets group(cornerCount);  // the smallest corner of a group is its root
     for (size_t i = 0; i < edges.size();) {
         size_t j = i;
         while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
@@ -90,8 +81,8 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
                 // Both corners at each end of the edge: start and end of the edge in each face.
                 const uint32_t e1 = c1 - c1 % 3 + (c1 + 1) % 3, e2 = c2 - c2 % 3 + (c2 + 1) % 3;
                 const uint32_t a1 = indices[c1];
-                unite(group, c1, indices[c2] == a1 ? c2 : e2);
-                unite(group, e1, indices[c2] == a1 ? e2 : c2);
+                group.unite(c1, indices[c2] == a1 ? c2 : e2);
+                group.unite(e1, indices[c2] == a1 ? e2 : c2);
             }
         }
         i = j;
@@ -108,7 +99,7 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
         const double lu = length(u), lw = length(w);
         if (!(lu > 0 && lw > 0) || faceNormal[f] == Vec3{0, 0, 0}) continue;
         const double angle = std::acos(std::clamp(dot(u, w) / (lu * lw), -1.0, 1.0));
-        Vec3& s = sum[findRoot(group, c)];
+        Vec3& s = sum[group.find(c)];
         Vec3& vs = vertexSum[indices[c]];
         for (int k = 0; k < 3; ++k) {
             s[k] += angle * faceNormal[f][k];
@@ -119,7 +110,7 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
     std::vector<uint32_t> outputOf(cornerCount, runtime::kNoIndex);
     out.indices.resize(cornerCount);
     for (uint32_t c = 0; c < cornerCount; ++c) {
-        const uint32_t root = findRoot(group, c);
+        const uint32_t root = group.find(c);
         if (outputOf[root] == runtime::kNoIndex) {
             outputOf[root] = uint32_t(out.positions.size() / 3);
             const float* p = &positions[3 * size_t(indices[c])];

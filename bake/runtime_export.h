@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: the hierarchy nodes (module) turned into the runtime's flat BuildParams,
-// and the bytes of OUTDIR/scene.aglod (DESIGN section 4).
+// and the bytes of OUTDIR/scene.aglod (docs/design.md §4).
 #pragma once
 
 #include <aggrelod/hierarchy_nodes.h>

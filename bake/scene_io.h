@@ -19,7 +19,7 @@ enum class ObjectUnit {
 };
 
 struct SceneReadOptions {
-    /// ECMAScript regex, searched in each node's name and in its index path ("#0/3/1": the
+    /// ECMAScript regex, searched in each node's name and in its index path ("@0/3/1": the
     /// node's position in the scene's root list, then child positions). A match leaves the
     /// node out with its subtree. A match on "mesh:" followed by the node's mesh name, or on
     /// the name or path followed by "/mesh" (e.g. '^Terrain/mesh$'), drops only the node's

@@ -251,7 +251,7 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
         writeProxyFigures(w, *nodes, -2);
     }
 
-    // Solidified models (DESIGN 2.0): distances sampled, not certified.
+    // Solidified models (docs/design.md §2.0): distances sampled, not certified.
     w.key("solids");
     w.beginArray();
     for (const SolidReport& r : h.solids) {

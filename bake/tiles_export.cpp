@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: 3D Tiles export (DESIGN section 4; runtime selection as in section 3).
+// aggrelod bake: 3D Tiles export (docs/design.md §4; runtime selection as in section 3).
 // See tiles_export.h for the mapping and the axis convention. The GLB contents are written
 // by writeTileGlb (gltf_io.cpp, the only tinygltf user); this file writes the JSON.
 #include "tiles_export.h"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: the hierarchy nodes as a 3D Tiles 1.1 tileset (DESIGN section 4), so that
+// aggrelod bake: the hierarchy nodes as a 3D Tiles 1.1 tileset (docs/design.md §4), so that
 // CesiumJS or 3DTilesRendererJS can stream the hierarchy: OUTDIR/tiles/tileset.json and one
 // GLB per tile.
 //

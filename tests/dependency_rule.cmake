@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-# Checks the dependency rule of DESIGN section 1. Run as
+# Checks the dependency rule of docs/design.md §1. Run as
 #   cmake -DSOURCE_DIR=<repo root> [-DLINK_INFO=<generated file>] -P dependency_rule.cmake
 #
 # - no file under runtime/ includes TetGen, CGAL, tinygltf, meshoptimizer, GEOS, GLM or any
@@ -173,6 +173,6 @@ if(LINK_INFO)
 endif()
 
 if(violations GREATER 0)
-  message(FATAL_ERROR "dependency_rule: ${violations} violation(s) of the dependency rule (DESIGN section 1)")
+  message(FATAL_ERROR "dependency_rule: ${violations} violation(s) of the dependency rule (docs/design.md §1)")
 endif()
 message("dependency_rule: OK")

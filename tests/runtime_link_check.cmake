@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-# Checks that an executable built only from the runtime (DESIGN section 1) carries none of the
+# Checks that an executable built only from the runtime (docs/design.md §1) carries none of the
 # bake-side libraries: neither as a shared library (ldd) nor as statically linked code (nm:
 # TetGen, CGAL, tinygltf, meshoptimizer, GEOS symbols). Run as
 #   cmake -DEXE=<path> -P runtime_link_check.cmake

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod module: few-faced enclosing polytopes of a convex hull (DESIGN section 2.6).
+// aggrelod module: few-faced enclosing polytopes of a convex hull (docs/design.md §2.6).
 //
 // Outer polyhedral approximation by cutting planes (the cutting variant of Kamenev's method
 // of refined estimates; see Lotov, Bushenkov, Kamenev, "Interactive Decision Maps", 2004,

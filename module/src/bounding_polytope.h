@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): few-faced convex polytopes that enclose a convex hull, for the
-// coarsest proxies (DESIGN section 2.6).
+// coarsest proxies (docs/design.md §2.6).
 #pragma once
 
 #include <cstddef>

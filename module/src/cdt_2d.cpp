@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// CGAL wrapper: 2D constrained Delaunay triangulation (DESIGN 2.1; paper Section 3.1).
+// CGAL wrapper: 2D constrained Delaunay triangulation (docs/design.md §2.1; paper Section 3.1).
 // All points and constraints go in as one batch, the way CGAL's insert_constraints() does it
 // (spatially sorted insertion: about 40x faster than inserting polygon by polygon, see
-// NOTES-deps), written out here to keep each input point's vertex. Inside/outside marking is
+// docs/design.md §6), written out here to keep each input point's vertex. Inside/outside marking is
 // done by the caller (CGAL 5.5 has no mark_domain_in_triangulation). Also CGAL's two exact
 // predicates, for the Steiner points that steiner_2d.cpp inserts into the export.
 #include "cdt_2d.h"

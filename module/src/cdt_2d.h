@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Constrained Delaunay triangulation of a planar point set with constraint segments
-// (DESIGN 2.1, 2D; paper Section 3.1). The only place that knows CGAL's 2D triangulation.
+// (docs/design.md §2.1, 2D; paper Section 3.1). The only place that knows CGAL's 2D triangulation.
 #pragma once
 
 #include <atomic>

@@ -2,6 +2,7 @@
 // Collision shapes per hierarchy node: a convex hull per shell, kept when its certified
 // distance to the originals fits the node's error (collision_shapes.h).
 #include <aggrelod/collision_shapes.h>
+#include <aggrelod/disjoint_sets.h>
 
 #include "convex_hull.h"
 #include "parallel_for.h"
@@ -16,11 +17,6 @@
 
 namespace aggrelod {
 namespace {
-
-uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-}
 
 /// Shells of a triangle mesh: triangles joined through vertices of equal position. Returns,
 /// per shell in order of its first triangle, the distinct positions of its vertices (doubles,
@@ -44,18 +40,14 @@ std::vector<std::vector<double>> shellPoints(const std::vector<float>& positions
         for (size_t k = i; k < j; ++k) weld[order[k]] = order[i];
         i = j;
     }
-    std::vector<uint32_t> parent(vertexCount);
-    std::iota(parent.begin(), parent.end(), 0u);
+    DisjointSets sets(vertexCount);
     for (size_t t = 0; t + 2 < indices.size(); t += 3)
-        for (int k = 1; k < 3; ++k) {
-            const uint32_t a = findRoot(parent, weld[indices[t]]), b = findRoot(parent, weld[indices[t + k]]);
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
-        }
+        for (int k = 1; k < 3; ++k) sets.unite(weld[indices[t]], weld[indices[t + k]]);
     std::vector<uint32_t> shellOf(vertexCount, ~0u);
     std::vector<std::vector<uint32_t>> members;
     for (size_t t = 0; t + 2 < indices.size(); t += 3)
         for (int k = 0; k < 3; ++k) {
-            const uint32_t v = weld[indices[t + k]], root = findRoot(parent, v);
+            const uint32_t v = weld[indices[t + k]], root = sets.find(v);
             if (shellOf[root] == ~0u) {
                 shellOf[root] = uint32_t(members.size());
                 members.emplace_back();

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod module: conservative simplification of closed meshes (DESIGN section 2.6).
+// aggrelod module: conservative simplification of closed meshes (docs/design.md §2.6).
 //
 // Implements progressive hulls (Sander, Gu, Gortler, Hoppe, Snyder, "Silhouette clipping",
 // SIGGRAPH 2000, section 3.3): an edge collapse whose new vertex lies on or outside the
@@ -18,6 +18,7 @@
 #include "conservative_simplify.h"
 
 #include "mesh_distance.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <array>
@@ -29,15 +30,7 @@
 namespace aggrelod::detail {
 namespace {
 
-struct V3 {
-    double x = 0, y = 0, z = 0;
-};
-V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-double length(V3 a) { return std::sqrt(dot(a, a)); }
+using V3 = Vec3;
 
 /// Symmetric 4x4 quadric of plane distances: sum of w (n.p + d)^2.
 struct Quadric {

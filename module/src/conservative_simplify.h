@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): simplification that keeps a closed mesh enclosing its input
-// (DESIGN section 2.6), for proxies that collide conservatively.
+// (docs/design.md §2.6), for proxies that collide conservatively.
 #pragma once
 
 #include <cstddef>

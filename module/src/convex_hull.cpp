@@ -2,6 +2,8 @@
 // Convex hull via CGAL::convex_hull_3 (exact predicates, inexact constructions).
 #include "convex_hull.h"
 
+#include <aggrelod/disjoint_sets.h>
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
@@ -61,22 +63,16 @@ void canonicalTriangulation(const std::vector<double>& positions, std::vector<st
         auto it = std::lower_bound(faceOfEdge.begin(), faceOfEdge.end(), EdgeFace{u, v, 0});
         return it != faceOfEdge.end() && it->u == u && it->v == v ? static_cast<long>(it->face) : -1;
     };
-    std::vector<size_t> parent(tris.size());
-    for (size_t f = 0; f < tris.size(); ++f) parent[f] = f;
-    auto find = [&](size_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    DisjointSets facets(tris.size());
+    auto find = [&](size_t x) -> size_t { return facets.find(uint32_t(x)); };
     for (size_t f = 0; f < tris.size(); ++f)
         for (int k = 0; k < 3; ++k) {
             const long other = faceAcross(tris[f][(k + 1) % 3], tris[f][k]);
             if (other < 0) continue;
             const auto& g = tris[static_cast<size_t>(other)];
             uint32_t apex = g[0] + g[1] + g[2] - tris[f][k] - tris[f][(k + 1) % 3];
-            if (CGAL::coplanar(point(tris[f][0]), point(tris[f][1]), point(tris[f][2]), point(apex))) {
-                size_t a = find(f), b = find(static_cast<size_t>(other));
-                if (a != b) parent[std::max(a, b)] = std::min(a, b);
-            }
+            if (CGAL::coplanar(point(tris[f][0]), point(tris[f][1]), point(tris[f][2]), point(apex)))
+                facets.unite(uint32_t(f), uint32_t(other));
         }
     // Boundary edges of each merged facet (root, u -> v), sorted by (root, u).
     std::vector<std::array<uint64_t, 3>> boundary;

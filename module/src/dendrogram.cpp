@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Kruskal dendrogram and level thresholds (DESIGN 2.3; paper Algorithm 1, Section 3.2).
+// Kruskal dendrogram and level thresholds (docs/design.md §2.3; paper Algorithm 1, Section 3.2).
 #include <aggrelod/dendrogram.h>
+#include <aggrelod/disjoint_sets.h>
 
 #include "radix_sort.h"
 
@@ -12,15 +13,6 @@
 
 namespace aggrelod {
 namespace {
-struct DisjointSets {
-    std::vector<uint32_t> parent;
-    explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    uint32_t find(uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-};
-
 struct SortedEdge {
     uint32_t index, a, b;  // a < b
     uint32_t rounded;      // bits of the weight rounded to float (radix path)
@@ -85,7 +77,7 @@ std::vector<Merge> kruskalMerges(size_t modelCount, const std::vector<GraphEdge>
         uint32_t ra = sets.find(e.a), rb = sets.find(e.b);
         if (ra == rb) continue;
         if (size[ra] < size[rb]) std::swap(ra, rb);
-        sets.parent[rb] = ra;
+        sets.attach(rb, ra);
         size[ra] += size[rb];
         merges.push_back(Merge{edges[e.index].weight, e.a, e.b});
         if (mergeEdge) mergeEdge->push_back(e.index);
@@ -98,8 +90,7 @@ std::vector<uint32_t> groupsAtThreshold(size_t modelCount, const std::vector<Mer
     DisjointSets sets(modelCount);
     for (const Merge& m : merges) {
         if (!(m.height < delta)) break;  // merges are ascending
-        uint32_t ra = sets.find(m.modelA), rb = sets.find(m.modelB);
-        if (ra != rb) sets.parent[std::max(ra, rb)] = std::min(ra, rb);
+        sets.unite(m.modelA, m.modelB);
     }
     // Roots are the smallest member (parent always points to the smaller index).
     std::vector<uint32_t> group(modelCount, UINT32_MAX);
@@ -112,6 +103,15 @@ std::vector<uint32_t> groupsAtThreshold(size_t modelCount, const std::vector<Mer
     }
     if (groupCount) *groupCount = next;
     return group;
+}
+
+bool validThresholds(const std::vector<double>& deltas, std::string& problem) {
+    for (double d : deltas)
+        if (!std::isfinite(d) || d < 0) {
+            problem = "every threshold delta must be a finite number >= 0";
+            return false;
+        }
+    return true;
 }
 
 std::vector<double> automaticDeltas(const std::vector<Merge>& merges, int levelCount) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The tetrahedralized scene shared by every level (DESIGN 2.1 and 2.2): which model owns
+// The tetrahedralized scene shared by every level (docs/design.md §2.1 and §2.2): which model owns
 // each vertex, which tets are free space, and the per-pair statistics of the neighbourhood
 // graph. Built once per bake; levels only read it.
 #pragma once

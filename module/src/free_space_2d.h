@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The triangulated free space of a 2D scene, shared by the graph, hierarchy and sculpting
-// stages (DESIGN 2.1-2.4, 2D). Built once; every level only reads it.
+// stages (docs/design.md §2.1–2.4, 2D). Built once; every level only reads it.
 #pragma once
 
 #include "cdt_2d.h"

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod module: hierarchy nodes for real-time use (DESIGN sections 2.5 and 2.6).
+// aggrelod module: hierarchy nodes for real-time use (docs/design.md §2.5 and §2.6).
 // Builds the tree (leaves = original objects, inner nodes = aggregates, unchanged aggregates
 // collapsed across levels), simplifies every aggregate into an enclosing proxy within its
 // error budget and gives each object a chain of enclosing simplifications (per-object LOD;
 // conservative_simplify.cpp),
 // measures its error (proxy_error.cpp), colours its faces after the nearest original surface
 // (surface_colors.cpp), and makes bounds nested and errors monotone so that
-// the runtime's screen-space rule (DESIGN section 3) always selects a clean cut.
+// the runtime's screen-space rule (docs/design.md §3) always selects a clean cut.
 #include "bounding_polytope.h"
 #include "conservative_simplify.h"
 #include "convex_hull.h"
@@ -16,6 +16,7 @@
 #include "proxy_error.h"
 #include "surface_colors.h"
 
+#include <aggrelod/disjoint_sets.h>
 #include <aggrelod/hierarchy_nodes.h>
 
 #include <algorithm>
@@ -254,7 +255,7 @@ struct ExactProxy {
 /// vertex-to-plane distance, not the certified one, so the largest can still miss).
 constexpr double kRoomFractions[] = {1.0 / 4, 1.0 / 2, 1.0, 2.0, 4.0};
 
-/// The proxy of an aggregate node (DESIGN section 2.6). Its budget is the exact aggregate's
+/// The proxy of an aggregate node (docs/design.md §2.6). Its budget is the exact aggregate's
 /// own certified error (the fill between the originals: nothing that encloses the aggregate
 /// does better) plus simplifyFraction * delta of room; the proxy is the coarsest
 /// conservative simplification of the aggregate that does not intersect itself and whose
@@ -307,18 +308,13 @@ const detail::ConservativeSnapshot* lighterCleanSnapshot(EnclosureSeries& series
 
 /// Connected pieces of a triangle mesh (triangles sharing a vertex are connected).
 size_t shellCount(size_t vertexCount, const std::vector<uint32_t>& triangles) {
-    std::vector<uint32_t> parent(vertexCount);
-    for (uint32_t v = 0; v < vertexCount; ++v) parent[v] = v;
-    const auto root = [&](uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    };
+    DisjointSets sets(vertexCount);
     for (size_t t = 0; t + 2 < triangles.size(); t += 3)
-        for (int k = 1; k < 3; ++k) parent[root(triangles[t + k])] = root(triangles[t]);
+        for (int k = 1; k < 3; ++k) sets.unite(triangles[t], triangles[t + k]);
     std::vector<char> used(vertexCount, 0);
     for (uint32_t v : triangles) used[v] = 1;
     size_t count = 0;
-    for (uint32_t v = 0; v < vertexCount; ++v) count += used[v] && root(v) == v;
+    for (uint32_t v = 0; v < vertexCount; ++v) count += used[v] && sets.find(v) == v;
     return count;
 }
 
@@ -350,7 +346,7 @@ std::vector<HierarchyNode> lightestChain(std::vector<HierarchyNode> candidates, 
 constexpr double kChainFinestFraction = 1.0 / 1024;
 constexpr double kChainRatio = 1.4142135623730951;
 
-/// Per-object LOD (DESIGN section 2.6): conservative simplifications of one object at error
+/// Per-object LOD (docs/design.md §2.6): conservative simplifications of one object at error
 /// targets sqrt(2) apart, from a thousandth of its diagonal up to below `ceiling` (the error
 /// of the first aggregate above it holding other objects; infinity for none, then up to its
 /// diagonal), and for an object of one shell the coarsest enclosing polytope of its convex
@@ -416,7 +412,7 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
     return chain;
 }
 
-/// Coarser versions of an aggregate node (DESIGN section 2.6): enclosing simplifications of
+/// Coarser versions of an aggregate node (docs/design.md §2.6): enclosing simplifications of
 /// its proxy at error targets sqrt(2) apart above the node's budget, up to below `ceiling`
 /// (its parent's certified error; infinity for a root, then up to the aggregate's diagonal).
 /// A level's proxy fits a budget near the fill's own error, the next level's error is that

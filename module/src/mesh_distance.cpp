@@ -3,6 +3,7 @@
 // See mesh_distance.h for what is implemented (Ericson, "Real-Time Collision Detection",
 // 2005: 5.1.2, 5.1.5, 5.1.9, 5.3.4, 6.3.x), units (world units) and array sizes.
 #include "mesh_distance.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <cfloat>
@@ -28,13 +29,6 @@ inline void store(const Vec3& v, double* out) {
         out[1] = v.y;
         out[2] = v.z;
     }
-}
-inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator*(const Vec3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline double dist2(const Vec3& a, const Vec3& b) {
     Vec3 d = a - b;

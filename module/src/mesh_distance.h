@@ -37,9 +37,6 @@
 
 namespace aggrelod::detail {
 
-struct Vec3 {
-    double x = 0, y = 0, z = 0;
-};
 
 /// BVH over a triangle soup. Copies the triangle corners (in leaf order), so the input
 /// arrays may be released after build().

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module (internal): index order of proxy meshes for the GPU's vertex cache
-// (DESIGN section 2.6). The only place that calls meshoptimizer, so it can be swapped.
+// (docs/design.md §2.6). The only place that calls meshoptimizer, so it can be swapped.
 #pragma once
 
 #include <cstdint>

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Input clean-up (DESIGN 2 and 5): exact weld, degenerate removal, finiteness check,
+// Input clean-up (docs/design.md §2 and §5): exact weld, degenerate removal, finiteness check,
 // closedness / manifoldness / orientation analysis, inside-out repair per shell.
 #include "mesh_preparation.h"
 
 #include "mesh_distance.h"
+
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <array>
@@ -26,20 +28,6 @@ double triangleArea(const double* a, const double* b, const double* c) {
     const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
     return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
-
-struct UnionFind {
-    std::vector<uint32_t> parent;
-    explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    uint32_t find(uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-    void unite(uint32_t a, uint32_t b) {
-        a = find(a);
-        b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-};
 
 }  // namespace
 
@@ -206,7 +194,7 @@ void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject
         return std::tie(x.lo, x.hi, x.tri) < std::tie(y.lo, y.hi, y.tri);
     });
     size_t boundaryEdges = 0, nonManifoldEdges = 0, misoriented = 0;
-    UnionFind shells(triCount);
+    DisjointSets shells(triCount);
     std::vector<std::array<uint32_t, 2>> manifoldPairs;  // triangle pairs sharing a 2-use edge
     std::vector<bool> sameDirection;
     for (size_t i = 0; i < edges.size();) {

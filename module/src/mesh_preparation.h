@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Input clean-up and validation of one object (DESIGN 2, "Bad input"): weld, drop
+// Input clean-up and validation of one object (docs/design.md §2, "Bad input"): weld, drop
 // degenerate triangles, reject NaN/inf, detect open, non-manifold and inside-out meshes.
 #pragma once
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The 2D pipeline (paper Sections 3.1-3.3 and 4.2; DESIGN 2.1-2.5 in 2D):
+// The 2D pipeline (paper Sections 3.1-3.3 and 4.2; docs/design.md §2.1–2.5 in 2D):
 // check input -> one constrained Delaunay triangulation -> inside/outside by winding ->
 // models (touching / overlapping polygons merged) -> neighbourhood graph -> Kruskal
 // dendrogram (shared with 3D) -> per level: sculpt, polygons, measures and baselines.
@@ -11,6 +11,7 @@
 
 #include <aggrelod/aggregate2d.h>
 #include <aggrelod/dendrogram.h>
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <atomic>
@@ -40,16 +41,6 @@ Measures2D normalizedMeasures(const Measures2D& m, const Measures2D& o) {
 namespace {
 using namespace detail;
 using Clock = std::chrono::steady_clock;
-
-uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-}
-void unite(std::vector<uint32_t>& parent, uint32_t a, uint32_t b) {
-    a = findRoot(parent, a);
-    b = findRoot(parent, b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-}
 
 /// Input vertices as one array, with the ring structure needed to orient constraints.
 struct InputVertices {
@@ -334,15 +325,14 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
 
     // 4. Models: parts of one feature, touching or overlapping parts, parts nested in others.
     const uint32_t partCount = static_cast<uint32_t>(checked.parts.size());
-    std::vector<uint32_t> parent(partCount);
-    std::iota(parent.begin(), parent.end(), 0u);
+    DisjointSets parts(partCount);
     for (uint32_t p = 1; p < partCount; ++p)
-        if (checked.partFeature[p] == checked.partFeature[p - 1]) unite(parent, p, p - 1);
+        if (checked.partFeature[p] == checked.partFeature[p - 1]) parts.unite(p, p - 1);
     std::vector<char>& partTouches = models.partTouches;
     partTouches.assign(partCount, 0);
     auto join = [&](uint32_t a, uint32_t b) {
         if (checked.partFeature[a] != checked.partFeature[b]) partTouches[a] = partTouches[b] = 1;
-        unite(parent, a, b);
+        parts.unite(a, b);
     };
     for (auto [a, b] : checked.touchingParts) join(a, b);
     // Interior faces of two parts side by side (found in parallel, joined in block order; the
@@ -362,7 +352,7 @@ void buildFreeSpace(const InputVertices& in, const CheckedPolygons& checked, con
     std::vector<int> modelOfRoot(partCount, -1);
     partModel.assign(partCount, -1);
     for (uint32_t p = 0; p < partCount; ++p) {
-        const uint32_t r = findRoot(parent, p);
+        const uint32_t r = parts.find(p);
         if (modelOfRoot[r] < 0) modelOfRoot[r] = static_cast<int>(space.modelCount++);
         partModel[p] = modelOfRoot[r];
     }
@@ -716,7 +706,7 @@ InputVertices inputVertices(const CheckedPolygons& checked, const SegmentSplits*
     return in;
 }
 
-/// Steiner points for the shortest connection of every merge (DESIGN 2.4 step 4): where a
+/// Steiner points for the shortest connection of every merge (docs/design.md §2.4 step 4): where a
 /// connection ends at a vertex, its boundary edges longer than 3 d get a point at distance d
 /// (d = the connection's length); where it ends inside an edge, the edge gets the foot point
 /// and points d to either side. mergePair: per merge, its index in space.pairs. Only called
@@ -812,8 +802,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
         out.diagnostics.push_back({Diagnostic::Severity::Error, "", message});
         return false;
     };
-    for (double d : settings.deltas)
-        if (!std::isfinite(d) || d < 0) return fail("every threshold delta must be a finite number >= 0");
+    if (std::string problem; !validThresholds(settings.deltas, problem)) return fail(problem);
 
     // 1. Input checks, in two steps: the rings are cleaned and oriented first; the contact
     // checks (self-intersections, crossings, touching polygons) then run on another thread
@@ -844,7 +833,7 @@ bool buildHierarchy2D(const std::vector<Feature2D>& features, const Settings2D& 
 
     const bool needHulls = settings.computeBaselines || settings.shape == Shape2D::ConvexHull;
     // 2.-5. Triangulation, free space, models and graph; then once more with Steiner points
-    // on long boundary edges at the shortest connections of the dendrogram (DESIGN 2.4
+    // on long boundary edges at the shortest connections of the dendrogram (docs/design.md §2.4
     // step 4), so that joined models get a narrow bridge of small triangles.
     progress("triangulating", 0);
     FreeSpace2D space;

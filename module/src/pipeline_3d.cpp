@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The 3D bake (DESIGN 2): prepare objects, set support surfaces aside and solidify what is
-// not a valid closed solid (DESIGN 2.0), group touching objects into models, triangulate
+// The 3D bake (docs/design.md §2): prepare objects, set support surfaces aside and solidify what is
+// not a valid closed solid (docs/design.md §2.0), group touching objects into models, triangulate
 // the free space once, build the neighbourhood graph and dendrogram, then shape and measure
 // every level from that one triangulation.
 #include "convex_hull.h"
@@ -9,12 +9,14 @@
 #include "mesh_distance.h"
 #include "mesh_preparation.h"
 #include "parallel_for.h"
+#include "radix_sort.h"
 #include "surface_colors.h"
 #include "sculpt_3d.h"
 #include "tetgen_backend.h"
 
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/dendrogram.h>
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <array>
@@ -92,27 +94,11 @@ void diag(Hierarchy3D& out, Diagnostic::Severity s, const std::string& object, c
     out.diagnostics.push_back(Diagnostic{s, object, message});
 }
 
-struct DisjointSets {
-    std::vector<uint32_t> parent;
-    explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    uint32_t find(uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-    bool unite(uint32_t a, uint32_t b) {
-        a = find(a);
-        b = find(b);
-        if (a == b) return false;
-        parent[std::max(a, b)] = std::min(a, b);
-        return true;
-    }
-};
-
 /// A vertex of the neighbourhood graph: one object, or objects that touch.
 struct Model {
     std::vector<uint32_t> objects;    ///< ascending input indices
     /// What the surface given to the triangulator is: the objects' own faces, or a solid
-    /// standing in for them (DESIGN 2.0).
+    /// standing in for them (docs/design.md §2.0).
     enum class Kind { Original, Union, Wrap, Hull } kind = Kind::Original;
     bool standIn() const { return kind != Kind::Original; }
     std::string reason;               ///< why it is solidified
@@ -306,7 +292,7 @@ bool Baker::prepare() {
     return true;
 }
 
-// Support surfaces (DESIGN 2.0): ground, terrain, sky dome, road network, room shell. The
+// Support surfaces (docs/design.md §2.0): ground, terrain, sky dome, road network, room shell. The
 // rule (Settings3D::supportSpanFraction): an object that spans most of the scene in two
 // axes and whose box meets the boxes of a large share of the other objects carries or
 // encloses them; aggregating it would join everything into one blob at the finest level.
@@ -1051,20 +1037,15 @@ void Baker::buildGraph() {
     // vertex first (counting sort): each edge appears in several tets, and the list is long.
     {
         const size_t pointCount = mesh.pointCount();
-        std::vector<uint32_t> start(pointCount + 1, 0);
-        for (const auto& e : edges) ++start[e.first + 1];
-        for (size_t p = 0; p < pointCount; ++p) start[p + 1] += start[p];
-        std::vector<int> second(edges.size());
-        std::vector<uint32_t> at(start.begin(), start.end() - 1);
-        for (const auto& e : edges) second[at[e.first]++] = e.second;
+        std::vector<uint32_t> start;
+        std::vector<std::pair<int, int>> byFirst;
+        detail::countingSortByBucket(edges, pointCount, [](const std::pair<int, int>& e) { return e.first; }, start, byFirst);
         edges.clear();
         for (size_t u = 0; u < pointCount; ++u) {
-            int* b = second.data() + start[u];
-            int* e = second.data() + start[u + 1];
-            if (b == e) continue;
-            std::sort(b, e);
-            for (int* v = b; v != e; ++v)
-                if (v == b || *v != v[-1]) edges.emplace_back(static_cast<int>(u), *v);
+            const auto b = byFirst.begin() + start[u], e = byFirst.begin() + start[u + 1];
+            std::sort(b, e);  // one first vertex: by the second
+            for (auto v = b; v != e; ++v)
+                if (v == b || v->second != (v - 1)->second) edges.push_back(*v);
         }
     }
     // Accumulate per model pair (u on a, v on b, a < b).
@@ -1151,7 +1132,7 @@ void Baker::buildGraph() {
 // Before the one triangulation: each model's nearest neighbours (by box distance) are
 // measured exactly; where the closest points lie far from the surface vertices (coarse
 // triangles), they are inserted as vertices, so the triangulation gets gap-spanning edges
-// close to the true distance without a second TetGen run (DESIGN 2.4 step 4).
+// close to the true distance without a second TetGen run (docs/design.md §2.4 step 4).
 void Baker::prerefineClosePairs() {
     timer_.begin("prerefine");
     resolveStandInOverlaps();
@@ -1394,7 +1375,7 @@ void Baker::prepareModels(int threadCount) {
     modelsPrepared_ = true;
 }
 
-// DESIGN 2.4 step 4: where large input triangles leave no short triangulation edge between
+// docs/design.md §2.4 step 4: where large input triangles leave no short triangulation edge between
 // two models the dendrogram joins (shortest edge much longer than the exact distance),
 // insert the closest points into both surfaces as Steiner vertices and triangulate again,
 // so that gap-spanning edges approach the true distance. One extra pass, only when needed.
@@ -1423,7 +1404,7 @@ bool Baker::refineCoarseConnections() {
     return inserted > 0;
 }
 
-// Automatic thresholds that change something one can see (DESIGN 2.3). Merges closer than
+// Automatic thresholds that change something one can see (docs/design.md §2.3). Merges closer than
 // 0.1 % of the diagonal of the aggregated objects (support surfaces left out) look the same
 // as touching at any distance where the scene is seen whole: the geometric series of levels
 // starts at the first merge above that, and runs to the last merge. The finest level sits
@@ -1689,6 +1670,10 @@ bool Baker::run() {
 }  // namespace
 
 bool buildHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, Hierarchy3D& out) {
+    if (std::string problem; !validThresholds(settings.deltas, problem)) {
+        out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", problem});
+        return false;
+    }
     try {
         Baker baker(objects, settings, out);
         return baker.run();

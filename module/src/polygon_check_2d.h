@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Input checks for 2D polygons (DESIGN 2.1 input rules): finite coordinates, rings of at
+// Input checks for 2D polygons (docs/design.md §2.1 input rules): finite coordinates, rings of at
 // least 3 distinct vertices with non-zero area, no self-intersecting ring, no crossing rings
 // within a polygon; and which polygons touch or overlap each other (merged into one model).
 #pragma once

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod module: geometric error of a proxy against the original objects (DESIGN 2.5,
+// aggrelod module: geometric error of a proxy against the original objects (docs/design.md §2.5,
 // "Geometric error of a proxy"): both one-sided Hausdorff distances, with certified upper
 // bounds.
 //

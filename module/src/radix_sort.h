@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Stable LSD radix sort on an unsigned integer key: linear passes of 11-bit digits instead of
-// a comparison sort, for the large flat arrays of the 2D pipeline and the dendrogram.
+// Linear-time sorts on small integer keys, instead of comparison sorts of large flat arrays:
+// a stable LSD radix sort (the 2D pipeline, the dendrogram) and a counting sort into buckets
+// (edges by their first vertex or their group, in the 2D and 3D pipelines and sculpting).
 #pragma once
 
 #include <algorithm>
@@ -33,6 +34,21 @@ void radixSortStable(std::vector<T>& items, KeyFn key, int keyBits = 64) {
         items.swap(buffer);
         keys.swap(keyBuffer);
     }
+}
+
+/// Counting sort into buckets: `out` receives `items` grouped by key(item) (an integer in
+/// [0, bucketCount)), each bucket in input order (stable); `start` receives bucketCount + 1
+/// offsets, bucket b being out[start[b], start[b + 1]). Both outputs are resized (their
+/// storage is reused); O(items + buckets).
+template <class T, class KeyFn>
+void countingSortByBucket(const std::vector<T>& items, size_t bucketCount, KeyFn key, std::vector<uint32_t>& start,
+                          std::vector<T>& out) {
+    start.assign(bucketCount + 1, 0);
+    for (const T& item : items) ++start[size_t(key(item)) + 1];
+    for (size_t b = 0; b < bucketCount; ++b) start[b + 1] += start[b];
+    out.resize(items.size());
+    std::vector<uint32_t> at(start.begin(), start.end() - 1);
+    for (const T& item : items) out[at[size_t(key(item))]++] = item;
 }
 
 }  // namespace aggrelod::detail

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Sculpting in 2D (DESIGN 2.4; paper Section 3.3 "Aggregated Approximation") and the
+// Sculpting in 2D (docs/design.md §2.4; paper Section 3.3 "Aggregated Approximation") and the
 // extraction of polygons with holes from the kept triangles.
 //
 // Step 1: a free triangle takes the single group of its owned vertices; triangles of two or
@@ -15,21 +15,15 @@
 
 #include "parallel_for.h"
 #include "polygon_check_2d.h"
+#include "radix_sort.h"
+
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 namespace aggrelod::detail {
-namespace {
-
-uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-}
-
-}  // namespace
-
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function) {
     EdgeLimits2D limits;
     AggregateFunctionInput same;
@@ -328,12 +322,9 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
     }
     // Sorted by (group, from, to): a counting sort on the group, then small sorts per group.
     {
-        std::vector<uint32_t> start(groupCount + 1, 0);
-        for (const HalfEdge& e : edges) ++start[e.group + 1];
-        for (size_t g = 0; g < groupCount; ++g) start[g + 1] += start[g];
-        std::vector<HalfEdge> bucketed(edges.size());
-        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-        for (const HalfEdge& e : edges) bucketed[fill[e.group]++] = e;
+        std::vector<uint32_t> start;
+        std::vector<HalfEdge> bucketed;
+        countingSortByBucket(edges, groupCount, [](const HalfEdge& e) { return e.group; }, start, bucketed);
         auto less = [](const HalfEdge& a, const HalfEdge& b) { return a.from != b.from ? a.from < b.from : a.to < b.to; };
         for (size_t g = 0; g < groupCount; ++g) {
             const auto first = bucketed.begin() + start[g], last = bucketed.begin() + start[g + 1];
@@ -348,22 +339,20 @@ void extractPolygons2D(const FreeSpace2D& space, const std::vector<int>& faceLab
     }
     // Face components (edge-connected kept faces of one group): holes join the exterior of
     // theirs. Built only when a level has a hole.
-    std::vector<uint32_t> parent;
+    DisjointSets components;
     auto componentOf = [&](int face) {
-        if (parent.empty()) {
-            parent.resize(faceCount);
-            std::iota(parent.begin(), parent.end(), 0u);
+        if (components.size() == 0) {
+            components.reset(faceCount);
             for (size_t f = 0; f < faceCount; ++f) {
                 if (faceLabel[f] < 0) continue;
                 for (int j = 0; j < 3; ++j) {
                     const int n = tri.neighbors[3 * f + j];
                     if (n < 0 || faceLabel[n] != faceLabel[f]) continue;
-                    uint32_t a = findRoot(parent, static_cast<uint32_t>(f)), b = findRoot(parent, static_cast<uint32_t>(n));
-                    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+                    components.unite(static_cast<uint32_t>(f), static_cast<uint32_t>(n));
                 }
             }
         }
-        return findRoot(parent, static_cast<uint32_t>(face));
+        return components.find(static_cast<uint32_t>(face));
     };
     auto px = [&](int v) { return tri.points[2 * static_cast<size_t>(v)]; };
     auto py = [&](int v) { return tri.points[2 * static_cast<size_t>(v) + 1]; };

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Sculpting one 2D level (DESIGN 2.4; paper Section 3.3) and turning the kept triangles
+// Sculpting one 2D level (docs/design.md §2.4; paper Section 3.3) and turning the kept triangles
 // into OGC-valid polygons with holes.
 #pragma once
 
@@ -9,7 +9,7 @@
 
 namespace aggrelod::detail {
 
-/// F of every model pair at one level (DESIGN 2.4 step 3), evaluated once per level.
+/// F of every model pair at one level (docs/design.md §2.4 step 3), evaluated once per level.
 struct EdgeLimits2D {
     double sameModel = 0;      ///< F for an edge with both ends on one model
     double unpaired = 0;       ///< F for an edge with a Steiner end
@@ -21,7 +21,7 @@ struct EdgeLimits2D {
 EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function);
 
 /// The fans of free faces that can carry each merge's shortest connection to its two models
-/// (DESIGN 2.4 step 4), walked once for all levels. The merges are kept in `order`, by their
+/// (docs/design.md §2.4 step 4), walked once for all levels. The merges are kept in `order`, by their
 /// pair's first best face (neighbouring merges touch neighbouring faces).
 /// For the merge at position p of `order`, best face i (of the pair's two) and model s (0:
 /// pair.a, 1: pair.b), slot 4p + 2i + s lists the walks around the model's vertices from that
@@ -42,7 +42,7 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
 
 /// Labels every face with the group whose aggregate contains it (-1: in none).
 /// The first `joinedMerges` merges (those of this level) keep their shortest connection
-/// (DESIGN 2.4 step 4), through `fans`.
+/// (docs/design.md §2.4 step 4), through `fans`.
 void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
                    const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel);
 

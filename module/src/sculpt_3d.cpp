@@ -1,19 +1,22 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Sculpting (DESIGN 2.4; paper Section 3.3 "Aggregated Approximation", 3D as Section 4.4)
+// Sculpting (docs/design.md §2.4; paper Section 3.3 "Aggregated Approximation", 3D as Section 4.4)
 // and surface extraction of the aggregates.
 //
 // Step 1 drops free tets whose owned vertices belong to several groups (or to none).
 // Step 2 carves from the outside: a kept free tet with an exposed facet (on the hull or
 // facing a tet outside its group's solid) is removed when an edge of such a facet is
 // longer than F(m1, m2). Carving is monotone (removing a tet only exposes more), so the
-// removed set does not depend on visiting order (DESIGN asks for longest-edge-first to get
-// that; monotonicity already gives it, and a stack is linear instead of n log n).
+// removed set does not depend on visiting order (a longest-edge-first queue would give that
+// too; monotonicity already does, and a stack is linear instead of n log n).
 // Step 4 keeps, for every pair joined at this level, a face-connected chain of tets from
 // one model's surface to the other's along the shortest connection (A* over tet
 // adjacency, Euclidean costs), so joined models always come out as one solid.
 #include "sculpt_3d.h"
 
 #include "parallel_for.h"
+#include "radix_sort.h"
+
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <deque>
@@ -447,15 +450,8 @@ struct Sculptor {
             // sorting all uses, without sorting hundreds of thousands of them.
             const size_t pointCount = mesh.pointCount();
             std::vector<uint32_t>& start = repairStart;
-            start.assign(pointCount + 1, 0);
-            for (const EdgeUse& use : uses) ++start[use.u + 1];
-            for (size_t p = 0; p < pointCount; ++p) start[p + 1] += start[p];
             std::vector<EdgeUse>& byVertex = repairByVertex;
-            byVertex.resize(uses.size());
-            {
-                std::vector<uint32_t> at(start.begin(), start.end() - 1);
-                for (const EdgeUse& use : uses) byVertex[at[use.u]++] = use;
-            }
+            countingSortByBucket(uses, pointCount, [](const EdgeUse& use) { return use.u; }, start, byVertex);
             uses.clear();
             for (size_t p = 0; p < pointCount; ++p) {
                 EdgeUse* b = byVertex.data() + start[p];
@@ -771,21 +767,6 @@ void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::
 
 // ---- surface extraction ----------------------------------------------------------------
 
-namespace {
-struct Corners {
-    std::vector<uint32_t> parent;
-    uint32_t find(uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-    void unite(uint32_t a, uint32_t b) {
-        a = find(a);
-        b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-};
-}  // namespace
-
 void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size_t groupCount,
                      std::vector<Aggregate>& aggregates, const std::vector<int>* surfaceTets, SculptScratch* scratch) {
     SculptScratch local;
@@ -834,7 +815,7 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
     std::vector<uint64_t>& edgeKeys = buffers.edgeKeys;  // open addressing: directed edge (from << 32 | to)
     std::vector<int>& edgeUse = buffers.edgeUse;         // its face edge 3 * face + e, or -1 when used twice
     std::vector<uint32_t> outIndex;
-    Corners corners, shells;
+    DisjointSets corners, shells;
     for (size_t g = 0; g < groupCount; ++g) {
         const std::pair<int, int>* list = byGroup.data() + groupStart[g];
         const size_t listSize = groupStart[g + 1] - groupStart[g];
@@ -850,10 +831,8 @@ void extractSurfaces(const FreeSpace& space, const std::vector<int>& label, size
                 if (mesh.tets[4 * t + k] == v) return k;
             return -1;
         };
-        corners.parent.resize(3 * listSize);
-        std::iota(corners.parent.begin(), corners.parent.end(), 0u);
-        shells.parent.resize(listSize);
-        std::iota(shells.parent.begin(), shells.parent.end(), 0u);
+        corners.reset(3 * listSize);
+        shells.reset(listSize);
         // Twin of each face edge, recorded for both sides. Where the group's surface uses the
         // edge once each way (a manifold edge: nearly all), the twin is the one face using it
         // the other way, looked up in a table of directed edges. Otherwise (the edge is on

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Sculpting one level (DESIGN 2.4; paper Sections 3.3 and 4.4) and extracting the
-// aggregate surfaces (DESIGN 2.4 step 5).
+// Sculpting one level (docs/design.md §2.4; paper Sections 3.3 and 4.4) and extracting the
+// aggregate surfaces (docs/design.md §2.4 step 5).
 #pragma once
 
 #include "free_space.h"
@@ -32,7 +32,7 @@ struct EdgeLimits {
 /// built): every level then only looks them up. threadCount: as Settings3D::threadCount.
 void precomputeTetEdges(FreeSpace& space, int threadCount);
 
-/// Evaluates `function` for every pair at threshold delta (DESIGN 2.4 step 3).
+/// Evaluates `function` for every pair at threshold delta (docs/design.md §2.4 step 3).
 EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
                              DistanceMode distance);
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Solidification of objects that are not valid closed solids (DESIGN 2.0 "Solidify"):
+// Solidification of objects that are not valid closed solids (docs/design.md §2.0 "Solidify"):
 // the exact union of touching closed parts (CGAL corefinement), and CGAL 3D Alpha Wrapping
 // (Portaneri, Rouxel-Labbé, Hemmer, Cohen-Steiner, Alliez, "Alpha Wrapping with an Offset",
 // ACM TOG 41(4), 2022), CGAL 5.5 `alpha_wrap_3`, GPL-3+:

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Steiner points on constrained edges of a flat constrained Delaunay triangulation, and the
-// canonical numbering of its faces (DESIGN 2.4 step 4; paper Section 3.1). Insertion is the
+// canonical numbering of its faces (docs/design.md §2.4 step 4; paper Section 3.1). Insertion is the
 // textbook incremental one for a point on an edge (split the two faces, then Lawson flips
 // across the edges opposite the new vertex; de Berg et al., Computational Geometry, 9.3),
 // with CGAL's exact predicates (cdt_2d.h), so the result equals CGAL's own insertion.

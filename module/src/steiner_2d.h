@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Steiner points on the constrained edges of a flat 2D constrained Delaunay triangulation
-// (DESIGN 2.4 step 4): the points the 2D pipeline adds at the shortest connection of every
+// (docs/design.md §2.4 step 4): the points the 2D pipeline adds at the shortest connection of every
 // merge, inserted into the exported triangulation instead of into CGAL's, so that the
 // triangulation is neither rebuilt nor exported twice. Also the canonical numbering that
 // every exported triangulation gets.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// TetGen wrapper (see tetgen_backend.h). Implements DESIGN 2.1, 3D: constrained Delaunay
+// TetGen wrapper (see tetgen_backend.h). Implements docs/design.md §2.1, 3D: constrained Delaunay
 // tetrahedralization of the free space, switches "pczQn", no hole points.
 #include "tetgen_backend.h"
 

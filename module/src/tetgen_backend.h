@@ -2,7 +2,7 @@
 // The one place that calls TetGen 1.5 (AGPL-3+). Swap this file to change triangulator.
 //
 // TetGen runs in a forked child process: the Debian build keeps its assert()s and
-// its error path double-frees (NOTES-deps.md), so a bad input must not be able to
+// its error path double-frees (docs/design.md §6), so a bad input must not be able to
 // take the baking process down. Results come back through a pipe.
 #pragma once
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Overrides TetGen's weak terminatetetgen(): the Debian library frees its mesh and then
-// throws, and the stack-held mesh frees it again while unwinding (NOTES-deps.md). This
+// throws, and the stack-held mesh frees it again while unwinding (docs/design.md §6). This
 // version only throws the code. It must not include tetgen.h (the declaration differs).
 class tetgenmesh;
 

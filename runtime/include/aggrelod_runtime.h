@@ -146,7 +146,7 @@ void aglod_selector_destroy(aglod_selector* selector);
  * non-finite triangles_per_draw_call. */
 aglod_status aglod_selector_set_draw_costs(aglod_selector* selector, const uint32_t* original_triangles,
                                            float triangles_per_draw_call);
-/* Screen-space-error selection, incremental from the previous call (DESIGN section 3).
+/* Screen-space-error selection, incremental from the previous call (docs/design.md §3).
  * pixel_tolerance: tau in pixels (> 0); coarsen_ratio in (0, 1]: hysteresis (1 = none). */
 aglod_status aglod_select(aglod_selector* selector, const aglod_camera* camera,
                           float pixel_tolerance, float coarsen_ratio, aglod_cut* out);

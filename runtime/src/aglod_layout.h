@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Byte layout of the `.aglod` runtime file (DESIGN section 4), shared by the writer and the
+// Byte layout of the `.aglod` runtime file (docs/design.md §4), shared by the writer and the
 // reader so they cannot drift apart. Everything little-endian.
 //
 //   offset  size  field

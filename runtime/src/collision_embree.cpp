@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Collision queries with Embree 3 (DESIGN section 3): the only file that includes Embree.
-// Pitfalls handled here (NOTES-deps): ray mask 0xFFFFFFFF (a zeroed ray never hits),
+// Collision queries with Embree 3 (docs/design.md §3): the only file that includes Embree.
+// Pitfalls handled here (docs/design.md §6): ray mask 0xFFFFFFFF (a zeroed ray never hits),
 // tnear/tfar/flags/geomID set explicitly, an error callback on the device, vertex buffers
 // allocated by Embree (rtcSetNewGeometryBuffer pads them for its 16-byte SIMD loads),
 // occlusion reported by rtcOccluded1 setting tfar to -inf.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Read-only memory mapping of a runtime file, so that the reader uses the bytes in place
-// (DESIGN section 4): opening costs the validation pass, not a copy. POSIX mmap, or on
+// (docs/design.md §4): opening costs the validation pass, not a copy. POSIX mmap, or on
 // Windows CreateFileMapping / MapViewOfFile.
 #include "mapped_file.h"
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Reader of the `.aglod` runtime file (DESIGN section 4): checks the header, the checksum,
+// Reader of the `.aglod` runtime file (docs/design.md §4): checks the header, the checksum,
 // the section table, every index range and the tree shape before anything is used, then
 // views the arrays in place. All arithmetic on file values is done in 64 bits so that no
 // value can overflow into a "valid" range.

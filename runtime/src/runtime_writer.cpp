@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Writer of the `.aglod` runtime file (DESIGN section 4): BuildParams -> one little-endian
+// Writer of the `.aglod` runtime file (docs/design.md §4): BuildParams -> one little-endian
 // blob with a 16-byte aligned section per array. The writer only lays bytes out; whether the
 // hierarchy is consistent is decided by the reader's validator, run on the result, so the
 // writer can never produce a file that the reader refuses.

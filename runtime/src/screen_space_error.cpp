@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Screen-space error rule of DESIGN section 3 (the 3D Tiles / CesiumJS formula).
+// Screen-space error rule of docs/design.md §3 (the 3D Tiles / CesiumJS formula).
 #include <aggrelod/runtime.h>
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Level selection by screen-space error (DESIGN section 3): the cut of the hierarchy to draw,
+// Level selection by screen-space error (docs/design.md §3): the cut of the hierarchy to draw,
 // with hysteresis, incremental from the previous frame, allocation-free per frame.
 //
 // Incremental pass, for each node N of the previous cut:

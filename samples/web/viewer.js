@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // aggrelod web viewer: streams a 3D Tiles tileset written by `aggrelod bake ... --tiles` with
-// three.js and 3DTilesRendererJS, choosing tiles by screen-space error (DESIGN section 3).
+// three.js and 3DTilesRendererJS, choosing tiles by screen-space error (docs/design.md §3).
 //
 // Query parameters (all optional):
 //   tileset=URL        tileset.json to open (default ./tileset/tileset.json, as serve.mjs serves it)

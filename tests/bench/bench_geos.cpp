@@ -3,7 +3,7 @@
 // ConcaveHullOfPolygons, the strongest open peer, at the same edge-length threshold.
 //
 // GEOS takes a length ratio r, not a length: L = r * (max - min) + min over the
-// unconstrained edges of ITS triangulation (GEOS computeTargetEdgeLength; NOTES-deps). That
+// unconstrained edges of ITS triangulation (GEOS computeTargetEdgeLength; its C API takes the ratio, whatever its doc comment says). That
 // triangulation has a frame around the input (the envelope grown by 4 diagonals on each
 // side) whose corners change which long edges exist near the convex hull, so min / max are
 // not those of aggrelod's triangulation. geosEdgeRange() rebuilds GEOS's triangulation (a

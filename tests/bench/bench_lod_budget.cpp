@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// What the drawn cut costs against the alternatives a user has (DESIGN 2.6, "the yardstick"):
+// What the drawn cut costs against the alternatives a user has (docs/design.md §2.6, "the yardstick"):
 // for a 1920 x 1080 viewport, 60 degree vertical field of view and tau = 1 px, cameras on a
 // circle around the scene's bounding-sphere centre at 1, 2, 4, 8 and 16 scene diameters
 // (8 azimuths, fixed elevation, looking at the centre, about the scene's up axis), the

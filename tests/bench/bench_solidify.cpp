@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// What solidifying costs on the shared real scenes (DESIGN 2.0, docs/real-art.md): per scene,
+// What solidifying costs on the shared real scenes (docs/design.md §2.0, docs/real-art.md): per scene,
 // as `aggrelod bake SCENE` with no options does it (default read options and settings, then
 // the proxies), the seconds of the "solidify" stage against the whole bake, the peak resident
 // memory during solidification (sampled at every progress report of that stage) against the

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/disjoint_sets.h>
 
 #include <algorithm>
 #include <array>
@@ -57,21 +58,16 @@ inline std::string edgeManifoldProblem(const std::vector<uint32_t>& indices) {
 /// Edge-connected shells of an indexed mesh (triangles sharing an undirected index edge).
 inline int shellCount(const std::vector<uint32_t>& indices) {
     const size_t triangles = indices.size() / 3;
-    std::vector<uint32_t> parent(triangles);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    DisjointSets sets(triangles);
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> firstUse;
     for (size_t t = 0; t < triangles; ++t)
         for (int k = 0; k < 3; ++k) {
             const uint32_t a = indices[3 * t + size_t(k)], b = indices[3 * t + size_t(k + 1) % 3];
             const auto [it, fresh] = firstUse.emplace(std::make_pair(std::min(a, b), std::max(a, b)), uint32_t(t));
-            if (!fresh) parent[find(uint32_t(t))] = find(it->second);
+            if (!fresh) sets.unite(uint32_t(t), it->second);
         }
     int shells = 0;
-    for (size_t t = 0; t < triangles; ++t) shells += find(uint32_t(t)) == t ? 1 : 0;
+    for (size_t t = 0; t < triangles; ++t) shells += sets.find(uint32_t(t)) == t ? 1 : 0;
     return shells;
 }
 
@@ -121,12 +117,7 @@ inline ClosedCheck checkClosedAfterWeld(const InputObject& o) {
         c.problem = "no triangles or index count not a multiple of 3";
         return c;
     }
-    std::vector<uint32_t> parent(ids.size());
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    DisjointSets sets(ids.size());
     std::map<std::pair<uint32_t, uint32_t>, std::array<int, 2>> edges;  // (lo, hi) -> uses lo->hi, hi->lo
     for (size_t t = 0; t < o.indices.size(); t += 3) {
         uint32_t v[3];
@@ -145,7 +136,7 @@ inline ClosedCheck checkClosedAfterWeld(const InputObject& o) {
             const uint32_t a = v[k], b = v[(k + 1) % 3];
             auto& uses = edges[{std::min(a, b), std::max(a, b)}];
             ++uses[a < b ? 0 : 1];
-            parent[find(a)] = find(b);
+            sets.unite(a, b);
         }
     }
     c.edges = edges.size();
@@ -161,7 +152,7 @@ inline ClosedCheck checkClosedAfterWeld(const InputObject& o) {
     std::vector<bool> used(ids.size(), false);
     for (uint32_t i : o.indices) used[weld[i]] = true;
     for (uint32_t i = 0; i < ids.size(); ++i)
-        if (used[i] && find(i) == i) ++c.components;
+        if (used[i] && sets.find(i) == i) ++c.components;
     return c;
 }
 

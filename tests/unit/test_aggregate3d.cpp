@@ -90,6 +90,21 @@ TEST(TwoCubes, StayApartBelowGap) {
     }
 }
 
+TEST(TwoCubes, ThresholdsThatAreNotFiniteAndNonNegativeAreRefused) {
+    // The same check and message as in 2D, before any work: a NaN threshold would also break
+    // the sort of the levels.
+    const auto objects = samples::makeTwoCubes(0.5);
+    for (double bad : {std::nan(""), -0.5, double(INFINITY)}) {
+        Settings3D settings;
+        settings.deltas = {0.4, bad};
+        Hierarchy3D h;
+        EXPECT_FALSE(buildHierarchy3D(objects, settings, h)) << bad;
+        ASSERT_FALSE(h.diagnostics.empty()) << bad;
+        EXPECT_EQ(h.diagnostics.back().message, "every threshold delta must be a finite number >= 0") << bad;
+        EXPECT_TRUE(h.levels.empty()) << bad;
+    }
+}
+
 TEST(TwoCubes, JoinAboveGapIntoOneClosedSolid) {
     for (auto fn : {AggregateFunctionKind::Adaptive, AggregateFunctionKind::Constant}) {
         auto objects = samples::makeTwoCubes(0.5);

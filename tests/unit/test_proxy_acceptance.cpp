@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Acceptance of the proxies an engine draws and collides against (DESIGN 2.6), for every
+// Acceptance of the proxies an engine draws and collides against (docs/design.md §2.6), for every
 // non-leaf node (aggregates and per-object LOD nodes) of in-process bakes of spheres15, chess,
 // forest, village, truck_town without its ground and a 400-object generated scene:
 //  - closed (after welding equal positions), edge-manifold (every index edge used by exactly

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Tests of the certified proxy error bounds (module/src/proxy_error.cpp, DESIGN 2.5) against
+// Tests of the certified proxy error bounds (module/src/proxy_error.cpp, docs/design.md §2.5) against
 // a brute-force measurement on small cases: a dense barycentric grid on every triangle, exact
 // closest points, inside-ness by the generalized winding number (independent of the ray
 // parity used by the bound). Each case exercises one of the region bounds: boxes of the

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Real game art (DESIGN 2.0): every shared real scene bakes as given; support surfaces are
+// Real game art (docs/design.md §2.0): every shared real scene bakes as given; support surfaces are
 // found by the default rule; objects that are not closed solids are wrapped, not hulled; the
 // wraps are closed, contain their originals and stay near them; objects can be chosen in
 // real files (index paths, own meshes, assembly depth, animated nodes).

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Collision queries with Embree (DESIGN section 3) against cuts of a synthetic hierarchy:
+// Collision queries with Embree (docs/design.md §3) against cuts of a synthetic hierarchy:
 // hits equal a brute-force ray/triangle search, coarser levels are conservative (their box
 // proxies contain the originals), segment and occlusion agree with the ray query, and a hit
 // names the original objects of its node.

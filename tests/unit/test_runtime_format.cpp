@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The `.aglod` runtime file (DESIGN section 4): round trip of the writer and the in-place
+// The `.aglod` runtime file (docs/design.md §4): round trip of the writer and the in-place
 // reader, refusal of inconsistent hierarchies by the writer, and refusal of corrupt bytes by
 // the reader (every single-byte change of the header and section table, truncations, forged
 // tables with a recomputed checksum). Built and run under AddressSanitizer

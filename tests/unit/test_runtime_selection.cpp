@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Level selection (DESIGN section 3): valid cuts for 1000 random cameras, the
+// Level selection (docs/design.md §3): valid cuts for 1000 random cameras, the
 // screen-space-error rule, incremental == full, hysteresis against flicker, and the
 // collision cut by distance. On synthetic hierarchies (tests/runtime_support).
 #include <aggrelod/runtime.h>
@@ -90,7 +90,7 @@ TEST(RuntimeSelection, ValidCutAndRuleFor1000RandomCameras) {
         expectExactCover(file, incremental);
         expectExactCover(file, full);
         ASSERT_EQ(sortedCut(incremental), sortedCut(full)) << "camera " << i;
-        // The rule of DESIGN section 3, checked with the reference formula.
+        // The rule of docs/design.md §3, checked with the reference formula.
         const float tau = noHysteresis.pixelTolerance;
         for (uint32_t node : full.cut()) {
             const NodeRecord& r = file.node(node);

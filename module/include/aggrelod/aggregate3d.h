@@ -35,14 +35,14 @@ struct InputObject {
     std::vector<float> triangleColors;
 };
 
-/// Which distance weights the neighbourhood graph (DESIGN 2.2).
+/// Which distance weights the neighbourhood graph (docs/design.md §2.2).
 enum class DistanceMode {
     Exact,  ///< exact mesh-to-mesh minimum distance (default)
     Cdt     ///< shortest triangulation edge joining the models (the paper's choice)
 };
 
 /// What stands in, in the triangulation, for an object or model that is not a valid closed
-/// solid (open, non-manifold, self-intersecting, or several touching objects; DESIGN 2.0).
+/// solid (open, non-manifold, self-intersecting, or several touching objects; docs/design.md §2.0).
 enum class SolidifyMethod {
     Wrap,  ///< a tight watertight wrap containing it (CGAL alpha wrap; default)
     Hull,  ///< its convex hull
@@ -127,7 +127,7 @@ struct Aggregate {
     Surface surface = Surface::Original;
 };
 
-/// One solidified model (DESIGN 2.0): what stood in for its objects in the triangulation.
+/// One solidified model (docs/design.md §2.0): what stood in for its objects in the triangulation.
 struct SolidReport {
     std::vector<uint32_t> objects;   ///< input indices, ascending
     SolidifyMethod method = SolidifyMethod::Wrap;

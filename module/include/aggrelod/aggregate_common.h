@@ -17,7 +17,7 @@ struct Diagnostic {
     std::string message;  ///< what is wrong and what was done about it
 };
 
-/// Which aggregate function sculpts the fill (DESIGN 2.4, paper Eqs. 1 and 2).
+/// Which aggregate function sculpts the fill (docs/design.md §2.4, paper Eqs. 1 and 2).
 enum class AggregateFunctionKind {
     Adaptive,  ///< F = 0.5 * (min(m1,m2) + sigma(m1,m2) + delta)
     Constant   ///< F = delta

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Neighbourhood graph -> dendrogram -> levels (DESIGN 2.3; paper Section 3.2, Algorithm 1).
+// Neighbourhood graph -> dendrogram -> levels (docs/design.md §2.3; paper Section 3.2, Algorithm 1).
 // Shared by 2D and 3D: models are plain indices, weights are distances in world units.
 #pragma once
 
 #include <aggrelod/aggregate_common.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace aggrelod {
@@ -27,6 +28,11 @@ std::vector<Merge> kruskalMerges(size_t modelCount, const std::vector<GraphEdge>
 /// `groupCount` (optional) receives the number of groups.
 std::vector<uint32_t> groupsAtThreshold(size_t modelCount, const std::vector<Merge>& merges, double delta,
                                         size_t* groupCount = nullptr);
+
+/// Explicit thresholds must each be a finite number >= 0 (world units). Returns false, with
+/// the message both pipelines report, when one is not (NaN would also break the sort of the
+/// levels).
+bool validThresholds(const std::vector<double>& deltas, std::string& problem);
 
 /// Automatic thresholds: `levelCount` targets on a geometric series between the smallest and
 /// largest merge height; each is moved to just above a merge height, so every level changes

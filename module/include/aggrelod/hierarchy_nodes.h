@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod module: the hierarchy of a 3D bake as a tree of nodes for real-time use
-// (DESIGN sections 2.5 and 2.6).
+// (docs/design.md §2.5 and §2.6).
 //
 // Leaves are the original objects (geometric error 0). Inner nodes are the aggregates of
 // the levels of a Hierarchy3D; the parent of an aggregate is the aggregate that contains

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // aggrelod runtime, optional collision part (target aggrelod_runtime_collision, Embree 3):
 // ray, segment and occlusion queries against a cut of the hierarchy chosen by distance from
-// a query point or at one fixed level (DESIGN section 3). A hit reports the node and the
+// a query point or at one fixed level (docs/design.md §3). A hit reports the node and the
 // original objects that node stands for. Embree stays inside collision_embree.cpp: this
 // header does not include it.
 #pragma once

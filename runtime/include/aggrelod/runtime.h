@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // aggrelod runtime: what a game engine links (standard library only; MIT-compatible).
-// Level selection by screen-space error, as in 3D Tiles / CesiumJS (DESIGN section 3).
+// Level selection by screen-space error, as in 3D Tiles / CesiumJS (docs/design.md §3).
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // aggrelod runtime: the whole contract between the bake and the runtime (as Recast's
 // dtNavMeshCreateParams). The bake fills one BuildParams with flat arrays; writeRuntimeFile
-// turns it into the versioned `.aglod` blob that the runtime reads in place (DESIGN section 4).
+// turns it into the versioned `.aglod` blob that the runtime reads in place (docs/design.md §4).
 // Standard library only.
 #pragma once
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// aggrelod runtime: the `.aglod` runtime file, read in place (DESIGN section 4).
+// aggrelod runtime: the `.aglod` runtime file, read in place (docs/design.md §4).
 // A RuntimeFile views a memory-mapped file or a caller buffer; it never copies the arrays.
 // Every count, stride, index range and the tree shape are validated once at open; a bad
 // file is refused with a FileStatus and a message, never a crash. Standard library only.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// aggrelod runtime: which nodes to draw this frame (DESIGN section 3), by the screen-space
+// aggrelod runtime: which nodes to draw this frame (docs/design.md §3), by the screen-space
 // error rule of 3D Tiles / CesiumJS, with hysteresis, incremental from the previous frame's
 // cut, without allocating per frame. Standard library only.
 #pragma once
@@ -106,7 +106,7 @@ public:
     /// non-finite forward, an up parallel to forward, aspect <= 0 or a NaN plane culls nothing.
     void select(const ViewCamera& camera, const SelectionSettings& settings);
 
-    /// Collision cut around a query point (DESIGN section 3): a node is used when its error is
+    /// Collision cut around a query point (docs/design.md §3): a node is used when its error is
     /// at most maxErrorPerDistance * (distance from `point` to its bounding sphere), i.e.
     /// finer close to the querying agent. Incremental like select(). Units: world / world.
     void selectByDistance(const float point[3], float maxErrorPerDistance, float coarsenRatio = 0.75f);

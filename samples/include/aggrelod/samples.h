@@ -101,7 +101,7 @@ std::vector<InputObject> makeTwoCubes(double gap);
 /// every face is a grid with spacing 8 and the upper grid is shifted by (4, 4), so no vertex
 /// of one slab is closer than sqrt(4^2 + 4^2 + 1) ~ 5.74 to a vertex of the other. A
 /// triangulation of the gap has no edge shorter than that: the hard case for keeping joined
-/// models connected (DESIGN 2.4 item 4).
+/// models connected (docs/design.md §2.4 item 4).
 std::vector<InputObject> makeOffsetSlabs();
 
 /// 15 equal spheres of radius 1 (UV spheres, 20 x 11, 400 triangles each), as in the paper's
