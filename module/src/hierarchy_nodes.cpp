@@ -29,6 +29,10 @@ namespace aggrelod {
 
 namespace {
 
+/// Relative growth of every bounding sphere radius; equal to aggrelod::runtime::kSphereMargin
+/// (runtime_build.h), which the reader's nesting slack is measured against.
+constexpr double kSphereMargin = 1e-6;
+
 /// Smallest float >= x (as a double).
 double floatUp(double x) {
     float f = static_cast<float>(x);
@@ -83,8 +87,9 @@ void computeBounds(HierarchyNode& node, const std::vector<double>& exactPosition
     for (size_t i = 0; i + 2 < exactPositions.size(); i += 3) r = std::max(r, distance(node.sphereCenter, &exactPositions[i]));
     for (uint32_t c : node.children)
         r = std::max(r, distance(node.sphereCenter, nodes[c].sphereCenter) + nodes[c].sphereRadius);
-    // A relative margin keeps the nesting true when a reader recomputes it in float.
-    node.sphereRadius = floatUp(r * (1 + 1e-6));
+    // A relative margin keeps the nesting true when a reader recomputes it in float: the
+    // runtime file's kSphereMargin (runtime_build.h; the module does not include the runtime).
+    node.sphereRadius = floatUp(r * (1 + kSphereMargin));
 }
 
 /// Vertex coordinates as sorted xyz triples.

@@ -318,12 +318,12 @@ struct FileValidator {
             d2 += d * d;
             scale = std::max(scale, std::fabs(double(outer.sphereCenter[k])));
         }
-        // Float rounding of the bake: a relative slack of 1e-5.
-        return std::sqrt(d2) + inner.sphereRadius <= outer.sphereRadius + 1e-5 * (scale + 1.0);
+        // Float rounding of the bake (runtime_build.h).
+        return std::sqrt(d2) + inner.sphereRadius <= outer.sphereRadius + kNestingSlack * (scale + 1.0);
     }
     static bool boxInside(const NodeRecord& inner, const NodeRecord& outer) {
         for (int k = 0; k < 3; ++k) {
-            const double slack = 1e-5 * (std::fabs(double(outer.boundsMin[k])) +
+            const double slack = kNestingSlack * (std::fabs(double(outer.boundsMin[k])) +
                                          std::fabs(double(outer.boundsMax[k])) + 1.0);
             if (inner.boundsMin[k] < outer.boundsMin[k] - slack ||
                 inner.boundsMax[k] > outer.boundsMax[k] + slack)

@@ -39,9 +39,9 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
                    r.parent, r.firstSource, r.childCount == 0 ? r.sourceCount : 0u};
     }
     // The incremental pass and the leases rely on sse never growing down a path. The file
-    // guarantees nesting up to a 1e-5 relative slack; close that slack here, children before
-    // parents (reverse preorder), by growing a parent's sphere and error just enough
-    // (plus 1e-6 relative so float evaluation of the test cannot break the order either).
+    // guarantees nesting up to kNestingSlack; close that slack here, children before parents
+    // (reverse preorder), by growing a parent's sphere and error just enough (plus
+    // kSphereMargin relative, so float evaluation of the test cannot break the order either).
     {
         std::vector<uint32_t> order;
         order.reserve(n);
@@ -62,7 +62,7 @@ Selector::Selector(const RuntimeFile& file) : file_(&file) {
                     const double d = double(parent.center[k]) - child.center[k];
                     d2 += d * d;
                 }
-                const double needed = (std::sqrt(d2) + child.radius) * (1.0 + 1e-6);
+                const double needed = (std::sqrt(d2) + child.radius) * (1.0 + kSphereMargin);
                 if (needed > parent.radius) parent.radius = static_cast<float>(needed);
                 parent.error = std::max(parent.error, child.error);
             }

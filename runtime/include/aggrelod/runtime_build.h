@@ -53,6 +53,15 @@ constexpr uint32_t kCoarserLevel = 0xFFFDu;
 /// Aggregate levels are < kMaxAggregateLevel; larger values other than the two above are refused.
 constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
 
+/// Float rounding in the nesting of bounds, decided here for the bake, the reader and the
+/// selector. The reader accepts a child's sphere or box that pokes out of its parent's by up to
+/// kNestingSlack × (|parent's coordinates| + 1) (world units). The bake rounds bounds outwards
+/// to float and grows every sphere radius by the relative kSphereMargin, so its files stay far
+/// inside that slack; the selector grows a parent's sphere by the same margin over its children
+/// to close whatever slack a file uses (sse must never grow down a path).
+constexpr double kNestingSlack = 1e-5;
+constexpr double kSphereMargin = 1e-6;
+
 /// Everything the runtime file holds. Arrays are owned by the caller.
 struct BuildParams {
     std::vector<BuildNode> nodes;        ///< parents may come before or after children
@@ -89,7 +98,7 @@ struct BuildParams {
 /// - each leaf (childCount 0) stands for >= 1 object, every object in exactly one leaf, an
 ///   inner node lists exactly the objects of its leaves (any order, no duplicates);
 /// - child error <= parent error (exact), child sphere and box inside the parent's (slack
-///   1e-5 relative to the parent's coordinates).
+///   kNestingSlack relative to the parent's coordinates).
 bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error);
 
 /// Linear RGBA in [0, 1] (glTF baseColorFactor / COLOR_0 meaning; clamped, NaN -> 0) to the

@@ -59,7 +59,7 @@ struct SelectionStats {
 ///     sse = geometricError * viewportHeight / (2 * d * tan(fovY / 2))
 /// (d = distance from the camera to its bounding sphere, clamped to >= 1e-6) exceeds tau, or
 /// exceeds tau * coarsenRatio when it was refined in the previous frame. Errors and spheres
-/// nest (the file guarantees it up to a 1e-5 relative slack, which the selector closes by
+/// nest (the file guarantees it up to a kNestingSlack relative slack, which the selector closes by
 /// growing a parent's sphere/error by that much), so sse never grows going down and the nodes
 /// drawn form a cut: every original object is covered exactly once.
 class Selector {
