@@ -357,12 +357,14 @@ constexpr double kChainRatio = 1.4142135623730951;
 /// diagonal), and for an object of one shell the coarsest enclosing polytope of its convex
 /// hull that fits each target. A candidate counts when it does not intersect itself and its
 /// certified error fits its budget (twice its target) and stays below the ceiling; the chain
-/// is the lightest one through them (lightestChain). Returned finest first; empty for an
-/// object that is not a closed solid (only a closed mesh can be simplified into an enclosure
-/// of it).
+/// is the lightest one through them (lightestChain). Returned finest first. An object that is
+/// not a closed solid is simplified from `standIn`, the watertight solid that contains it
+/// alone (its alpha wrap), when there is one: whatever encloses that solid encloses the
+/// object, and errors are still certified against the object itself. Empty for such an object
+/// without a solid of its own.
 std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t objectIndex,
-                                          const detail::PreparedOriginal& original, double ceiling,
-                                          const ProxySettings& settings) {
+                                          const detail::PreparedOriginal& original, const SolidReport* standIn,
+                                          double ceiling, const ProxySettings& settings) {
     std::vector<HierarchyNode> chain;
     if (settings.objectLodCount <= 0) return chain;
     detail::PreparedObject prepared;
@@ -372,16 +374,25 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
     const double diagonal = distance(lo, hi);
     if (!(diagonal > 0)) return chain;
     detail::prepareObject(object, 1e-14 * diagonal * diagonal, prepared, ignored);
-    if (!prepared.validSolid()) return chain;
+    const std::vector<double>* basePositions = &prepared.positions;
+    const std::vector<uint32_t>* baseTriangles = &prepared.triangles;
+    double finest = kChainFinestFraction * diagonal;
+    if (!prepared.validSolid()) {
+        if (!standIn || !standIn->closedManifold || standIn->triangles.empty()) return chain;
+        basePositions = &standIn->positions;
+        baseTriangles = &standIn->triangles;
+        // No version can be closer to the object than its solid is.
+        finest = std::max(finest, 0.5 * std::max(standIn->distanceSolidToOriginal, standIn->distanceOriginalToSolid));
+    }
     const double top = std::min(ceiling, diagonal);
     std::vector<double> targets;  // ascending
-    for (double t = kChainFinestFraction * diagonal; t < top; t *= kChainRatio) targets.push_back(t);
+    for (double t = finest; t < top; t *= kChainRatio) targets.push_back(t);
     if (targets.empty()) return chain;
-    EnclosureSeries series(prepared.positions, prepared.triangles, targets);
+    EnclosureSeries series(*basePositions, *baseTriangles, targets);
     const std::vector<const detail::PreparedOriginal*> originals{&original};
     std::unique_ptr<PolytopeSource> polytopes;
-    if (shellCount(prepared.positions.size() / 3, prepared.triangles) == 1)
-        polytopes = std::make_unique<PolytopeSource>(prepared.positions, originals,
+    if (shellCount(basePositions->size() / 3, *baseTriangles) == 1)
+        polytopes = std::make_unique<PolytopeSource>(*basePositions, originals,
                                                      settings.toleranceFraction * targets.front(), settings,
                                                      std::min(ceiling, 2 * top));
     std::vector<HierarchyNode> candidates;
@@ -670,10 +681,14 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         while (up != kNoNode && nodes[up].sources.size() == 1) up = nodes[up].parent;
         firstGroup[o] = up;
     }
+    // The solid that stands in for an object alone (not for a model of several objects).
+    std::vector<const SolidReport*> standInOf(objectCount, nullptr);
+    for (const SolidReport& r : hierarchy.solids)
+        if (r.objects.size() == 1 && r.objects.front() < objectCount) standInOf[r.objects.front()] = &r;
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (nodes[o].parent == kNoNode || nodes[o].positions.empty()) return;
         const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
-        chains[o] = objectLodChain(objects[o], static_cast<uint32_t>(o), prepared[o], ceiling, settings);
+        chains[o] = objectLodChain(objects[o], static_cast<uint32_t>(o), prepared[o], standInOf[o], ceiling, settings);
         std::vector<const InputObject*> source{&objects[o]};
         for (HierarchyNode& c : chains[o]) {
             detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);

@@ -257,11 +257,19 @@ std::vector<ProxyUnderTest> nodeProxies(const AcceptanceScene& s) {
         p.positions = &n.positions;
         p.indices = &n.indices;
         p.sources.assign(n.sources.begin(), n.sources.end());
-        // A coarser version has the shells of the aggregate it simplifies.
-        const HierarchyNode& a = nodes.nodes[aggregateBelow(nodes, i)];
-        p.expectedShells = n.objectLod >= 1
-                               ? objectShells(s.input.objects[n.sources.front()])
-                               : s.baked.hierarchy.levels[size_t(a.firstLevel)].aggregates[a.aggregateIndex].componentCount;
+        // A coarser version has the shells of the aggregate it simplifies; a per-object LOD
+        // those of its object, or of the solid standing in for an object that is not a
+        // closed solid (it is simplified from that solid).
+        if (n.objectLod >= 1) {
+            const uint32_t object = n.sources.front();
+            p.expectedShells = objectShells(s.input.objects[object]);
+            if (!checkClosedAfterWeld(s.input.objects[object]).problem.empty())  // open: simplified from its solid
+                for (const SolidReport& r : s.baked.hierarchy.solids)
+                    if (r.objects == std::vector<uint32_t>{object}) p.expectedShells = shellCount(r.triangles);
+        } else {
+            const HierarchyNode& a = nodes.nodes[aggregateBelow(nodes, i)];
+            p.expectedShells = s.baked.hierarchy.levels[size_t(a.firstLevel)].aggregates[a.aggregateIndex].componentCount;
+        }
         out.push_back(std::move(p));
     }
     return out;
