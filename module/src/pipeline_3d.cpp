@@ -1671,6 +1671,7 @@ bool Baker::run() {
 
 bool buildHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, Hierarchy3D& out) {
     if (std::string problem; !validThresholds(settings.deltas, problem)) {
+        out = Hierarchy3D{};  // nothing of an earlier result stays
         out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", problem});
         return false;
     }

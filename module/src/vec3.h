@@ -11,6 +11,9 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+// GLM_FORCE_CTOR_INIT works only when this is the first GLM include of the file.
+static_assert(GLM_CONFIG_CTOR_INIT != GLM_CTOR_INIT_DISABLE, "vec3.h must be included before any other GLM header");
+
 namespace aggrelod::detail {
 
 using Vec3 = glm::dvec3;
