@@ -17,7 +17,7 @@ packages=(
   build-essential cmake pkg-config ccache git
   libglm-dev libtinygltf-dev libembree-dev libtet1.5-dev
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev
-  libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev
+  libgtest-dev libbenchmark-dev libstb-dev libcli11-dev libgeos-dev nlohmann-json3-dev
   libompl-dev
   chromium clang libclang-rt-14-dev python3
   mingw-w64 wine wine64

@@ -3,6 +3,7 @@
 // optional link table, pictures and stats (paper Sections 3-4 in 2D; docs/design.md §4 "2D").
 #include "commands_2d.h"
 #include "geo_io.h"
+#include "geo_picture.h"
 #include "terminal.h"
 
 #include <aggrelod/aggregate2d.h>

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: WKT and GeoJSON readers and writers, link table and 2D stats JSON.
-// A small hand-written JSON parser (with line/column in messages) keeps the bake free of
-// another dependency; numbers are written shortest round-trip, locale-independent.
+// JSON is read through json.h; numbers are written shortest round-trip, locale-independent.
 #include "geo_io.h"
+#include "json.h"
 
 #include <algorithm>
 #include <cctype>
@@ -19,179 +19,12 @@
 namespace aggrelod::io {
 namespace {
 
-// ---------------------------------------------------------------------------------------
-// JSON
-
-struct JsonValue {
-    enum class Type { Null, Bool, Number, String, Array, Object } type = Type::Null;
-    double number = 0;
-    bool boolean = false;
-    std::string string;
-    std::vector<JsonValue> items;                            // Array
-    std::vector<std::pair<std::string, JsonValue>> members;  // Object
-    int line = 0;
-
-    const JsonValue* get(const std::string& key) const {
-        for (const auto& m : members)
-            if (m.first == key) return &m.second;
-        return nullptr;
-    }
-};
-
-class JsonParser {
-public:
-    explicit JsonParser(const std::string& text) : s_(text) {}
-
-    bool parse(JsonValue& out, std::string& error) {
-        if (!value(out, 0)) {
-            error = error_;
-            return false;
-        }
-        skipSpace();
-        if (pos_ != s_.size()) {
-            fail("unexpected text after the JSON value");
-            error = error_;
-            return false;
-        }
-        return true;
-    }
-
-private:
-    const std::string& s_;
-    size_t pos_ = 0;
-    int line_ = 1;
-    size_t lineStart_ = 0;
-    std::string error_;
-
-    bool fail(const std::string& what) {
-        if (error_.empty())
-            error_ = "line " + std::to_string(line_) + ", column " + std::to_string(pos_ - lineStart_ + 1) + ": " + what;
-        return false;
-    }
-    void skipSpace() {
-        while (pos_ < s_.size()) {
-            const char c = s_[pos_];
-            if (c == '\n') {
-                ++line_;
-                lineStart_ = pos_ + 1;
-            } else if (c != ' ' && c != '\t' && c != '\r') {
-                break;
-            }
-            ++pos_;
-        }
-    }
-    bool literal(const char* word) {
-        const size_t n = std::strlen(word);
-        if (s_.compare(pos_, n, word) != 0) return false;
-        pos_ += n;
-        return true;
-    }
-    bool value(JsonValue& v, int depth) {
-        if (depth > 256) return fail("nesting too deep");
-        skipSpace();
-        if (pos_ >= s_.size()) return fail("unexpected end of file");
-        v.line = line_;
-        const char c = s_[pos_];
-        if (c == '{') return object(v, depth);
-        if (c == '[') return array(v, depth);
-        if (c == '"') {
-            v.type = JsonValue::Type::String;
-            return string(v.string);
-        }
-        if (literal("true")) { v.type = JsonValue::Type::Bool; v.boolean = true; return true; }
-        if (literal("false")) { v.type = JsonValue::Type::Bool; return true; }
-        if (literal("null")) { v.type = JsonValue::Type::Null; return true; }
-        // Non-standard NaN / Infinity (written by some tools) are accepted as numbers so the
-        // geometry check can name the feature that holds them.
-        if (literal("NaN")) { v.type = JsonValue::Type::Number; v.number = NAN; return true; }
-        if (literal("Infinity")) { v.type = JsonValue::Type::Number; v.number = INFINITY; return true; }
-        if (literal("-Infinity")) { v.type = JsonValue::Type::Number; v.number = -INFINITY; return true; }
-        if (c == '-' || (c >= '0' && c <= '9')) {
-            size_t end = pos_;
-            while (end < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[end])) || s_[end] == '-' ||
-                                       s_[end] == '+' || s_[end] == '.' || s_[end] == 'e' || s_[end] == 'E'))
-                ++end;
-            const auto r = std::from_chars(s_.data() + pos_, s_.data() + end, v.number);
-            if (r.ec != std::errc() || r.ptr != s_.data() + end) return fail("malformed number");
-            v.type = JsonValue::Type::Number;
-            pos_ = end;
-            return true;
-        }
-        return fail(std::string("unexpected character '") + c + "'");
-    }
-    bool string(std::string& out) {
-        ++pos_;  // opening quote
-        while (pos_ < s_.size()) {
-            const char c = s_[pos_++];
-            if (c == '"') return true;
-            if (c == '\n') return fail("line break inside a string");
-            if (c != '\\') {
-                out += c;
-                continue;
-            }
-            if (pos_ >= s_.size()) break;
-            const char e = s_[pos_++];
-            switch (e) {
-                case 'n': out += '\n'; break;
-                case 't': out += '\t'; break;
-                case 'r': out += '\r'; break;
-                case 'b': out += '\b'; break;
-                case 'f': out += '\f'; break;
-                case 'u': {
-                    if (pos_ + 4 > s_.size()) return fail("truncated \\u escape");
-                    unsigned code = 0;
-                    const auto r = std::from_chars(s_.data() + pos_, s_.data() + pos_ + 4, code, 16);
-                    if (r.ec != std::errc()) return fail("malformed \\u escape");
-                    pos_ += 4;
-                    // UTF-8 (surrogate pairs kept as two code units; names only appear in messages)
-                    if (code < 0x80) out += static_cast<char>(code);
-                    else if (code < 0x800) { out += static_cast<char>(0xC0 | (code >> 6)); out += static_cast<char>(0x80 | (code & 0x3F)); }
-                    else { out += static_cast<char>(0xE0 | (code >> 12)); out += static_cast<char>(0x80 | ((code >> 6) & 0x3F)); out += static_cast<char>(0x80 | (code & 0x3F)); }
-                    break;
-                }
-                default: out += e;
-            }
-        }
-        return fail("unterminated string");
-    }
-    bool array(JsonValue& v, int depth) {
-        v.type = JsonValue::Type::Array;
-        ++pos_;
-        skipSpace();
-        if (pos_ < s_.size() && s_[pos_] == ']') { ++pos_; return true; }
-        while (true) {
-            v.items.emplace_back();
-            if (!value(v.items.back(), depth + 1)) return false;
-            skipSpace();
-            if (pos_ >= s_.size()) return fail("unexpected end of file inside an array");
-            if (s_[pos_] == ',') { ++pos_; continue; }
-            if (s_[pos_] == ']') { ++pos_; return true; }
-            return fail("expected ',' or ']' in an array");
-        }
-    }
-    bool object(JsonValue& v, int depth) {
-        v.type = JsonValue::Type::Object;
-        ++pos_;
-        skipSpace();
-        if (pos_ < s_.size() && s_[pos_] == '}') { ++pos_; return true; }
-        while (true) {
-            skipSpace();
-            if (pos_ >= s_.size() || s_[pos_] != '"') return fail("expected a member name in quotes");
-            std::string key;
-            if (!string(key)) return false;
-            skipSpace();
-            if (pos_ >= s_.size() || s_[pos_] != ':') return fail("expected ':' after a member name");
-            ++pos_;
-            v.members.emplace_back(std::move(key), JsonValue{});
-            if (!value(v.members.back().second, depth + 1)) return false;
-            skipSpace();
-            if (pos_ >= s_.size()) return fail("unexpected end of file inside an object");
-            if (s_[pos_] == ',') { ++pos_; continue; }
-            if (s_[pos_] == '}') { ++pos_; return true; }
-            return fail("expected ',' or '}' in an object");
-        }
-    }
-};
+/// The member `key` of an object, or null (also when v is not an object).
+const Json* member(const Json& v, const char* key) {
+    if (!v.is_object()) return nullptr;
+    const auto it = v.find(key);
+    return it == v.end() ? nullptr : &*it;
+}
 
 // ---------------------------------------------------------------------------------------
 // Rings
@@ -228,34 +61,33 @@ std::string ringName(size_t polygon, size_t polygonCount, size_t ring) {
 // ---------------------------------------------------------------------------------------
 // GeoJSON reading
 
-bool readPosition(const JsonValue& p, std::vector<double>& ring, std::string& problem) {
-    if (p.type != JsonValue::Type::Array || p.items.size() < 2 || p.items[0].type != JsonValue::Type::Number ||
-        p.items[1].type != JsonValue::Type::Number) {
-        problem = "a position is not an array of at least 2 numbers (line " + std::to_string(p.line) + ")";
+bool readPosition(const Json& p, std::vector<double>& ring, std::string& problem) {
+    if (!p.is_array() || p.size() < 2 || !p[0].is_number() || !p[1].is_number()) {
+        problem = "a position is not an array of at least 2 numbers";
         return false;
     }
-    ring.push_back(p.items[0].number);
-    ring.push_back(p.items[1].number);
+    ring.push_back(p[0].get<double>());
+    ring.push_back(p[1].get<double>());
     return true;
 }
 
-bool readPolygonCoordinates(const JsonValue& rings, Polygon2D& poly, size_t index, size_t count, std::string& problem) {
-    if (rings.type != JsonValue::Type::Array) {
+bool readPolygonCoordinates(const Json& rings, Polygon2D& poly, size_t index, size_t count, std::string& problem) {
+    if (!rings.is_array()) {
         problem = "polygon coordinates are not an array of rings";
         return false;
     }
-    if (rings.items.empty()) {
+    if (rings.empty()) {
         problem = "empty geometry (polygon without rings)";
         return false;
     }
-    for (size_t r = 0; r < rings.items.size(); ++r) {
-        const JsonValue& ringValue = rings.items[r];
-        if (ringValue.type != JsonValue::Type::Array) {
+    for (size_t r = 0; r < rings.size(); ++r) {
+        const Json& ringValue = rings[r];
+        if (!ringValue.is_array()) {
             problem = ringName(index, count, r) + ": not an array of positions";
             return false;
         }
         std::vector<double> ring;
-        for (const JsonValue& p : ringValue.items)
+        for (const Json& p : ringValue)
             if (!readPosition(p, ring, problem)) {
                 problem = ringName(index, count, r) + ": " + problem;
                 return false;
@@ -271,24 +103,24 @@ bool readPolygonCoordinates(const JsonValue& rings, Polygon2D& poly, size_t inde
     return true;
 }
 
-void readGeoJsonFeature(const JsonValue* geometry, const std::string& name, uint32_t id, GeoReadResult& out) {
+void readGeoJsonFeature(const Json* geometry, const std::string& name, uint32_t id, GeoReadResult& out) {
     auto problemOf = [&](Diagnostic::Severity severity, const std::string& message) {
         out.diagnostics.push_back({severity, name, message});
     };
-    if (!geometry || geometry->type == JsonValue::Type::Null) {
+    if (!geometry || geometry->is_null()) {
         problemOf(Diagnostic::Severity::Error, "empty geometry (null); feature skipped");
         return;
     }
-    const JsonValue* type = geometry->get("type");
-    const JsonValue* coords = geometry->get("coordinates");
-    const std::string t = type && type->type == JsonValue::Type::String ? type->string : "";
+    const Json* type = member(*geometry, "type");
+    const Json* coords = member(*geometry, "coordinates");
+    const std::string t = type && type->is_string() ? type->get<std::string>() : "";
     if (t != "Polygon" && t != "MultiPolygon") {
         problemOf(Diagnostic::Severity::Warning,
                   "unsupported geometry type '" + (t.empty() ? std::string("(none)") : t) +
                       "' (only Polygon and MultiPolygon are aggregated); feature skipped");
         return;
     }
-    if (!coords || coords->type != JsonValue::Type::Array || coords->items.empty()) {
+    if (!coords || !coords->is_array() || coords->empty()) {
         problemOf(Diagnostic::Severity::Error, "empty geometry (no coordinates); feature skipped");
         return;
     }
@@ -304,9 +136,9 @@ void readGeoJsonFeature(const JsonValue* geometry, const std::string& name, uint
         }
         feature.polygons.push_back(std::move(poly));
     } else {
-        for (size_t i = 0; i < coords->items.size(); ++i) {
+        for (size_t i = 0; i < coords->size(); ++i) {
             Polygon2D poly;
-            if (!readPolygonCoordinates(coords->items[i], poly, i, coords->items.size(), problem)) {
+            if (!readPolygonCoordinates((*coords)[i], poly, i, coords->size(), problem)) {
                 problemOf(Diagnostic::Severity::Error, problem + "; feature skipped");
                 return;
             }
@@ -317,43 +149,49 @@ void readGeoJsonFeature(const JsonValue* geometry, const std::string& name, uint
 }
 
 bool readGeoJson(const std::string& text, GeoReadResult& out, std::string& error) {
-    JsonValue root;
-    JsonParser parser(text);
-    if (!parser.parse(root, error)) {
+    Json root;
+    JsonLines lines;
+    lines.arrayKey = "features";
+    if (!parseJson(text, root, error, 256, &lines)) {
         error = "malformed JSON: " + error;
         return false;
     }
-    const JsonValue* type = root.get("type");
-    if (root.type != JsonValue::Type::Object || !type || type->type != JsonValue::Type::String) {
+    const Json* type = member(root, "type");
+    if (!type || !type->is_string()) {
         error = "not GeoJSON: the top level is not an object with a \"type\"";
         return false;
     }
-    auto featureName = [](size_t index, const JsonValue& f) {
-        std::string name = "feature " + std::to_string(index + 1);
-        const JsonValue* props = f.get("properties");
-        const JsonValue* label = props ? props->get("name") : nullptr;
-        if (!label && props) label = props->get("NAME");
-        if (label && label->type == JsonValue::Type::String) name += " \"" + label->string + "\"";
-        return name + " (line " + std::to_string(f.line) + ")";
+    const auto lineOf = [&](size_t index) {
+        const int line = index < lines.elementLines.size() ? lines.elementLines[index] : 0;
+        return line > 0 ? " (line " + std::to_string(line) + ")" : std::string();
     };
-    if (type->string == "FeatureCollection") {
-        const JsonValue* features = root.get("features");
-        if (!features || features->type != JsonValue::Type::Array) {
+    auto featureName = [&](size_t index, const Json& f) {
+        std::string name = "feature " + std::to_string(index + 1);
+        const Json* props = member(f, "properties");
+        const Json* label = props ? member(*props, "name") : nullptr;
+        if (!label && props) label = member(*props, "NAME");
+        if (label && label->is_string()) name += " \"" + label->get<std::string>() + "\"";
+        return name + (&f == &root ? " (line " + std::to_string(lines.rootLine) + ")" : lineOf(index));
+    };
+    const std::string kind = type->get<std::string>();
+    if (kind == "FeatureCollection") {
+        const Json* features = member(root, "features");
+        if (!features || !features->is_array()) {
             error = "GeoJSON FeatureCollection without a \"features\" array";
             return false;
         }
-        for (size_t i = 0; i < features->items.size(); ++i) {
-            const JsonValue& f = features->items[i];
-            if (f.type != JsonValue::Type::Object) {
+        for (size_t i = 0; i < features->size(); ++i) {
+            const Json& f = (*features)[i];
+            if (!f.is_object()) {
                 out.diagnostics.push_back({Diagnostic::Severity::Error, featureName(i, f), "not a GeoJSON Feature object; skipped"});
                 continue;
             }
-            readGeoJsonFeature(f.get("geometry"), featureName(i, f), static_cast<uint32_t>(i), out);
+            readGeoJsonFeature(member(f, "geometry"), featureName(i, f), static_cast<uint32_t>(i), out);
         }
-    } else if (type->string == "Feature") {
-        readGeoJsonFeature(root.get("geometry"), featureName(0, root), 0, out);
+    } else if (kind == "Feature") {
+        readGeoJsonFeature(member(root, "geometry"), featureName(0, root), 0, out);
     } else {
-        readGeoJsonFeature(&root, "geometry (line " + std::to_string(root.line) + ")", 0, out);
+        readGeoJsonFeature(&root, "geometry (line " + std::to_string(lines.rootLine) + ")", 0, out);
     }
     return true;
 }
@@ -520,16 +358,6 @@ void appendNumber(std::string& out, double v) {
     out.append(buf, r.ptr);
 }
 
-void appendJsonString(std::string& out, const std::string& s) {
-    out += '"';
-    for (char c : s) {
-        if (c == '"' || c == '\\') { out += '\\'; out += c; }
-        else if (static_cast<unsigned char>(c) < 0x20) { char b[8]; std::snprintf(b, sizeof b, "\\u%04x", c); out += b; }
-        else out += c;
-    }
-    out += '"';
-}
-
 void appendRing(std::string& out, const std::vector<double>& ring) {
     out += '[';
     const size_t n = ring.size() / 2;
@@ -553,25 +381,6 @@ void appendPolygon(std::string& out, const Polygon2D& p) {
         appendRing(out, h);
     }
     out += ']';
-}
-
-void appendMeasures(std::string& out, const char* key, const Measures2D& m, const Measures2D& originals, bool comma = true) {
-    const Measures2D n = normalizedMeasures(m, originals);
-    out += "    ";
-    appendJsonString(out, key);
-    out += ": {\"area\": ";
-    appendNumber(out, m.area);
-    out += ", \"perimeter\": ";
-    appendNumber(out, m.perimeter);
-    out += ", \"circularity\": ";
-    appendNumber(out, m.circularity);
-    out += ", \"normalized_area\": ";
-    appendNumber(out, n.area);
-    out += ", \"normalized_perimeter\": ";
-    appendNumber(out, n.perimeter);
-    out += ", \"normalized_circularity\": ";
-    appendNumber(out, n.circularity);
-    out += comma ? "},\n" : "}\n";
 }
 
 /// Largest magnitude of a coordinate: squares of coordinates (areas, distances) must stay
@@ -643,11 +452,11 @@ bool readPolygonFile(const std::string& path, GeoReadResult& out, std::string& e
 namespace {
 
 /// A JSON number that is a non-negative integer below 2^31.
-bool asIndex(const JsonValue* v, int64_t limit, int64_t& out) {
-    if (!v || v->type != JsonValue::Type::Number || !std::isfinite(v->number) || v->number < 0 ||
-        v->number >= double(limit) || v->number != std::floor(v->number))
-        return false;
-    out = static_cast<int64_t>(v->number);
+bool asIndex(const Json* v, int64_t limit, int64_t& out) {
+    if (!v || !v->is_number()) return false;
+    const double number = v->get<double>();
+    if (!std::isfinite(number) || number < 0 || number >= double(limit) || number != std::floor(number)) return false;
+    out = static_cast<int64_t>(number);
     return true;
 }
 
@@ -665,73 +474,75 @@ bool readLevelsGeoJsonText(const std::string& text, std::vector<LevelAggregateRe
                            std::string& error) {
     out.clear();
     isLevels = false;
-    JsonValue root;
-    JsonParser parser(text);
-    if (!parser.parse(root, error)) {
+    Json root;
+    JsonLines lines;
+    lines.arrayKey = "features";
+    if (!parseJson(text, root, error, 256, &lines)) {
         error = "malformed JSON: " + error;
         return false;
     }
-    const JsonValue* type = root.type == JsonValue::Type::Object ? root.get("type") : nullptr;
-    if (!type || type->type != JsonValue::Type::String) {
+    const Json* type = member(root, "type");
+    if (!type || !type->is_string()) {
         error = "not GeoJSON: the top level is not an object with a \"type\"";
         return false;
     }
-    const JsonValue* features = root.get("features");
-    if (type->string != "FeatureCollection" || !features || features->type != JsonValue::Type::Array) return true;
+    const Json* features = member(root, "features");
+    if (*type != "FeatureCollection" || !features || !features->is_array()) return true;
     static const char* const kKeys[] = {"level", "delta", "aggregate", "sources"};
-    auto propertiesOf = [](const JsonValue& f) -> const JsonValue* {
-        const JsonValue* p = f.type == JsonValue::Type::Object ? f.get("properties") : nullptr;
-        return p && p->type == JsonValue::Type::Object ? p : nullptr;
+    auto propertiesOf = [](const Json& f) -> const Json* {
+        const Json* p = member(f, "properties");
+        return p && p->is_object() ? p : nullptr;
     };
     // Plain polygons may well carry one of these names (a building's "level"): only a feature
     // with all four marks the file as aggregate2d's output.
     size_t marked = 0;
-    for (const JsonValue& f : features->items)
-        if (const JsonValue* p = propertiesOf(f))
-            if (std::all_of(std::begin(kKeys), std::end(kKeys), [&](const char* key) { return p->get(key) != nullptr; }))
+    for (const Json& f : *features)
+        if (const Json* p = propertiesOf(f))
+            if (std::all_of(std::begin(kKeys), std::end(kKeys), [&](const char* key) { return member(*p, key) != nullptr; }))
                 ++marked;
     if (marked == 0) return true;
     isLevels = true;
     const std::string notOutput = ": not the GeoJSON of `aggrelod aggregate2d` (each of its features has the properties "
                                   "level, delta, aggregate and sources)";
-    for (size_t i = 0; i < features->items.size(); ++i) {
-        const JsonValue& f = features->items[i];
-        const std::string name = "feature " + std::to_string(i + 1) + " at line " + std::to_string(f.line);
-        const JsonValue* p = propertiesOf(f);
+    for (size_t i = 0; i < features->size(); ++i) {
+        const Json& f = (*features)[i];
+        const int line = i < lines.elementLines.size() ? lines.elementLines[i] : 0;
+        const std::string name = "feature " + std::to_string(i + 1) + (line > 0 ? " at line " + std::to_string(line) : "");
+        const Json* p = propertiesOf(f);
         if (!p) {
             error = name + " has no properties" + notOutput;
             return false;
         }
         for (const char* key : kKeys)
-            if (!p->get(key)) {
+            if (!member(*p, key)) {
                 error = name + " has no \"" + key + "\" property" + notOutput;
                 return false;
             }
         LevelAggregateRecord r;
         r.name = name;
         int64_t value = 0;
-        if (!asIndex(p->get("level"), 1 << 20, value)) {
+        if (!asIndex(member(*p, "level"), 1 << 20, value)) {
             error = name + ": \"level\" is not a level number (an integer >= 0)" + notOutput;
             return false;
         }
         r.level = int(value);
-        if (!asIndex(p->get("aggregate"), int64_t(1) << 31, value)) {
+        if (!asIndex(member(*p, "aggregate"), int64_t(1) << 31, value)) {
             error = name + ": \"aggregate\" is not an aggregate index (an integer >= 0)" + notOutput;
             return false;
         }
         r.aggregate = int(value);
-        const JsonValue* delta = p->get("delta");
-        if (delta->type != JsonValue::Type::Number || !std::isfinite(delta->number) || delta->number < 0) {
+        const Json* delta = member(*p, "delta");
+        if (!delta->is_number() || !std::isfinite(delta->get<double>()) || delta->get<double>() < 0) {
             error = name + ": \"delta\" is not a finite number >= 0" + notOutput;
             return false;
         }
-        r.delta = delta->number;
-        const JsonValue* sources = p->get("sources");
-        if (sources->type != JsonValue::Type::Array || sources->items.empty()) {
+        r.delta = delta->get<double>();
+        const Json* sources = member(*p, "sources");
+        if (!sources->is_array() || sources->empty()) {
             error = name + ": \"sources\" is not a non-empty array of input feature ids" + notOutput;
             return false;
         }
-        for (const JsonValue& s : sources->items) {
+        for (const Json& s : *sources) {
             if (!asIndex(&s, int64_t(1) << 32, value)) {
                 error = name + ": \"sources\" holds something that is not an input feature id (an integer >= 0)" + notOutput;
                 return false;
@@ -747,7 +558,7 @@ bool readLevelsGeoJsonText(const std::string& text, std::vector<LevelAggregateRe
         // The geometry, read as for plain polygons; here a problem refuses the file: a missing
         // aggregate would leave its originals uncovered.
         GeoReadResult one;
-        readGeoJsonFeature(f.get("geometry"), name, 0, one);
+        readGeoJsonFeature(member(f, "geometry"), name, 0, one);
         if (one.features.size() != 1) {
             error = name + ": " + (one.diagnostics.empty() ? std::string("no usable geometry") : one.diagnostics[0].message);
             const size_t skipped = error.rfind("; feature skipped");
@@ -918,49 +729,50 @@ std::string formatLinksCsv(const Hierarchy2D& h, const std::vector<Feature2D>& f
 }
 
 std::string formatStats2DJson(const Hierarchy2D& h, const std::vector<Feature2D>& features) {
-    std::string out = "{\n  \"features\": " + std::to_string(features.size()) +
-                      ",\n  \"models\": " + std::to_string(h.modelCount) +
-                      ",\n  \"triangulation\": {\"vertices\": " + std::to_string(h.vertexCount) +
-                      ", \"triangles\": " + std::to_string(h.triangleCount) + "},\n  \"originals\": {\"area\": ";
-    appendNumber(out, h.originals.area);
-    out += ", \"perimeter\": ";
-    appendNumber(out, h.originals.perimeter);
-    out += ", \"circularity\": ";
-    appendNumber(out, h.originals.circularity);
-    out += "},\n  \"levels\": [\n";
+    const auto measures = [&](const Measures2D& m) {
+        const Measures2D n = normalizedMeasures(m, h.originals);
+        Json j;
+        j["area"] = jsonNumber(m.area);
+        j["perimeter"] = jsonNumber(m.perimeter);
+        j["circularity"] = jsonNumber(m.circularity);
+        j["normalized_area"] = jsonNumber(n.area);
+        j["normalized_perimeter"] = jsonNumber(n.perimeter);
+        j["normalized_circularity"] = jsonNumber(n.circularity);
+        return j;
+    };
+    Json w;
+    w["features"] = features.size();
+    w["models"] = h.modelCount;
+    w["triangulation"] = {{"vertices", h.vertexCount}, {"triangles", h.triangleCount}};
+    w["originals"] = {{"area", jsonNumber(h.originals.area)},
+                      {"perimeter", jsonNumber(h.originals.perimeter)},
+                      {"circularity", jsonNumber(h.originals.circularity)}};
+    Json levels = Json::array();
     for (size_t l = 0; l < h.levels.size(); ++l) {
         const Level2D& level = h.levels[l];
-        out += "   {\"level\": " + std::to_string(l) + ", \"delta\": ";
-        appendNumber(out, level.delta);
-        out += ", \"groups\": " + std::to_string(level.aggregates.size()) + ",\n";
-        appendMeasures(out, "output", level.measures, h.originals);
-        appendMeasures(out, "constant", level.constant, h.originals);
-        appendMeasures(out, "adaptive", level.adaptive, h.originals);
-        appendMeasures(out, "hull", level.hull, h.originals, false);
-        out += l + 1 < h.levels.size() ? "   },\n" : "   }\n";
+        Json j;
+        j["level"] = l;
+        j["delta"] = jsonNumber(level.delta);
+        j["groups"] = level.aggregates.size();
+        j["output"] = measures(level.measures);
+        j["constant"] = measures(level.constant);
+        j["adaptive"] = measures(level.adaptive);
+        j["hull"] = measures(level.hull);
+        levels.push_back(std::move(j));
     }
-    out += "  ],\n  \"diagnostics\": [";
-    for (size_t i = 0; i < h.diagnostics.size(); ++i) {
-        const Diagnostic& d = h.diagnostics[i];
-        out += i ? ",\n    " : "\n    ";
-        out += "{\"severity\": ";
-        appendJsonString(out, d.severity == Diagnostic::Severity::Error ? "error"
-                              : d.severity == Diagnostic::Severity::Warning ? "warning" : "note");
-        out += ", \"object\": ";
-        appendJsonString(out, d.object);
-        out += ", \"message\": ";
-        appendJsonString(out, d.message);
-        out += "}";
-    }
-    out += "\n  ],\n  \"timings\": {";
-    for (size_t i = 0; i < h.timings.size(); ++i) {
-        out += i ? ", " : "";
-        appendJsonString(out, h.timings[i].first);
-        out += ": ";
-        appendNumber(out, h.timings[i].second);
-    }
-    out += "}\n}\n";
-    return out;
+    w["levels"] = std::move(levels);
+    Json diagnostics = Json::array();
+    for (const Diagnostic& d : h.diagnostics)
+        diagnostics.push_back({{"severity", d.severity == Diagnostic::Severity::Error     ? "error"
+                                            : d.severity == Diagnostic::Severity::Warning ? "warning"
+                                                                                          : "note"},
+                               {"object", d.object},
+                               {"message", d.message}});
+    w["diagnostics"] = std::move(diagnostics);
+    Json timings = Json::object();
+    for (const auto& t : h.timings) timings[t.first] = jsonNumber(t.second);
+    w["timings"] = std::move(timings);
+    return jsonText(w);
 }
 
 bool writeTextFile(const std::string& path, const std::string& text, std::string& error) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: 2D polygon files in and out (WKT, GeoJSON, link table CSV, stats JSON)
-// and pictures (SVG, PNG). module/ sees plain polygons; only this code knows formats.
+// aggrelod bake: 2D polygon files in and out (WKT, GeoJSON, link table CSV, stats JSON);
+// the pictures are in geo_picture.h. module/ sees plain polygons; only this code knows formats.
 // Coordinates are taken as plain planar numbers (degrees are not projected).
 #pragma once
 
@@ -111,28 +111,5 @@ std::string formatStats2DJson(const Hierarchy2D& hierarchy, const std::vector<Fe
 
 /// Writes text to a file (via a temporary file renamed over the target).
 bool writeTextFile(const std::string& path, const std::string& text, std::string& error);
-
-/// What to draw in a picture panel.
-struct PicturePanel {
-    const std::vector<Feature2D>* originals = nullptr;  ///< filled in one colour
-    const std::vector<Aggregate2D>* aggregates = nullptr;  ///< outlined (may be null)
-    std::string title;
-};
-
-/// SVG of one or more panels side by side (same scale).
-std::string formatSvg(const std::vector<PicturePanel>& panels, int panelWidth);
-
-/// PNG (stb_image_write) of one or more panels side by side, each panelWidth pixels wide.
-bool writePng(const std::vector<PicturePanel>& panels, int panelWidth, const std::string& path, std::string& error);
-
-/// A simple chart for reproduce2d: groups of bars (one group per row label, one bar per
-/// series), one chart per metric, stacked vertically. values[metric][row][series].
-struct BarChart {
-    std::vector<std::string> metricNames;
-    std::vector<std::string> rowLabels;
-    std::vector<std::string> seriesNames;
-    std::vector<std::vector<std::vector<double>>> values;
-};
-bool writeBarChartPng(const BarChart& chart, const std::string& path, std::string& error);
 
 }  // namespace aggrelod::io

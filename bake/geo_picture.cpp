@@ -2,7 +2,7 @@
 // aggrelod bake: pictures of 2D levels (SVG text, PNG through stb_image_write) and the bar
 // charts of reproduce2d. A scanline polygon filler (even-odd per feature), line drawing and
 // a 5x7 bitmap font: enough for clear figures without a graphics dependency.
-#include "geo_io.h"
+#include "geo_picture.h"
 #include "raster.h"
 
 #include <algorithm>

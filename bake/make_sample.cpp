@@ -4,8 +4,10 @@
 //   aggrelod_make_sample NAME -o FILE.glb [--seed N] [options]
 //
 // NAME: two_cubes [--gap G] | slabs | spheres15 | chess [--board] | forest | village | random [--objects N]
-// [--triangles T]. Exit status: 0 written, 1 could not write, 2 bad command line.
+// [--triangles T] | world [--objects N] (samples/include/aggrelod/world.h, streamed to the file).
+// Exit status: 0 written, 1 could not write, 2 bad command line.
 #include <aggrelod/samples.h>
+#include <aggrelod/world.h>
 
 #include "scene_io.h"
 
@@ -19,11 +21,11 @@ namespace {
 
 const char* const kUsage =
     "usage: aggrelod_make_sample NAME -o FILE.glb [--seed N] [options]\n"
-    "  NAME       two_cubes | slabs | spheres15 | chess | forest | village | random\n"
-    "  --seed N   random seed (spheres15, chess, forest, village, random; default 1)\n"
+    "  NAME       two_cubes | slabs | spheres15 | chess | forest | village | random | world\n"
+    "  --seed N   random seed (spheres15, chess, forest, village, random, world; default 1)\n"
     "  --gap G    two_cubes: gap between the cubes (default 0.5)\n"
     "  --board    chess: also write the board, 0.05 below the pieces (default: pieces only)\n"
-    "  --objects N    random: object count (default 1000)\n"
+    "  --objects N    random: object count (default 1000); world: 1-65536 (default 4000)\n"
     "  --triangles T  random: approximate total triangle count (default 150000)\n";
 
 int usage(const std::string& message) {
@@ -48,7 +50,7 @@ bool parseInteger(const std::string& text, long long min, long long max, long lo
 
 int main(int argc, char** argv) {
     std::string name, output;
-    long long seed = 1, objects = 1000, triangles = 150000;
+    long long seed = 1, objects = -1, triangles = 150000;
     double gap = 0.5;
     bool board = false;
     for (int i = 1; i < argc; ++i) {
@@ -89,6 +91,24 @@ int main(int argc, char** argv) {
     if (name.empty()) return usage("no scene name");
     if (output.empty()) return usage("no output file (-o FILE.glb)");
 
+    if (name == "world") {
+        aggrelod::samples::WorldSettings world;
+        world.seed = uint32_t(seed);
+        world.objectCount = objects < 0 ? 4000 : uint64_t(objects);
+        if (world.objectCount > aggrelod::samples::kMaxWorldObjects)
+            return usage("world: --objects must be at most " + std::to_string(aggrelod::samples::kMaxWorldObjects));
+        aggrelod::samples::WorldSummary summary;
+        std::string error;
+        if (!aggrelod::samples::writeWorldGlb(world, output, &summary, error)) {
+            std::fprintf(stderr, "aggrelod_make_sample: cannot write %s: %s\n", output.c_str(), error.c_str());
+            return 1;
+        }
+        std::printf("world: %llu objects, %llu triangles, %llu blocks, %.0f m across -> %s\n",
+                    static_cast<unsigned long long>(summary.objects), static_cast<unsigned long long>(summary.triangles),
+                    static_cast<unsigned long long>(summary.blocks), summary.extent, output.c_str());
+        return 0;
+    }
+    if (objects < 0) objects = 1000;
     std::vector<aggrelod::InputObject> scene;
     try {
         namespace s = aggrelod::samples;

@@ -17,6 +17,7 @@
 // Commits and that clean-up hold an exclusive lock on OUTDIR (flock), so that two bakes into
 // one OUTDIR do not interleave their moves.
 #include "output_set.h"
+#include "json.h"
 
 #include <algorithm>
 #include <array>
@@ -264,197 +265,44 @@ bool isPlainRelative(const std::string& p) {
 
 // --- the manifest as JSON -----------------------------------------------------------------------
 
-void appendJsonString(std::string& out, const std::string& s) {
-    out += '"';
-    for (const char c : s) {
-        if (c == '"' || c == '\\') {
-            out += '\\';
-            out += c;
-        } else if (static_cast<unsigned char>(c) < 0x20) {
-            char buffer[8];
-            std::snprintf(buffer, sizeof buffer, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
-            out += buffer;
-        } else {
-            out += c;
-        }
-    }
-    out += '"';
-}
-
-/// Just enough JSON for the manifest: objects, arrays, strings, non-negative integers, and
-/// true / false / null (skipped).
-class ManifestParser {
-public:
-    explicit ManifestParser(const std::string& text) : s_(text) {}
-
-    bool parse(SetManifest& manifest, std::string& error) {
-        bool ok = expect('{');
-        bool sawFormat = false, sawFiles = false;
-        while (ok && !peek('}')) {
-            std::string key;
-            ok = string(key) && expect(':');
-            if (!ok) break;
-            if (key == "format") {
-                std::string format;
-                ok = string(format);
-                if (ok && format != "aggrelod-set") ok = fail("\"format\" is not \"aggrelod-set\"");
-                sawFormat = true;
-            } else if (key == "version") {
-                uint64_t version = 0;
-                ok = number(version);
-                if (ok && version != 1) ok = fail("version " + std::to_string(version) + ", this reader reads 1");
-            } else if (key == "files") {
-                ok = files(manifest);
-                sawFiles = true;
-            } else {
-                ok = skipValue(0);
-            }
-            if (ok && !peek('}')) ok = expect(',');
-        }
-        ok = ok && expect('}');
-        skipSpace();
-        if (ok && pos_ != s_.size()) ok = fail("text after the manifest");
-        if (ok && (!sawFormat || !sawFiles)) ok = fail("no \"format\" or no \"files\"");
-        if (!ok) error = error_;
-        return ok;
-    }
-
-private:
-    const std::string& s_;
-    size_t pos_ = 0;
-    std::string error_;
-
-    bool fail(const std::string& what) {
-        if (error_.empty()) error_ = "at byte " + std::to_string(pos_) + ": " + what;
+/// Reads the manifest from parsed JSON: "format", "version" 1 and "files"; other keys are
+/// ignored. Every file's name (and "at") must be a plain path inside the folder.
+bool manifestFromJson(const Json& j, SetManifest& manifest, std::string& error) {
+    const auto fail = [&](const std::string& what) {
+        error = what;
+        manifest.files.clear();
         return false;
+    };
+    if (!j.is_object()) return fail("the manifest is not a JSON object");
+    const auto format = j.find("format"), version = j.find("version"), files = j.find("files");
+    if (format == j.end() || files == j.end()) return fail("no \"format\" or no \"files\"");
+    if (*format != "aggrelod-set") return fail("\"format\" is not \"aggrelod-set\"");
+    if (version != j.end()) {
+        if (!version->is_number_unsigned()) return fail("\"version\" is not a non-negative integer");
+        if (*version != 1) return fail("version " + version->dump() + ", this reader reads 1");
     }
-    void skipSpace() {
-        while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\n' || s_[pos_] == '\r' || s_[pos_] == '\t')) ++pos_;
+    if (!files->is_array()) return fail("\"files\" is not an array");
+    for (const Json& entry : *files) {
+        if (!entry.is_object()) return fail("a file entry is not an object");
+        const auto name = entry.find("name"), size = entry.find("size"), hash = entry.find("sha256"), at = entry.find("at");
+        if (name == entry.end() || size == entry.end() || hash == entry.end())
+            return fail("a file without \"name\", \"size\" or \"sha256\"");
+        if (!name->is_string() || !hash->is_string() || (at != entry.end() && !at->is_string()))
+            return fail("a file whose \"name\", \"sha256\" or \"at\" is not a string");
+        if (!size->is_number_unsigned()) return fail("a file whose \"size\" is not a non-negative integer");
+        SetManifestFile f;
+        f.name = name->get<std::string>();
+        f.size = size->get<uint64_t>();
+        f.sha256 = hash->get<std::string>();
+        if (at != entry.end()) f.at = at->get<std::string>();
+        if (!isPlainRelative(f.name) || (!f.at.empty() && !isPlainRelative(f.at)))
+            return fail("\"" + f.name + "\": not a path inside the folder");
+        if (f.sha256.size() != 64 || f.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
+            return fail("\"" + f.name + "\": \"sha256\" is not 64 lower-case hex digits");
+        manifest.files.push_back(std::move(f));
     }
-    bool peek(char c) {
-        skipSpace();
-        return pos_ < s_.size() && s_[pos_] == c;
-    }
-    bool expect(char c) {
-        if (!peek(c)) return fail(std::string("expected '") + c + "'");
-        ++pos_;
-        return true;
-    }
-    bool string(std::string& out) {
-        if (!expect('"')) return false;
-        out.clear();
-        while (pos_ < s_.size()) {
-            const char c = s_[pos_++];
-            if (c == '"') return true;
-            if (static_cast<unsigned char>(c) < 0x20) return fail("control character in a string");
-            if (c != '\\') {
-                out += c;
-                continue;
-            }
-            if (pos_ >= s_.size()) break;
-            const char e = s_[pos_++];
-            switch (e) {
-                case '"': case '\\': case '/': out += e; break;
-                case 'b': out += '\b'; break;
-                case 'f': out += '\f'; break;
-                case 'n': out += '\n'; break;
-                case 'r': out += '\r'; break;
-                case 't': out += '\t'; break;
-                case 'u': {
-                    if (pos_ + 4 > s_.size()) return fail("truncated \\u escape");
-                    unsigned code = 0;
-                    for (int i = 0; i < 4; ++i) {
-                        const char h = s_[pos_++];
-                        code = code * 16 + unsigned(h >= '0' && h <= '9' ? h - '0'
-                                                    : h >= 'a' && h <= 'f' ? h - 'a' + 10
-                                                    : h >= 'A' && h <= 'F' ? h - 'A' + 10
-                                                                           : 99);
-                        if (code > 0xFFFF) return fail("malformed \\u escape");
-                    }
-                    if (code < 0x80) {
-                        out += char(code);
-                    } else if (code < 0x800) {
-                        out += char(0xC0 | (code >> 6));
-                        out += char(0x80 | (code & 0x3F));
-                    } else {
-                        out += char(0xE0 | (code >> 12));
-                        out += char(0x80 | ((code >> 6) & 0x3F));
-                        out += char(0x80 | (code & 0x3F));
-                    }
-                    break;
-                }
-                default: return fail("unknown escape in a string");
-            }
-        }
-        return fail("unterminated string");
-    }
-    bool number(uint64_t& out) {
-        skipSpace();
-        const size_t start = pos_;
-        out = 0;
-        while (pos_ < s_.size() && s_[pos_] >= '0' && s_[pos_] <= '9') {
-            if (out > (UINT64_MAX - 9) / 10) return fail("number too large");
-            out = out * 10 + uint64_t(s_[pos_++] - '0');
-        }
-        if (pos_ == start) return fail("expected a non-negative integer");
-        return true;
-    }
-    bool skipValue(int depth) {
-        if (depth > 16) return fail("nesting too deep");
-        skipSpace();
-        if (pos_ >= s_.size()) return fail("unexpected end");
-        const char c = s_[pos_];
-        std::string ignored;
-        if (c == '"') return string(ignored);
-        if (c == '{' || c == '[') {
-            const char close = c == '{' ? '}' : ']';
-            ++pos_;
-            while (!peek(close)) {
-                if (c == '{' && !(string(ignored) && expect(':'))) return false;
-                if (!skipValue(depth + 1)) return false;
-                if (!peek(close) && !expect(',')) return false;
-            }
-            ++pos_;
-            return true;
-        }
-        for (const char* word : {"true", "false", "null"})
-            if (s_.compare(pos_, std::strlen(word), word) == 0) {
-                pos_ += std::strlen(word);
-                return true;
-            }
-        while (pos_ < s_.size() && std::strchr("+-.eE0123456789", s_[pos_])) ++pos_;
-        return pos_ > 0 && std::strchr("+-.eE0123456789", s_[pos_ - 1]) ? true : fail("unexpected character");
-    }
-    bool files(SetManifest& manifest) {
-        if (!expect('[')) return false;
-        while (!peek(']')) {
-            if (!expect('{')) return false;
-            SetManifestFile f;
-            bool sawName = false, sawSize = false, sawHash = false;
-            while (!peek('}')) {
-                std::string key;
-                if (!string(key) || !expect(':')) return false;
-                bool ok;
-                if (key == "name") ok = string(f.name), sawName = true;
-                else if (key == "size") ok = number(f.size), sawSize = true;
-                else if (key == "sha256") ok = string(f.sha256), sawHash = true;
-                else if (key == "at") ok = string(f.at);
-                else ok = skipValue(0);
-                if (!ok || (!peek('}') && !expect(','))) return false;
-            }
-            ++pos_;
-            if (!sawName || !sawSize || !sawHash) return fail("a file without \"name\", \"size\" or \"sha256\"");
-            if (!isPlainRelative(f.name) || (!f.at.empty() && !isPlainRelative(f.at)))
-                return fail("\"" + f.name + "\": not a path inside the folder");
-            if (f.sha256.size() != 64 || f.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
-                return fail("\"" + f.name + "\": \"sha256\" is not 64 lower-case hex digits");
-            manifest.files.push_back(std::move(f));
-            if (!peek(']') && !expect(',')) return false;
-        }
-        ++pos_;
-        return true;
-    }
-};
+    return true;
+}
 
 // --- undoing a commit -------------------------------------------------------------------------
 
@@ -580,24 +428,27 @@ bool sha256File(const fs::path& path, std::string& hex, uint64_t& size, std::str
 }
 
 std::string formatSetManifest(const SetManifest& manifest) {
-    std::string out = "{\n  \"format\": \"aggrelod-set\",\n  \"version\": 1,\n  \"files\": [";
-    for (size_t i = 0; i < manifest.files.size(); ++i) {
-        const SetManifestFile& f = manifest.files[i];
-        out += i ? ",\n    {\"name\": " : "\n    {\"name\": ";
-        appendJsonString(out, f.name);
-        out += ", \"size\": " + std::to_string(f.size) + ", \"sha256\": \"" + f.sha256 + "\"";
-        if (!f.at.empty()) {
-            out += ", \"at\": ";
-            appendJsonString(out, f.at);
-        }
-        out += "}";
+    Json j;
+    j["format"] = "aggrelod-set";
+    j["version"] = 1;
+    Json files = Json::array();
+    for (const SetManifestFile& f : manifest.files) {
+        Json entry;
+        entry["name"] = f.name;
+        entry["size"] = f.size;
+        entry["sha256"] = f.sha256;
+        if (!f.at.empty()) entry["at"] = f.at;
+        files.push_back(std::move(entry));
     }
-    return out + (manifest.files.empty() ? "]\n}\n" : "\n  ]\n}\n");
+    j["files"] = std::move(files);
+    return jsonText(j);
 }
 
 bool parseSetManifest(const std::string& text, SetManifest& manifest, std::string& error) {
     manifest.files.clear();
-    return ManifestParser(text).parse(manifest, error);
+    Json j;
+    if (!parseJson(text, j, error, 16)) return false;
+    return manifestFromJson(j, manifest, error);
 }
 
 SetCheck checkOutputSet(const fs::path& outDir) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: small raster helpers shared by the 2D pictures and the 3D renders: the 5x7
-// bitmap font and PNG output (stb_image_write stays inside geo_picture.cpp).
+// aggrelod bake: small raster helpers shared by the 2D pictures and the 3D renders (both in
+// the aggrelod_render library): the 5x7 bitmap font and PNG output (stb_image_write stays
+// inside geo_picture.cpp).
 #pragma once
 
 #include <string>

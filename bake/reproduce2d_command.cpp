@@ -7,6 +7,7 @@
 // times go to the terminal only.
 #include "commands_2d.h"
 #include "geo_io.h"
+#include "geo_picture.h"
 #include "terminal.h"
 
 #include <aggrelod/aggregate2d.h>

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: the stats JSON file, with a small hand-written JSON writer
-// (deterministic: shortest round-trip doubles, locale-independent; NaN/inf as null).
+// aggrelod bake: the stats JSON file (json.h: keys in a fixed order, round-trip doubles,
+// NaN/inf as null; deterministic).
+#include "json.h"
 #include "scene_io.h"
 
 #include <algorithm>
@@ -17,131 +18,6 @@
 namespace aggrelod::io {
 namespace {
 
-/// Minimal streaming JSON writer with two-space indentation. The caller keeps the
-/// structure valid; commas and indentation are handled here.
-class JsonWriter {
-public:
-    explicit JsonWriter(std::string& out) : out_(out) {}
-
-    void beginObject() { open('{'); }
-    void endObject() { close('}'); }
-    void beginArray() { open('['); }
-    void endArray() { close(']'); }
-
-    /// Arrays whose elements stay on one line (small records): `{"a": 1, "b": 2}`.
-    void beginInlineObject() {
-        value();
-        out_ += '{';
-        inlineDepth_++;
-        first_ = true;
-    }
-    void endInlineObject() {
-        out_ += '}';
-        inlineDepth_--;
-        first_ = false;
-    }
-
-    void key(const std::string& k) {
-        separator();
-        string(k);
-        out_ += ": ";
-        afterKey_ = true;
-    }
-
-    void number(double v) {
-        value();
-        if (!std::isfinite(v)) {
-            out_ += "null";
-            return;
-        }
-        if (v == 0) v = 0;  // no "-0"
-        char buf[64];
-        const auto r = std::to_chars(buf, buf + sizeof buf, v);
-        out_.append(buf, r.ptr);
-    }
-    void integer(long long v) {
-        value();
-        out_ += std::to_string(v);
-    }
-    void unsignedInteger(unsigned long long v) {
-        value();
-        out_ += std::to_string(v);
-    }
-    void str(const std::string& s) {
-        value();
-        string(s);
-    }
-
-    // key + value shorthands
-    void field(const std::string& k, double v) { key(k); number(v); }
-    void fieldInt(const std::string& k, unsigned long long v) { key(k); unsignedInteger(v); }
-    void fieldSigned(const std::string& k, long long v) { key(k); integer(v); }
-    void fieldStr(const std::string& k, const std::string& v) { key(k); str(v); }
-
-    void finish() { out_ += '\n'; }
-
-private:
-    void open(char c) {
-        value();
-        out_ += c;
-        depth_++;
-        first_ = true;
-    }
-    void close(char c) {
-        depth_--;
-        if (!first_) newline();
-        out_ += c;
-        first_ = false;
-    }
-    void newline() {
-        out_ += '\n';
-        out_.append(size_t(depth_) * 2, ' ');
-    }
-    void separator() {
-        if (!first_) out_ += inlineDepth_ > 0 ? ", " : ",";
-        if (inlineDepth_ == 0) newline();
-        first_ = false;
-    }
-    /// Before a value: separator unless it follows a key.
-    void value() {
-        if (afterKey_) {
-            afterKey_ = false;
-            return;
-        }
-        if (depth_ == 0 && inlineDepth_ == 0 && out_.empty()) return;
-        separator();
-    }
-    void string(const std::string& s) {
-        out_ += '"';
-        for (unsigned char c : s) {
-            switch (c) {
-                case '"': out_ += "\\\""; break;
-                case '\\': out_ += "\\\\"; break;
-                case '\b': out_ += "\\b"; break;
-                case '\f': out_ += "\\f"; break;
-                case '\n': out_ += "\\n"; break;
-                case '\r': out_ += "\\r"; break;
-                case '\t': out_ += "\\t"; break;
-                default:
-                    if (c < 0x20 || c == 0x7f) {
-                        char buf[8];
-                        std::snprintf(buf, sizeof buf, "\\u%04x", unsigned(c));
-                        out_ += buf;
-                    } else {
-                        out_ += char(c);  // UTF-8 passes through
-                    }
-            }
-        }
-        out_ += '"';
-    }
-
-    std::string& out_;
-    int depth_ = 0;
-    int inlineDepth_ = 0;
-    bool first_ = true;
-    bool afterKey_ = false;
-};
-
 const char* severityName(Diagnostic::Severity s) {
     switch (s) {
         case Diagnostic::Severity::Note: return "note";
@@ -151,20 +27,20 @@ const char* severityName(Diagnostic::Severity s) {
     return "warning";
 }
 
-void writeMeasures(JsonWriter& w, const SolidMeasures& m) {
-    w.beginInlineObject();
-    w.field("volume", m.volume);
-    w.field("area", m.area);
-    w.field("sphericity", m.sphericity);
-    w.endInlineObject();
+Json measuresJson(const SolidMeasures& m) {
+    Json j;
+    j["volume"] = jsonNumber(m.volume);
+    j["area"] = jsonNumber(m.area);
+    j["sphericity"] = jsonNumber(m.sphericity);
+    return j;
 }
 
-void writeDiagnostic(JsonWriter& w, const Diagnostic& d) {
-    w.beginInlineObject();
-    w.fieldStr("severity", severityName(d.severity));
-    w.fieldStr("object", d.object);
-    w.fieldStr("message", d.message);
-    w.endInlineObject();
+Json diagnosticJson(const Diagnostic& d) {
+    Json j;
+    j["severity"] = severityName(d.severity);
+    j["object"] = d.object;
+    j["message"] = d.message;
+    return j;
 }
 
 /// Largest and median of `values` (0, 0 when empty).
@@ -177,7 +53,7 @@ std::pair<double, double> maxAndMedian(std::vector<double> values) {
 /// The proxies of the nodes a cut of `nodes` would draw at one level (level -1: the
 /// per-object LOD nodes, -2: the coarser versions of aggregates): their budgets, certified
 /// errors and triangles.
-void writeProxyFigures(JsonWriter& w, const HierarchyNodes& nodes, int level) {
+Json proxyFiguresJson(const HierarchyNodes& nodes, int level) {
     std::vector<double> budgets, errors;
     size_t triangles = 0, count = 0;
     for (const HierarchyNode& n : nodes.nodes) {
@@ -194,116 +70,99 @@ void writeProxyFigures(JsonWriter& w, const HierarchyNodes& nodes, int level) {
     }
     const auto [budgetMax, budgetMedian] = maxAndMedian(budgets);
     const auto [errorMax, errorMedian] = maxAndMedian(errors);
-    w.beginInlineObject();
-    w.fieldInt("nodes", count);
-    w.field("budget_max", budgetMax);
-    w.field("budget_median", budgetMedian);
-    w.field("error_max", errorMax);
-    w.field("error_median", errorMedian);
-    w.fieldInt("triangles", triangles);
-    w.endInlineObject();
+    Json j;
+    j["nodes"] = count;
+    j["budget_max"] = jsonNumber(budgetMax);
+    j["budget_median"] = jsonNumber(budgetMedian);
+    j["error_max"] = jsonNumber(errorMax);
+    j["error_median"] = jsonNumber(errorMedian);
+    j["triangles"] = triangles;
+    return j;
 }
 
 std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& objects,
                           const std::vector<Diagnostic>& readDiagnostics, const HierarchyNodes* nodes) {
-    std::string text;
-    JsonWriter w(text);
-    w.beginObject();
-    w.fieldInt("objects", objects.size());
-    w.fieldInt("models", h.modelCount);
-    w.fieldInt("input_triangles", h.inputTriangleCount);
-    w.fieldInt("tetrahedra", h.tetrahedronCount);
-    w.key("originals");
-    writeMeasures(w, h.originals);
+    Json w;
+    w["objects"] = objects.size();
+    w["models"] = h.modelCount;
+    w["input_triangles"] = h.inputTriangleCount;
+    w["tetrahedra"] = h.tetrahedronCount;
+    w["originals"] = measuresJson(h.originals);
 
-    w.key("levels");
-    w.beginArray();
+    Json& levels = w["levels"] = Json::array();
     for (size_t k = 0; k < h.levels.size(); ++k) {
         const Level& l = h.levels[k];
         long long components = 0;
         for (const Aggregate& a : l.aggregates) components += a.componentCount;
-        w.beginInlineObject();
-        w.fieldInt("level", k);
-        w.field("delta", l.delta);
-        w.fieldInt("groups", l.aggregates.size());
-        w.fieldInt("triangles", l.triangleCount);
-        w.field("volume_original", l.volumeOriginal);
-        w.field("volume_aggregate", l.measures.volume);
-        w.field("volume_hull", l.volumeHull);
-        if (l.hasVolumeConstant) w.field("volume_constant", l.volumeConstant);
-        w.field("added_volume", l.measures.volume - l.volumeOriginal);
-        w.field("added_volume_hull", l.volumeHull - l.volumeOriginal);
-        if (l.hasVolumeConstant) w.field("added_volume_constant", l.volumeConstant - l.volumeOriginal);
-        w.field("area", l.measures.area);
-        w.field("sphericity", l.measures.sphericity);
-        w.fieldSigned("components", components);
-        if (nodes) {
-            w.key("proxies");
-            writeProxyFigures(w, *nodes, int(k));
-        }
-        w.endInlineObject();
+        Json j;
+        j["level"] = k;
+        j["delta"] = jsonNumber(l.delta);
+        j["groups"] = l.aggregates.size();
+        j["triangles"] = l.triangleCount;
+        j["volume_original"] = jsonNumber(l.volumeOriginal);
+        j["volume_aggregate"] = jsonNumber(l.measures.volume);
+        j["volume_hull"] = jsonNumber(l.volumeHull);
+        if (l.hasVolumeConstant) j["volume_constant"] = jsonNumber(l.volumeConstant);
+        j["added_volume"] = jsonNumber(l.measures.volume - l.volumeOriginal);
+        j["added_volume_hull"] = jsonNumber(l.volumeHull - l.volumeOriginal);
+        if (l.hasVolumeConstant) j["added_volume_constant"] = jsonNumber(l.volumeConstant - l.volumeOriginal);
+        j["area"] = jsonNumber(l.measures.area);
+        j["sphericity"] = jsonNumber(l.measures.sphericity);
+        j["components"] = components;
+        if (nodes) j["proxies"] = proxyFiguresJson(*nodes, int(k));
+        levels.push_back(std::move(j));
     }
-    w.endArray();
-    if (nodes) {  // the per-object LOD nodes below the levels
-        w.key("object_lods");
-        writeProxyFigures(w, *nodes, -1);
-        w.key("coarser_versions");  // between each aggregate and its parent
-        writeProxyFigures(w, *nodes, -2);
+    if (nodes) {
+        w["object_lods"] = proxyFiguresJson(*nodes, -1);       // the per-object LOD nodes below the levels
+        w["coarser_versions"] = proxyFiguresJson(*nodes, -2);  // between each aggregate and its parent
     }
 
     // Solidified models (docs/design.md §2.0): distances sampled, not certified.
-    w.key("solids");
-    w.beginArray();
+    Json& solids = w["solids"] = Json::array();
     for (const SolidReport& r : h.solids) {
-        w.beginInlineObject();
+        Json j;
         std::string names;
         for (size_t i = 0; i < r.objects.size(); ++i) names += (i ? ", " : "") + objects[r.objects[i]].name;
-        w.fieldStr("objects", names);
-        w.fieldStr("method", r.method == SolidifyMethod::Wrap    ? "alpha_wrap"
-                            : r.method == SolidifyMethod::Union ? "boolean_union"
-                                                                : "convex_hull");
-        w.fieldStr("reason", r.reason);
-        w.field("alpha", r.alpha);
-        w.field("offset", r.offset);
-        w.field("bbox_diagonal", r.bboxDiagonal);
-        w.field("volume_original", r.volumeOriginal);
-        w.field("volume_solid", r.volumeSolid);
-        w.field("added_volume", r.volumeSolid - r.volumeOriginal);
-        w.field("distance_solid_to_original", r.distanceSolidToOriginal);
-        w.field("distance_original_to_solid", r.distanceOriginalToSolid);
-        w.field("hausdorff", std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid));
-        w.fieldStr("hausdorff_kind", "sampled");
-        if (r.hullDistance > 0) w.field("hausdorff_convex_hull", r.hullDistance);
-        w.fieldInt("triangles", r.triangles.size() / 3);
-        w.fieldStr("closed_manifold", r.closedManifold ? "yes" : "no");
-        w.endInlineObject();
+        j["objects"] = names;
+        j["method"] = r.method == SolidifyMethod::Wrap    ? "alpha_wrap"
+                      : r.method == SolidifyMethod::Union ? "boolean_union"
+                                                          : "convex_hull";
+        j["reason"] = r.reason;
+        j["alpha"] = jsonNumber(r.alpha);
+        j["offset"] = jsonNumber(r.offset);
+        j["bbox_diagonal"] = jsonNumber(r.bboxDiagonal);
+        j["volume_original"] = jsonNumber(r.volumeOriginal);
+        j["volume_solid"] = jsonNumber(r.volumeSolid);
+        j["added_volume"] = jsonNumber(r.volumeSolid - r.volumeOriginal);
+        j["distance_solid_to_original"] = jsonNumber(r.distanceSolidToOriginal);
+        j["distance_original_to_solid"] = jsonNumber(r.distanceOriginalToSolid);
+        j["hausdorff"] = jsonNumber(std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid));
+        j["hausdorff_kind"] = "sampled";
+        if (r.hullDistance > 0) j["hausdorff_convex_hull"] = jsonNumber(r.hullDistance);
+        j["triangles"] = r.triangles.size() / 3;
+        j["closed_manifold"] = r.closedManifold ? "yes" : "no";
+        solids.push_back(std::move(j));
     }
-    w.endArray();
-    const auto writeNames = [&](const char* key, const std::vector<uint32_t>& ids) {
-        w.key(key);
-        w.beginArray();
-        for (uint32_t i : ids) w.str(objects[i].name);
-        w.endArray();
+    const auto names = [&](const std::vector<uint32_t>& ids) {
+        Json list = Json::array();
+        for (uint32_t i : ids) list.push_back(objects[i].name);
+        return list;
     };
-    writeNames("support_surfaces", h.supportObjects);
-    writeNames("left_out", h.leftOutObjects);
+    w["support_surfaces"] = names(h.supportObjects);
+    w["left_out"] = names(h.leftOutObjects);
 
-    w.key("merges");
-    w.beginArray();
+    Json& merges = w["merges"] = Json::array();
     for (const Merge& m : h.merges) {
-        w.beginInlineObject();
-        w.field("height", m.height);
-        w.fieldInt("a", m.modelA);
-        w.fieldInt("b", m.modelB);
-        w.endInlineObject();
+        Json j;
+        j["height"] = jsonNumber(m.height);
+        j["a"] = m.modelA;
+        j["b"] = m.modelB;
+        merges.push_back(std::move(j));
     }
-    w.endArray();
 
-    w.key("warnings");
-    w.beginArray();
-    for (const Diagnostic& d : readDiagnostics) writeDiagnostic(w, d);
-    for (const Diagnostic& d : h.diagnostics) writeDiagnostic(w, d);
-    w.endArray();
+    Json& warnings = w["warnings"] = Json::array();
+    for (const Diagnostic& d : readDiagnostics) warnings.push_back(diagnosticJson(d));
+    for (const Diagnostic& d : h.diagnostics) warnings.push_back(diagnosticJson(d));
 
     // Last, so that determinism checks can drop it.
     // A stage run more than once (e.g. triangulating again after a refinement) is summed,
@@ -318,13 +177,9 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
             it->second += t.second;
         }
     }
-    w.key("timings");
-    w.beginObject();
-    for (const auto& t : timings) w.field(t.first, t.second);
-    w.endObject();
-    w.endObject();
-    w.finish();
-    return text;
+    Json& times = w["timings"] = Json::object();
+    for (const auto& t : timings) times[t.first] = jsonNumber(t.second);
+    return jsonText(w);
 }
 
 }  // namespace

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: 3D Tiles export (docs/design.md §4; runtime selection as in section 3).
 // See tiles_export.h for the mapping and the axis convention. The GLB contents are written
-// by writeTileGlb (gltf_io.cpp, the only tinygltf user); this file writes the JSON.
+// by writeTileGlb (gltf_write.cpp); this file writes the JSON (json.h).
 #include "tiles_export.h"
 
+#include "json.h"
 #include "scene_io.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -18,31 +18,6 @@
 namespace aggrelod::io {
 namespace {
 
-/// Shortest text that reads back as the same double (locale-independent, deterministic).
-std::string number(double v) {
-    if (v == 0) return "0";  // also turns -0 into 0
-    char buffer[32];
-    const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
-    return std::string(buffer, r.ptr);
-}
-
-std::string jsonString(const std::string& s) {
-    std::string out = "\"";
-    for (unsigned char c : s) {
-        if (c == '"' || c == '\\') {
-            out += '\\';
-            out += char(c);
-        } else if (c < 0x20) {
-            char buffer[8];
-            std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-            out += buffer;
-        } else {
-            out += char(c);
-        }
-    }
-    return out + "\"";
-}
-
 /// Axis-aligned box in glTF (y-up) world coordinates.
 struct Box {
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -50,7 +25,7 @@ struct Box {
 
 /// The 3D Tiles "box" (12 numbers: centre, x half axis, y half axis, z half axis) of `b`
 /// grown by `pad` on every side, taken from glTF y-up to 3D Tiles z-up: (x, y, z) -> (x, -z, y).
-std::string tilesBox(const Box& b, double pad) {
+Json tilesBox(const Box& b, double pad) {
     double c[3], h[3];
     for (int k = 0; k < 3; ++k) {
         c[k] = 0.5 * (b.lo[k] + b.hi[k]);
@@ -60,9 +35,9 @@ std::string tilesBox(const Box& b, double pad) {
                                h[0], 0,     0,     // glTF x stays x
                                0,    h[2],  0,     // glTF z becomes -y (a half axis: sign irrelevant)
                                0,    0,     h[1]};  // glTF y becomes z
-    std::string s = "[";
-    for (int i = 0; i < 12; ++i) s += (i ? ", " : "") + number(values[i]);
-    return s + "]";
+    Json box = Json::array();
+    for (double v : values) box.push_back(jsonNumber(v));
+    return box;
 }
 
 class TilesetWriter {
@@ -107,27 +82,23 @@ public:
         // Without any tile drawn, the error is about the whole scene: its diagonal.
         summary.geometricError = std::max(diagonal, rootError);
 
-        out_ = "{\n  \"asset\": {\"version\": \"1.1\", \"generator\": \"aggrelod\"},\n";
-        out_ += "  \"geometricError\": " + number(summary.geometricError) + ",\n";
-        out_ += "  \"root\": ";
+        Json tileset;
+        tileset["asset"] = {{"version", "1.1"}, {"generator", "aggrelod"}};
+        tileset["geometricError"] = jsonNumber(summary.geometricError);
         if (roots.size() == 1) {
-            writeTile(roots[0], 2);
+            tileset["root"] = tile(roots[0]);
         } else {
             // Several roots: a root without content standing for "nothing drawn".
             ++tileCount_;
-            out_ += "{\n    \"boundingVolume\": {\"box\": " + tilesBox(scene, pad_) + "},\n";
-            out_ += "    \"geometricError\": " + number(summary.geometricError) + ",\n";
-            out_ += "    \"refine\": \"REPLACE\",\n";
-            out_ += "    \"children\": [\n";
-            for (size_t i = 0; i < roots.size(); ++i) {
-                out_ += "      ";
-                writeTile(roots[i], 6);
-                out_ += i + 1 < roots.size() ? ",\n" : "\n";
-            }
-            out_ += "    ]\n  }";
+            Json root;
+            root["boundingVolume"] = {{"box", tilesBox(scene, pad_)}};
+            root["geometricError"] = jsonNumber(summary.geometricError);
+            root["refine"] = "REPLACE";
+            root["children"] = Json::array();
+            for (uint32_t r : roots) root["children"].push_back(tile(r));
+            tileset["root"] = std::move(root);
         }
-        out_ += "\n}\n";
-        json = std::move(out_);
+        json = jsonText(tileset);
         summary.tileCount = tileCount_;
         summary.contentCount = contentCount_;
         return true;
@@ -161,54 +132,49 @@ private:
         return r;
     }
 
-    void writeTile(uint32_t n, int indent) {
+    Json tile(uint32_t n) {
         const HierarchyNode& node = nodes_.nodes[n];
-        const std::string in(size_t(indent) + 2, ' ');
         ++tileCount_;
-        out_ += "{\n";
-        out_ += in + "\"boundingVolume\": {\"box\": " + tilesBox(box(n), pad_) + "},\n";
-        out_ += in + "\"geometricError\": " + number(node.leaf ? 0.0 : node.geometricError) + ",\n";
-        out_ += in + "\"refine\": \"REPLACE\",\n";
+        Json t;
+        t["boundingVolume"] = {{"box", tilesBox(box(n), pad_)}};
+        t["geometricError"] = jsonNumber(node.leaf ? 0.0 : node.geometricError);
+        t["refine"] = "REPLACE";
         if (!node.indices.empty()) {
             ++contentCount_;
             contentNodes_.push_back(n);
-            out_ += in + "\"content\": {\"uri\": \"node" + std::to_string(n) + ".glb\"},\n";
+            t["content"] = {{"uri", "node" + std::to_string(n) + ".glb"}};
         }
-        out_ += in + "\"extras\": {\"node\": " + std::to_string(n);
+        Json extras;
+        extras["node"] = n;
         if (node.leaf) {
-            out_ += ", \"object\": " + jsonString(objects_[n].name) + ", \"id\": " + std::to_string(objects_[n].id);
+            extras["object"] = objects_[n].name;
+            extras["id"] = objects_[n].id;
         } else if (node.objectLod >= 1) {
             // A simplified version of one object: no aggregate level of its own.
-            out_ += ", \"objectLod\": " + std::to_string(node.objectLod) + ", \"objects\": 1";
+            extras["objectLod"] = node.objectLod;
+            extras["objects"] = 1;
         } else if (node.coarserStep >= 1) {
             // A coarser version of the aggregate below it: no level of its own either.
-            out_ += ", \"coarserStep\": " + std::to_string(node.coarserStep) + ", \"delta\": " + number(node.delta) +
-                    ", \"objects\": " + std::to_string(node.sources.size());
+            extras["coarserStep"] = node.coarserStep;
+            extras["delta"] = jsonNumber(node.delta);
+            extras["objects"] = node.sources.size();
         } else {
-            out_ += ", \"level\": " + std::to_string(node.firstLevel) + ", \"lastLevel\": " +
-                    std::to_string(node.lastLevel) + ", \"delta\": " + number(node.delta) +
-                    ", \"objects\": " + std::to_string(node.sources.size());
+            extras["level"] = node.firstLevel;
+            extras["lastLevel"] = node.lastLevel;
+            extras["delta"] = jsonNumber(node.delta);
+            extras["objects"] = node.sources.size();
         }
-        out_ += "}";
-        std::vector<uint32_t> children;
+        t["extras"] = std::move(extras);
+        Json children = Json::array();
         for (uint32_t c : node.children)
-            if (hasGeometry(c)) children.push_back(c);
-        if (!children.empty()) {
-            out_ += ",\n" + in + "\"children\": [\n";
-            for (size_t i = 0; i < children.size(); ++i) {
-                out_ += in + "  ";
-                writeTile(children[i], indent + 4);
-                out_ += i + 1 < children.size() ? ",\n" : "\n";
-            }
-            out_ += in + "]";
-        }
-        out_ += "\n" + std::string(size_t(indent), ' ') + "}";
+            if (hasGeometry(c)) children.push_back(tile(c));
+        if (!children.empty()) t["children"] = std::move(children);
+        return t;
     }
 
     const HierarchyNodes& nodes_;
     const std::vector<InputObject>& objects_;
     double pad_ = 0;
-    std::string out_;
     size_t tileCount_ = 0, contentCount_ = 0;
     std::vector<uint32_t> contentNodes_;
 };

@@ -2,7 +2,7 @@
 # Checks the dependency rule of docs/design.md §1. Run as
 #   cmake -DSOURCE_DIR=<repo root> [-DLINK_INFO=<generated file>] -P dependency_rule.cmake
 #
-# - no file under runtime/ includes TetGen, CGAL, tinygltf, meshoptimizer, GEOS, GLM or any
+# - no file under runtime/ includes TetGen, CGAL, tinygltf, nlohmann-json, meshoptimizer, GEOS, GLM or any
 #   header of module/;
 # - no file under module/ includes tinygltf or any header of runtime/;
 # - no file under planning/ includes TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS,
@@ -112,7 +112,7 @@ endforeach()
 collect_header_names(samples samples_headers)
 
 check_includes(runtime
-  "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|(^|/)module/"
+  "(^|/)tetgen\\.h$|^CGAL/|(^|/)tiny_gltf\\.h$|(^|/)meshoptimizer\\.h$|^geos|^glm/|^nlohmann/|(^|/)module/"
   "${module_only}")
 check_includes(module
   "(^|/)tiny_gltf\\.h$|(^|/)runtime/"
@@ -148,7 +148,7 @@ if(LINK_INFO)
     message(FATAL_ERROR "dependency_rule: ${LINK_INFO} is missing (re-run cmake)")
   endif()
   include("${LINK_INFO}")
-  set(_forbidden_runtime "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples")
+  set(_forbidden_runtime "tet|cgal|gmp|mpfr|tinygltf|nlohmann|meshoptimizer|geos|glm|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples")
   set(_forbidden_module "tinygltf|aggrelod_runtime|aggrelod::runtime|aggrelod_io")
   set(_forbidden_planning "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|cli11|pkgconfig::stb|stb_image|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_render|aggrelod_samples|aggrelod::samples|^aggrelod$|^aggrelod_asan$")
   set(_forbidden_viewer "tet|cgal|gmp|mpfr|tinygltf|meshoptimizer|geos|glm|embree|aggrelod_module|aggrelod::module|aggrelod_io|aggrelod_samples|aggrelod_render|aggrelod_planning|aggrelod_runtime_collision")

@@ -1,0 +1,896 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// aggrelod bake: writing glTF: the sample scenes (writeObjectsGlb), levels.glb, proxies.glb,
+// collision.glb and the 3D Tiles contents, all through one GLB builder (tinygltf, whose
+// implementation Debian ships compiled in libtinygltf.so).
+#include "runtime_export.h"
+#include "scene_io.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <utility>
+
+
+namespace aggrelod::io {
+namespace {
+
+using Severity = Diagnostic::Severity;
+
+// ---------------------------------------------------------------------------
+// Writing.
+
+/// Builds one GLB model; meshes share one buffer, one buffer view per accessor.
+class GlbBuilder {
+public:
+    GlbBuilder() {
+        model_.asset.version = "2.0";
+        model_.asset.generator = "aggrelod";
+    }
+
+    /// Adds a mesh with one triangle primitive; returns its index, or -1 when there is
+    /// nothing to draw. Positions are converted to float32. The primitive always has NORMAL
+    /// (per-vertex, angle-weighted, split at creases of more than kCreaseAngleDegrees and at
+    /// colour changes: buildRenderMesh, as in scene.aglod) and COLOR_0 (float VEC4, linear:
+    /// `faceColors`, 4 per triangle, or white without them). Throws std::runtime_error for an
+    /// index out of range.
+    /// With `renderAttributes` false (input scenes written by the samples) the vertices stay
+    /// as given, apart from the colour split, with COLOR_0 only when coloured and no NORMAL.
+    int addMesh(const std::string& name, const std::vector<double>& positionsIn,
+                const std::vector<uint32_t>& indicesIn, int material,
+                const std::vector<float>* faceColors = nullptr, bool renderAttributes = true) {
+        if (positionsIn.empty() || indicesIn.empty()) return -1;
+        const bool coloured = faceColors && faceColors->size() == 4 * (indicesIn.size() / 3) &&
+                              indicesIn.size() % 3 == 0;
+        // A vertex shared by faces of different colours (exact float values) is split first, one
+        // copy per colour, so that every output vertex carries the exact colour of its faces.
+        std::vector<float> positions;
+        std::vector<uint32_t> indices;
+        if (coloured) {
+            // New vertex per (vertex, colour) pair, numbered in order of first use.
+            std::map<std::pair<uint32_t, std::array<float, 4>>, uint32_t> copies;
+            indices.reserve(indicesIn.size());
+            for (size_t i = 0; i < indicesIn.size(); ++i) {
+                if (indicesIn[i] >= positionsIn.size() / 3) throw std::runtime_error(name + ": index out of range");
+                const float* c = &(*faceColors)[4 * (i / 3)];
+                const std::array<float, 4> colour = {c[0], c[1], c[2], c[3]};
+                const auto key = std::make_pair(indicesIn[i], colour);
+                auto it = copies.find(key);
+                if (it == copies.end()) {
+                    it = copies.emplace(key, uint32_t(positions.size() / 3)).first;
+                    for (int k = 0; k < 3; ++k) positions.push_back(float(positionsIn[3 * size_t(indicesIn[i]) + k]));
+                }
+                indices.push_back(it->second);
+            }
+        } else {
+            positions.reserve(positionsIn.size());
+            for (double x : positionsIn) positions.push_back(float(x));
+            indices = indicesIn;
+        }
+        RenderMesh render;
+        if (renderAttributes) {
+            if (!buildRenderMesh(positions, indices, coloured ? *faceColors : std::vector<float>(), render))
+                throw std::runtime_error(name + ": a triangle index is out of range");
+        } else {
+            render.positions = std::move(positions);
+            render.indices = std::move(indices);
+        }
+        const size_t vertexCount = render.positions.size() / 3;
+        std::vector<float> colours(4 * vertexCount, 1.0f);
+        if (coloured)
+            for (size_t c = 0; c < render.indices.size(); ++c)
+                std::copy_n(&(*faceColors)[4 * (c / 3)], 4, &colours[4 * size_t(render.indices[c])]);
+
+        // min/max (required for POSITION) over the finite values of each component.
+        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+        bool any[3] = {false, false, false};
+        for (size_t v = 0; v < vertexCount; ++v) {
+            for (size_t c = 0; c < 3; ++c) {
+                const float f = render.positions[3 * v + c];
+                if (!std::isfinite(f)) continue;
+                const double x = double(f);
+                if (!any[c] || x < lo[c]) lo[c] = x;
+                if (!any[c] || x > hi[c]) hi[c] = x;
+                any[c] = true;
+            }
+        }
+
+        tinygltf::Primitive prim;
+        {
+            tinygltf::Accessor pos;
+            pos.bufferView = addView(render.positions.data(), render.positions.size() * sizeof(float),
+                                     TINYGLTF_TARGET_ARRAY_BUFFER);
+            pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+            pos.type = TINYGLTF_TYPE_VEC3;
+            pos.count = vertexCount;
+            pos.minValues.assign(lo, lo + 3);
+            pos.maxValues.assign(hi, hi + 3);
+            model_.accessors.push_back(std::move(pos));
+            prim.attributes["POSITION"] = int(model_.accessors.size()) - 1;
+        }
+        if (renderAttributes) {
+            tinygltf::Accessor normal;
+            normal.bufferView = addView(render.normals.data(), render.normals.size() * sizeof(float),
+                                        TINYGLTF_TARGET_ARRAY_BUFFER);
+            normal.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+            normal.type = TINYGLTF_TYPE_VEC3;
+            normal.count = vertexCount;
+            model_.accessors.push_back(std::move(normal));
+            prim.attributes["NORMAL"] = int(model_.accessors.size()) - 1;
+        }
+        if (renderAttributes || coloured) {
+            tinygltf::Accessor col;
+            col.bufferView = addView(colours.data(), colours.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+            col.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+            col.type = TINYGLTF_TYPE_VEC4;
+            col.count = vertexCount;
+            model_.accessors.push_back(std::move(col));
+            prim.attributes["COLOR_0"] = int(model_.accessors.size()) - 1;
+        }
+        {
+            tinygltf::Accessor idx;
+            idx.bufferView = addView(render.indices.data(), render.indices.size() * sizeof(uint32_t),
+                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+            idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+            idx.type = TINYGLTF_TYPE_SCALAR;
+            idx.count = render.indices.size();
+            model_.accessors.push_back(std::move(idx));
+            prim.indices = int(model_.accessors.size()) - 1;
+        }
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        prim.material = material;
+        tinygltf::Mesh mesh;
+        mesh.name = name;
+        mesh.primitives.push_back(std::move(prim));
+        model_.meshes.push_back(std::move(mesh));
+        return int(model_.meshes.size()) - 1;
+    }
+
+    /// Adds a mesh of float positions without normals or colours (collision geometry): POSITION
+    /// and indices only, vertices as given. Returns its index, -1 when empty.
+    int addPlainMesh(const std::string& name, const std::vector<float>& positions, const std::vector<uint32_t>& indices) {
+        if (positions.empty() || indices.empty()) return -1;
+        const size_t vertexCount = positions.size() / 3;
+        for (uint32_t i : indices)
+            if (i >= vertexCount) throw std::runtime_error(name + ": index out of range");
+        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+        for (size_t v = 0; v < vertexCount; ++v)
+            for (size_t c = 0; c < 3; ++c) {
+                const double x = double(positions[3 * v + c]);
+                if (v == 0 || x < lo[c]) lo[c] = x;
+                if (v == 0 || x > hi[c]) hi[c] = x;
+            }
+        tinygltf::Primitive prim;
+        tinygltf::Accessor pos;
+        pos.bufferView = addView(positions.data(), positions.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+        pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+        pos.type = TINYGLTF_TYPE_VEC3;
+        pos.count = vertexCount;
+        pos.minValues.assign(lo, lo + 3);
+        pos.maxValues.assign(hi, hi + 3);
+        model_.accessors.push_back(std::move(pos));
+        prim.attributes["POSITION"] = int(model_.accessors.size()) - 1;
+        tinygltf::Accessor idx;
+        idx.bufferView = addView(indices.data(), indices.size() * sizeof(uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+        idx.type = TINYGLTF_TYPE_SCALAR;
+        idx.count = indices.size();
+        model_.accessors.push_back(std::move(idx));
+        prim.indices = int(model_.accessors.size()) - 1;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        tinygltf::Mesh mesh;
+        mesh.name = name;
+        mesh.primitives.push_back(std::move(prim));
+        model_.meshes.push_back(std::move(mesh));
+        return int(model_.meshes.size()) - 1;
+    }
+
+    int addNode(tinygltf::Node node) {
+        model_.nodes.push_back(std::move(node));
+        return int(model_.nodes.size()) - 1;
+    }
+
+    tinygltf::Model& model() { return model_; }
+
+    bool write(const std::string& path, const std::vector<int>& sceneRoots, std::string& error) {
+        return writeScenes(path, {{std::string(), sceneRoots}}, error);
+    }
+
+    /// Writes the model with these scenes (name, root nodes); the first is the default scene.
+    bool writeScenes(const std::string& path, const std::vector<std::pair<std::string, std::vector<int>>>& scenes,
+                     std::string& error) {
+        for (const auto& [name, roots] : scenes) {
+            tinygltf::Scene scene;
+            scene.name = name;
+            scene.nodes = roots;
+            model_.scenes.push_back(std::move(scene));
+        }
+        model_.defaultScene = 0;
+        if (!bin_.empty()) {
+            tinygltf::Buffer buffer;
+            buffer.data = std::move(bin_);
+            model_.buffers.push_back(std::move(buffer));
+        }
+        std::ofstream out(path, std::ios::binary | std::ios::trunc);
+        if (!out) {
+            error = path + ": cannot create: " + std::strerror(errno);
+            return false;
+        }
+        tinygltf::TinyGLTF writer;
+        bool ok = false;
+        try {
+            ok = writer.WriteGltfSceneToStream(&model_, out, false, true);
+        } catch (const std::exception& e) {
+            error = path + ": cannot write glTF: " + e.what();
+            return false;
+        }
+        out.close();
+        if (!ok || !out) {
+            error = path + ": write error (disk full?)";
+            return false;
+        }
+        return true;
+    }
+
+private:
+    int addView(const void* data, size_t bytes, int target) {
+        while (bin_.size() % 4) bin_.push_back(0);
+        tinygltf::BufferView view;
+        view.buffer = 0;
+        view.byteOffset = bin_.size();
+        view.byteLength = bytes;
+        view.target = target;
+        const auto* b = static_cast<const unsigned char*>(data);
+        bin_.insert(bin_.end(), b, b + bytes);
+        model_.bufferViews.push_back(std::move(view));
+        return int(model_.bufferViews.size()) - 1;
+    }
+
+    tinygltf::Model model_;
+    std::vector<unsigned char> bin_;
+};
+
+tinygltf::Value intValue(uint64_t v) {
+    if (v <= uint64_t(std::numeric_limits<int>::max())) return tinygltf::Value(int(v));
+    return tinygltf::Value(double(v));
+}
+
+/// Distinct, deterministic colour per level: from warm (fine levels) to cool (coarse).
+std::vector<double> levelColour(size_t level, size_t levelCount) {
+    const double t = levelCount > 1 ? double(level) / double(levelCount - 1) : 0.0;
+    const double hue = (1.0 - t) * 30.0 + t * 220.0;  // degrees
+    const double s = 0.55, v = 0.9;
+    const double c = v * s, h = hue / 60.0;
+    const double x = c * (1 - std::fabs(std::fmod(h, 2.0) - 1));
+    double r = 0, g = 0, b = 0;
+    if (h < 1) { r = c; g = x; }
+    else if (h < 2) { r = x; g = c; }
+    else if (h < 3) { g = c; b = x; }
+    else if (h < 4) { g = x; b = c; }
+    else if (h < 5) { r = x; b = c; }
+    else { r = c; b = x; }
+    const double m = v - c;
+    return {r + m, g + m, b + m, 1.0};
+}
+
+// MSFT_lod switching hints (MSFT_screencoverage): the fraction of the viewport height covered
+// by a node's bounding sphere when its screen-space error reaches kCoverageTau pixels, at
+// kCoverageViewport pixels and a vertical field of view of kCoverageFovY (the defaults of
+// the runtime's examples). Engines scale these with their own LOD bias.
+constexpr double kCoverageTau = 1.0;          // pixels
+constexpr double kCoverageViewport = 1080.0;  // pixels
+constexpr double kCoverageFovY = 60.0;        // degrees
+
+/// Screen coverage (0..1) of a sphere of `radius` seen from the distance d at which a stand-in
+/// of geometric error `error` projects to kCoverageTau: d - radius = error * H / (2 tau tan(fov/2))
+/// (the runtime's rule, distance to the sphere), coverage = radius / (d tan(fov/2)). 1 for an
+/// error of 0 (the stand-in is as good as the finer level).
+double screenCoverage(double radius, double error) {
+    if (!(error > 0) || !(radius > 0)) return 1.0;
+    const double t = std::tan(kCoverageFovY * 3.14159265358979323846 / 360.0);
+    const double d = error * kCoverageViewport / (2.0 * kCoverageTau * t) + radius;
+    return std::clamp(radius / (d * t), 0.0, 1.0);
+}
+
+/// Radius of a sphere containing every root's bounding sphere (centred on their box).
+double enclosingRadius(const HierarchyNodes& nodes) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t r : nodes.roots)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::min(lo[k], nodes.nodes[r].sphereCenter[k] - nodes.nodes[r].sphereRadius);
+            hi[k] = std::max(hi[k], nodes.nodes[r].sphereCenter[k] + nodes.nodes[r].sphereRadius);
+        }
+    double radius = 0;
+    for (uint32_t r : nodes.roots) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double c = 0.5 * (lo[k] + hi[k]) - nodes.nodes[r].sphereCenter[k];
+            d2 += c * c;
+        }
+        radius = std::max(radius, std::sqrt(d2) + nodes.nodes[r].sphereRadius);
+    }
+    return std::isfinite(radius) ? radius : 0.0;
+}
+
+/// Puts MSFT_lod {ids} on `node` (the finest level) and, when `withCoverage`, extras
+/// MSFT_screencoverage: one value per level (ids.size() + 1), the coverage below which that
+/// level gives way to the next, from screenCoverage(radius, error of the next); the last is 0
+/// (never culled). `coarserErrors[k]`: stored error of stand-in ids[k]. Non-increasing.
+void setMsftLod(tinygltf::Model& model, tinygltf::Node& node, const std::vector<int>& ids, double radius,
+                const std::vector<double>& coarserErrors, bool withCoverage) {
+    if (ids.empty()) return;
+    tinygltf::Value::Array idValues;
+    for (int id : ids) idValues.push_back(tinygltf::Value(id));
+    tinygltf::Value::Object lod;
+    lod["ids"] = tinygltf::Value(std::move(idValues));
+    node.extensions["MSFT_lod"] = tinygltf::Value(std::move(lod));
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), "MSFT_lod") == model.extensionsUsed.end())
+        model.extensionsUsed.push_back("MSFT_lod");
+    if (!withCoverage || coarserErrors.size() != ids.size()) return;
+    tinygltf::Value::Array coverage;
+    double previous = 1.0;
+    for (double e : coarserErrors) {
+        previous = std::min(previous, screenCoverage(radius, e));
+        coverage.push_back(tinygltf::Value(previous));
+    }
+    coverage.push_back(tinygltf::Value(0.0));
+    tinygltf::Value::Object extras = node.extras.IsObject() ? node.extras.Get<tinygltf::Value::Object>() : tinygltf::Value::Object{};
+    extras["MSFT_screencoverage"] = tinygltf::Value(std::move(coverage));
+    node.extras = tinygltf::Value(std::move(extras));
+}
+
+}  // namespace
+
+bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string& path,
+                     std::string& error) {
+    try {
+        GlbBuilder glb;
+        std::vector<int> roots;
+        std::map<std::vector<double>, int> materialOfColour;
+        for (const InputObject& o : objects) {
+            if (o.positions.size() % 3 != 0 || o.indices.size() % 3 != 0) {
+                error = path + ": object '" + o.name +
+                        "': positions or indices size is not a multiple of 3";
+                return false;
+            }
+            tinygltf::Node node;
+            node.name = o.name;
+            // Colours: one material when the object has one colour, else COLOR_0.
+            const bool coloured = !o.triangleColors.empty() && o.triangleColors.size() == 4 * (o.indices.size() / 3);
+            bool uniform = coloured;
+            for (size_t i = 4; uniform && i < o.triangleColors.size(); ++i)
+                uniform = o.triangleColors[i] == o.triangleColors[i % 4];
+            int material = -1;
+            if (uniform) {
+                const std::vector<double> colour(o.triangleColors.begin(), o.triangleColors.begin() + 4);
+                auto it = materialOfColour.find(colour);
+                if (it == materialOfColour.end()) {
+                    tinygltf::Material m;
+                    m.name = "colour" + std::to_string(materialOfColour.size());
+                    m.pbrMetallicRoughness.baseColorFactor = colour;
+                    m.pbrMetallicRoughness.metallicFactor = 0.0;
+                    m.pbrMetallicRoughness.roughnessFactor = 0.8;
+                    glb.model().materials.push_back(std::move(m));
+                    it = materialOfColour.emplace(colour, int(glb.model().materials.size()) - 1).first;
+                }
+                material = it->second;
+            }
+            node.mesh = glb.addMesh(o.name, o.positions, o.indices, material,
+                                    coloured && !uniform ? &o.triangleColors : nullptr, false);
+            tinygltf::Value::Object extras;
+            extras["id"] = intValue(o.id);
+            node.extras = tinygltf::Value(std::move(extras));
+            roots.push_back(glb.addNode(std::move(node)));
+        }
+        return glb.write(path, roots, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                    const std::string& path, std::string& error, const HierarchyNodes* nodes) {
+    if (nodes && (nodes->nodeOfAggregate.size() != hierarchy.levels.size() || nodes->objectCount != objects.size())) {
+        error = path + ": the hierarchy nodes do not belong to this hierarchy";
+        return false;
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        std::vector<int> roots;
+        const size_t levelCount = hierarchy.levels.size();
+        bool anyColours = false;
+        for (const Level& level : hierarchy.levels)
+            for (const Aggregate& agg : level.aggregates) anyColours = anyColours || !agg.faceColors.empty();
+        for (size_t k = 0; k < levelCount; ++k) {
+            const Level& level = hierarchy.levels[k];
+            const std::string levelName = "level" + std::to_string(k);
+
+            tinygltf::Material material;
+            material.name = levelName;
+            // With colours the faces carry them (COLOR_0 times a white base colour); without,
+            // each level gets a distinct tint.
+            material.pbrMetallicRoughness.baseColorFactor =
+                anyColours ? std::vector<double>{1, 1, 1, 1} : levelColour(k, levelCount);
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.8;
+            model.materials.push_back(std::move(material));
+            const int materialIndex = int(model.materials.size()) - 1;
+
+            tinygltf::Node levelNode;
+            levelNode.name = "levels_LOD" + std::to_string(k);
+            tinygltf::Value::Object levelExtras;
+            levelExtras["level"] = intValue(k);
+            levelExtras["lod"] = intValue(k);
+            levelExtras["delta"] = tinygltf::Value(level.delta);
+            levelNode.extras = tinygltf::Value(std::move(levelExtras));
+            const int levelIndex = glb.addNode(std::move(levelNode));
+            roots.push_back(levelIndex);
+
+            std::vector<int> children;
+            for (size_t g = 0; g < level.aggregates.size(); ++g) {
+                const Aggregate& agg = level.aggregates[g];
+                const std::string name = levelName + "_group" + std::to_string(g);
+                if (agg.positions.size() % 3 != 0 || agg.indices.size() % 3 != 0) {
+                    error = path + ": " + name + ": positions or indices size is not a multiple of 3";
+                    return false;
+                }
+                tinygltf::Value::Array sources, sourceIds;
+                for (uint32_t s : agg.sourceObjects) {
+                    if (s >= objects.size()) {
+                        error = path + ": " + name + " refers to object " + std::to_string(s) +
+                                " but there are " + std::to_string(objects.size()) + " objects";
+                        return false;
+                    }
+                    sources.push_back(tinygltf::Value(objects[s].name));
+                    sourceIds.push_back(intValue(objects[s].id));
+                }
+                tinygltf::Node node;
+                node.name = name;
+                node.mesh = glb.addMesh(name, agg.positions, agg.indices, materialIndex, &agg.faceColors);
+                tinygltf::Value::Object extras;
+                extras["level"] = intValue(k);
+                extras["group"] = intValue(g);
+                extras["delta"] = tinygltf::Value(level.delta);
+                extras["sources"] = tinygltf::Value(std::move(sources));
+                extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+                extras["components"] = tinygltf::Value(agg.componentCount);
+                extras["volume"] = tinygltf::Value(agg.measures.volume);
+                extras["volume_original"] = tinygltf::Value(agg.volumeOriginal);
+                // Where the faces on the objects come from: their own faces, or the watertight
+                // solid that stood in for objects that were not closed solids.
+                extras["surface"] = tinygltf::Value(std::string(agg.surface == Aggregate::Surface::Original     ? "original"
+                                                                : agg.surface == Aggregate::Surface::Solidified ? "solidified"
+                                                                                                                : "mixed"));
+                if (nodes) {
+                    if (g >= nodes->nodeOfAggregate[k].size()) {
+                        error = path + ": " + name + " has no hierarchy node";
+                        return false;
+                    }
+                    const uint32_t nodeIndex = nodes->nodeOfAggregate[k][g];
+                    const HierarchyNode& hn = nodes->nodes[nodeIndex];
+                    tinygltf::Value::Array children;
+                    for (uint32_t c : hn.children) children.push_back(intValue(c));
+                    extras["node"] = intValue(nodeIndex);
+                    extras["parent"] = hn.parent == kNoNode ? tinygltf::Value(-1) : intValue(hn.parent);
+                    extras["children"] = tinygltf::Value(std::move(children));
+                    extras["first_level"] = tinygltf::Value(hn.firstLevel);
+                    extras["last_level"] = tinygltf::Value(hn.lastLevel);
+                    extras["geometric_error"] = tinygltf::Value(hn.geometricError);
+                    tinygltf::Value::Object proxyError;
+                    proxyError["proxy_to_originals"] = tinygltf::Value(hn.error.proxyToOriginals);
+                    proxyError["originals_to_proxy"] = tinygltf::Value(hn.error.originalsToProxy);
+                    proxyError["proxy_to_originals_found"] = tinygltf::Value(hn.error.proxyToOriginalsLower);
+                    proxyError["originals_to_proxy_found"] = tinygltf::Value(hn.error.originalsToProxyLower);
+                    proxyError["tolerance"] = tinygltf::Value(hn.error.tolerance);
+                    proxyError["bound"] = tinygltf::Value(hn.error.bound());
+                    extras["proxy_error"] = tinygltf::Value(std::move(proxyError));
+                    extras["proxy_triangles"] = intValue(hn.indices.size() / 3);
+                }
+                node.extras = tinygltf::Value(std::move(extras));
+                children.push_back(glb.addNode(std::move(node)));
+            }
+            model.nodes[size_t(levelIndex)].children = std::move(children);
+        }
+        // Support surfaces pass through unchanged, flagged, under their own root node.
+        if (!hierarchy.supportObjects.empty()) {
+            tinygltf::Material material;
+            material.name = "support";
+            material.pbrMetallicRoughness.baseColorFactor = {0.5, 0.5, 0.5, 1};
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.9;
+            model.materials.push_back(std::move(material));
+            const int materialIndex = int(model.materials.size()) - 1;
+            tinygltf::Node supportNode;
+            supportNode.name = "support";
+            tinygltf::Value::Object supportExtras;
+            supportExtras["support"] = tinygltf::Value(true);
+            supportNode.extras = tinygltf::Value(std::move(supportExtras));
+            const int supportIndex = glb.addNode(std::move(supportNode));
+            roots.push_back(supportIndex);
+            std::vector<int> children;
+            for (uint32_t s : hierarchy.supportObjects) {
+                if (s >= objects.size()) {
+                    error = path + ": support object " + std::to_string(s) + " does not exist";
+                    return false;
+                }
+                const InputObject& o = objects[s];
+                const std::string name = "support_" + o.name;
+                tinygltf::Node node;
+                node.name = name;
+                node.mesh = glb.addMesh(name, o.positions, o.indices, materialIndex, &o.triangleColors);
+                tinygltf::Value::Object extras;
+                extras["support"] = tinygltf::Value(true);
+                extras["sources"] = tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(o.name)});
+                extras["source_ids"] = tinygltf::Value(tinygltf::Value::Array{intValue(o.id)});
+                if (nodes && s < nodes->objectCount) extras["node"] = intValue(s);
+                node.extras = tinygltf::Value(std::move(extras));
+                children.push_back(glb.addNode(std::move(node)));
+            }
+            model.nodes[size_t(supportIndex)].children = std::move(children);
+        }
+        // One scene per level (the first, finest, is the default scene), each with the support
+        // surfaces; the finest level's root lists the coarser ones as MSFT_lod stand-ins.
+        const int supportRoot = hierarchy.supportObjects.empty() ? -1 : roots.back();
+        std::vector<std::pair<std::string, std::vector<int>>> scenes;
+        for (size_t k = 0; k < levelCount; ++k) {
+            std::vector<int> sceneRoots{roots[k]};
+            if (supportRoot >= 0) sceneRoots.push_back(supportRoot);
+            scenes.emplace_back("level" + std::to_string(k), std::move(sceneRoots));
+        }
+        if (levelCount == 0) scenes.emplace_back("levels", roots);
+        if (levelCount > 1) {
+            std::vector<int> ids(roots.begin() + 1, roots.begin() + std::ptrdiff_t(levelCount));
+            std::vector<double> errors;  // per coarser level: the largest stored error of its nodes
+            double radius = 0;
+            if (nodes) {
+                radius = enclosingRadius(*nodes);
+                for (size_t k = 1; k < levelCount; ++k) {
+                    double e = 0;
+                    for (uint32_t n : nodes->nodeOfAggregate[k]) e = std::max(e, nodes->nodes[n].geometricError);
+                    errors.push_back(e);
+                }
+            }
+            setMsftLod(model, model.nodes[size_t(roots[0])], ids, radius, errors, nodes != nullptr);
+        }
+        return glb.writeScenes(path, scenes, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                     const std::string& path, std::string& error) {
+    if (nodes.objectCount != objects.size() || nodes.nodes.size() < objects.size()) {
+        error = path + ": the hierarchy nodes do not belong to these objects";
+        return false;
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        int levelCount = 0;
+        bool anyColours = false;
+        for (const HierarchyNode& n : nodes.nodes) {
+            levelCount = std::max(levelCount, n.lastLevel + 1);
+            anyColours = anyColours || !n.faceColors.empty();
+        }
+        for (int k = 0; k < levelCount; ++k) {
+            tinygltf::Material material;
+            material.name = "level" + std::to_string(k);
+            material.pbrMetallicRoughness.baseColorFactor =
+                anyColours ? std::vector<double>{1, 1, 1, 1} : levelColour(size_t(k), size_t(levelCount));
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.8;
+            model.materials.push_back(std::move(material));
+        }
+        const int originalMaterial = int(model.materials.size());
+        {
+            tinygltf::Material material;
+            material.name = "original";
+            material.pbrMetallicRoughness.baseColorFactor =
+                anyColours ? std::vector<double>{1, 1, 1, 1} : std::vector<double>{0.7, 0.7, 0.7, 1};
+            material.pbrMetallicRoughness.metallicFactor = 0.0;
+            material.pbrMetallicRoughness.roughnessFactor = 0.8;
+            model.materials.push_back(std::move(material));
+        }
+        for (size_t i = 0; i < nodes.nodes.size(); ++i)
+            for (uint32_t c : nodes.nodes[i].children)
+                if (c >= nodes.nodes.size() || nodes.nodes[c].parent != i) {
+                    error = path + ": node " + std::to_string(i) + " has a bad child " + std::to_string(c);
+                    return false;
+                }
+
+        // The extras of hierarchy node i, with its place `lod` in its LOD group.
+        auto extrasOf = [&](size_t i, size_t lod) {
+            const HierarchyNode& n = nodes.nodes[i];
+            tinygltf::Value::Object extras;
+            tinygltf::Value::Array sources, sourceIds;
+            for (uint32_t o : n.sources) {
+                if (o >= objects.size())
+                    throw std::runtime_error("node " + std::to_string(i) + " refers to object " + std::to_string(o));
+                sources.push_back(tinygltf::Value(objects[o].name));
+                sourceIds.push_back(intValue(objects[o].id));
+            }
+            extras["node"] = intValue(i);
+            extras["lod"] = intValue(lod);
+            extras["sources"] = tinygltf::Value(std::move(sources));
+            extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+            extras["geometric_error"] = tinygltf::Value(n.geometricError);
+            tinygltf::Value::Array sphere;
+            for (int k = 0; k < 3; ++k) sphere.push_back(tinygltf::Value(n.sphereCenter[k]));
+            sphere.push_back(tinygltf::Value(n.sphereRadius));
+            extras["bounding_sphere"] = tinygltf::Value(std::move(sphere));
+            if (n.leaf) {
+                extras["leaf"] = tinygltf::Value(true);
+            } else if (n.objectLod >= 1) {
+                extras["object_lod"] = intValue(size_t(n.objectLod));
+            } else if (n.coarserStep >= 1) {
+                extras["coarser_step"] = intValue(size_t(n.coarserStep));
+                extras["aggregate_level"] = tinygltf::Value(std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0));
+                extras["delta"] = tinygltf::Value(n.delta);
+            } else {
+                extras["level"] = tinygltf::Value(n.firstLevel);
+                extras["last_level"] = tinygltf::Value(n.lastLevel);
+                extras["delta"] = tinygltf::Value(n.delta);
+            }
+            if (!n.leaf) {
+                extras["proxy_error_bound"] = tinygltf::Value(n.error.bound());
+                extras["proxy_error_budget"] = tinygltf::Value(n.budget);
+                extras["exact_triangles"] = intValue(n.exactTriangleCount);
+            }
+            return extras;
+        };
+        // A glTF node with hierarchy node i's mesh (proxy; a leaf: the original object).
+        auto meshNode = [&](size_t i, const std::string& name, size_t lod) {
+            const HierarchyNode& n = nodes.nodes[i];
+            tinygltf::Node node;
+            node.name = name;
+            const int material = n.leaf || n.objectLod >= 1
+                                     ? (n.leaf ? originalMaterial : 0)
+                                     : std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0);
+            const std::vector<double> positions(n.positions.begin(), n.positions.end());
+            node.mesh = glb.addMesh(name, positions, n.indices, material, &n.faceColors);
+            node.extras = tinygltf::Value(extrasOf(i, lod));
+            return glb.addNode(std::move(node));
+        };
+
+        // LOD groups: one per root and per child of a node with several children (its "top").
+        // From the top, single children lead down to the group's bottom: a leaf, or a node with
+        // several children. Finest first, the group's levels are LOD0 = the original (leaf
+        // bottom) or a node holding the child groups' LOD0 nodes (otherwise), then the stand-ins:
+        // the bottom's own proxy (when it is not a leaf) and every node up the chain to the top.
+        // LOD0 nodes form the default scene; stand-ins are roots of the second scene and listed
+        // by MSFT_lod on their LOD0 node.
+        std::vector<int> finestRoots, standInRoots;
+        struct Pending {
+            uint32_t top;
+            int parentLod0;  ///< glTF node receiving this group's LOD0 as a child, -1 for a root
+        };
+        std::vector<Pending> stack;
+        for (size_t r = nodes.roots.size(); r-- > 0;) stack.push_back({nodes.roots[r], -1});
+        size_t visitedTops = 0;
+        while (!stack.empty()) {
+            const Pending p = stack.back();
+            stack.pop_back();
+            if (++visitedTops > nodes.nodes.size()) throw std::runtime_error("the node tree has a cycle");
+            std::vector<uint32_t> chain{p.top};  // top first
+            while (nodes.nodes[chain.back()].children.size() == 1) {
+                chain.push_back(nodes.nodes[chain.back()].children[0]);
+                if (chain.size() > nodes.nodes.size()) throw std::runtime_error("the node tree has a cycle");
+            }
+            const uint32_t bottom = chain.back();
+            const HierarchyNode& b = nodes.nodes[bottom];
+            const std::string stem = b.leaf ? objects[bottom].name : "node" + std::to_string(bottom);
+            int lod0 = -1;
+            if (b.leaf) {
+                lod0 = meshNode(bottom, stem + "_LOD0", 0);
+            } else {
+                tinygltf::Node group;
+                group.name = stem + "_LOD0";
+                tinygltf::Value::Object extras;
+                extras["lod"] = tinygltf::Value(0);
+                extras["children_of"] = intValue(bottom);
+                group.extras = tinygltf::Value(std::move(extras));
+                lod0 = glb.addNode(std::move(group));
+                for (size_t c = b.children.size(); c-- > 0;) stack.push_back({b.children[c], lod0});
+            }
+            if (p.parentLod0 < 0) finestRoots.push_back(lod0);
+            else model.nodes[size_t(p.parentLod0)].children.push_back(lod0);
+            std::vector<int> ids;
+            std::vector<double> errors;
+            size_t lod = 1;
+            for (size_t c = chain.size() - (b.leaf ? 1 : 0); c-- > 0;) {
+                const uint32_t i = chain[c];
+                const int standIn = meshNode(i, stem + "_LOD" + std::to_string(lod), lod);
+                ++lod;
+                ids.push_back(standIn);
+                errors.push_back(nodes.nodes[i].geometricError);
+                standInRoots.push_back(standIn);
+            }
+            setMsftLod(model, model.nodes[size_t(lod0)], ids, nodes.nodes[p.top].sphereRadius, errors, true);
+        }
+        // Children were pushed in reverse onto the stack, so they arrive in order; the LOD0
+        // nodes of a group's children are appended in that order.
+        std::vector<std::pair<std::string, std::vector<int>>> scenes{{"finest", finestRoots}};
+        if (!standInRoots.empty()) scenes.emplace_back("coarser_stand_ins", standInRoots);
+        return glb.writeScenes(path, scenes, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+bool writeCollisionGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                       const std::vector<NodeCollisionShapes>& shapes, const std::vector<CollisionCut>& cuts,
+                       const std::string& path, std::string& error) {
+    if (nodes.objectCount != objects.size() || nodes.nodes.size() < objects.size() || shapes.size() != nodes.nodes.size()) {
+        error = path + ": the collision shapes do not belong to these hierarchy nodes";
+        return false;
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        tinygltf::Value::Array omiShapes;
+        // Static colliders: no motion. Each collider node carries its own mesh and names it as
+        // KHR geometry (geometry.node = itself), and the same mesh as an OMI_physics_shape.
+        auto colliderNode = [&](const std::string& name, const std::vector<float>& positions,
+                                const std::vector<uint32_t>& indices, bool convex, tinygltf::Value::Object extras) {
+            tinygltf::Node node;
+            node.name = name;
+            node.mesh = glb.addPlainMesh(name, positions, indices);
+            const int index = int(model.nodes.size());
+            tinygltf::Value::Object geometry;
+            geometry["node"] = tinygltf::Value(index);
+            geometry["convexHull"] = tinygltf::Value(convex);
+            tinygltf::Value::Object collider;
+            collider["geometry"] = tinygltf::Value(std::move(geometry));
+            tinygltf::Value::Object khr;
+            khr["collider"] = tinygltf::Value(std::move(collider));
+            node.extensions["KHR_physics_rigid_bodies"] = tinygltf::Value(std::move(khr));
+            tinygltf::Value::Object shapeMesh;
+            shapeMesh["mesh"] = tinygltf::Value(node.mesh);
+            tinygltf::Value::Object shape;
+            const std::string type = convex ? "convex" : "trimesh";
+            shape["type"] = tinygltf::Value(type);
+            shape[type] = tinygltf::Value(std::move(shapeMesh));
+            omiShapes.push_back(tinygltf::Value(std::move(shape)));
+            tinygltf::Value::Object omiCollider;
+            omiCollider["shape"] = tinygltf::Value(int(omiShapes.size()) - 1);
+            tinygltf::Value::Object omi;
+            omi["collider"] = tinygltf::Value(std::move(omiCollider));
+            node.extensions["OMI_physics_body"] = tinygltf::Value(std::move(omi));
+            extras["shape"] = tinygltf::Value(convex ? std::string("convex") : std::string("trimesh"));
+            node.extras = tinygltf::Value(std::move(extras));
+            return glb.addNode(std::move(node));
+        };
+        auto commonExtras = [&](size_t i) {
+            const HierarchyNode& n = nodes.nodes[i];
+            tinygltf::Value::Object extras;
+            extras["node"] = intValue(i);
+            extras["geometric_error"] = tinygltf::Value(n.geometricError);
+            tinygltf::Value::Array sourceIds;
+            for (uint32_t o : n.sources) {
+                if (o >= objects.size())
+                    throw std::runtime_error("node " + std::to_string(i) + " refers to object " + std::to_string(o));
+                sourceIds.push_back(intValue(objects[o].id));
+            }
+            extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+            if (n.leaf) extras["leaf"] = tinygltf::Value(true);
+            return extras;
+        };
+        std::vector<int> trimeshOf(nodes.nodes.size(), -1), convexOf(nodes.nodes.size(), -1);
+        for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+            const HierarchyNode& n = nodes.nodes[i];
+            if (n.indices.empty()) continue;
+            const std::string stem = n.leaf ? objects[i].name : "node" + std::to_string(i);
+            trimeshOf[i] = colliderNode(stem + "_collider", n.positions, n.indices, false, commonExtras(i));
+            const NodeCollisionShapes& c = shapes[i];
+            if (c.convexParts.empty()) continue;
+            tinygltf::Node group;
+            group.name = stem + "_convex";
+            tinygltf::Value::Object extras = commonExtras(i);
+            extras["shape"] = tinygltf::Value(std::string("convex_decomposition"));
+            extras["convex_error"] = tinygltf::Value(c.convexError);
+            extras["allowance"] = tinygltf::Value(c.allowance);
+            extras["parts"] = intValue(c.convexParts.size());
+            group.extras = tinygltf::Value(std::move(extras));
+            const int groupIndex = glb.addNode(std::move(group));
+            std::vector<int> children;
+            for (size_t j = 0; j < c.convexParts.size(); ++j) {
+                tinygltf::Value::Object partExtras = commonExtras(i);
+                partExtras["part"] = intValue(j);
+                partExtras["error_bound"] = tinygltf::Value(c.convexParts[j].errorBound);
+                children.push_back(colliderNode(stem + "_convex" + std::to_string(j), c.convexParts[j].positions,
+                                                c.convexParts[j].indices, true, std::move(partExtras)));
+            }
+            model.nodes[size_t(groupIndex)].children = std::move(children);
+            convexOf[i] = groupIndex;
+        }
+        // Scenes: per cut its trimesh colliders, then the same cut with convex decompositions
+        // where a node has one; last every node's shapes (overlapping: for tools).
+        std::vector<std::pair<std::string, std::vector<int>>> scenes;
+        for (const CollisionCut& cut : cuts) {
+            std::vector<int> trimesh, convex;
+            for (uint32_t i : cut.nodes) {
+                if (i >= nodes.nodes.size() || trimeshOf[i] < 0) continue;
+                trimesh.push_back(trimeshOf[i]);
+                convex.push_back(convexOf[i] >= 0 ? convexOf[i] : trimeshOf[i]);
+            }
+            scenes.emplace_back(cut.name, std::move(trimesh));
+            scenes.emplace_back(cut.name + "_convex", std::move(convex));
+        }
+        std::vector<int> all;
+        for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+            if (trimeshOf[i] >= 0) all.push_back(trimeshOf[i]);
+            if (convexOf[i] >= 0) all.push_back(convexOf[i]);
+        }
+        scenes.emplace_back("all_nodes", std::move(all));
+        tinygltf::Value::Object omiShape;
+        omiShape["shapes"] = tinygltf::Value(std::move(omiShapes));
+        model.extensions["OMI_physics_shape"] = tinygltf::Value(std::move(omiShape));
+        model.extensionsUsed = {"KHR_physics_rigid_bodies", "OMI_physics_body", "OMI_physics_shape"};
+        return glb.writeScenes(path, scenes, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+std::vector<double> levelBaseColour(size_t level, size_t levelCount) { return levelColour(level, levelCount); }
+
+bool writeTileGlb(const TileMesh& tile, const std::string& path, std::string& error) {
+    if (tile.positions.size() % 3 != 0 || tile.indices.size() % 3 != 0) {
+        error = path + ": " + tile.name + ": positions or indices size is not a multiple of 3";
+        return false;
+    }
+    const size_t vertexCount = tile.positions.size() / 3;
+    for (uint32_t i : tile.indices) {
+        if (i >= vertexCount) {
+            error = path + ": " + tile.name + ": index " + std::to_string(i) + " out of range (" +
+                    std::to_string(vertexCount) + " vertices)";
+            return false;
+        }
+    }
+    try {
+        GlbBuilder glb;
+        tinygltf::Model& model = glb.model();
+        tinygltf::Material material;
+        material.name = tile.name;
+        material.pbrMetallicRoughness.baseColorFactor.assign(tile.baseColor, tile.baseColor + 4);
+        material.pbrMetallicRoughness.metallicFactor = 0.0;
+        material.pbrMetallicRoughness.roughnessFactor = 0.8;
+        model.materials.push_back(std::move(material));
+
+        tinygltf::Node node;
+        node.name = tile.name;
+        const std::vector<double> positions(tile.positions.begin(), tile.positions.end());
+        node.mesh = glb.addMesh(tile.name, positions, tile.indices, 0);
+        tinygltf::Value::Object extras;
+        extras["node"] = intValue(tile.node);
+        extras["geometric_error"] = tinygltf::Value(tile.geometricError);
+        tinygltf::Value::Array sourceIds;
+        for (uint64_t id : tile.sourceIds) sourceIds.push_back(intValue(id));
+        extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
+        node.extras = tinygltf::Value(std::move(extras));
+        const int root = glb.addNode(std::move(node));
+        if (model.meshes.empty()) model.materials.clear();  // nothing drawn: no unused material
+        return glb.write(path, std::vector<int>{root}, error);
+    } catch (const std::exception& e) {
+        error = path + ": " + e.what();
+        return false;
+    }
+}
+
+
+}  // namespace aggrelod::io
