@@ -23,7 +23,9 @@ packages=(
   mingw-w64 wine wine64
   libglfw3-dev libgl1-mesa-dri xvfb
   libbullet-dev
+  time
 )
+# time: GNU time, for the peak memory in tests/bench/bench_world.sh.
 # libbullet-dev: a real physics engine for the test of collision.glb (tests/physics); tests only.
 # mingw-w64: the Windows cross build of the runtime (tests/windows); wine, wine64: run its unit
 # tests there.
