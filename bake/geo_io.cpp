@@ -61,14 +61,100 @@ std::string ringName(size_t polygon, size_t polygonCount, size_t ring) {
 // ---------------------------------------------------------------------------------------
 // GeoJSON reading
 
+/// A coordinate: a number, or NaN for null (what NaN and Infinity literals were read as,
+/// see readableJson), which the geometry check then names.
+bool coordinate(const Json& v, double& out) {
+    if (v.is_number()) out = v.get<double>();
+    else if (v.is_null()) out = NAN;
+    else return false;
+    return true;
+}
+
 bool readPosition(const Json& p, std::vector<double>& ring, std::string& problem) {
-    if (!p.is_array() || p.size() < 2 || !p[0].is_number() || !p[1].is_number()) {
+    double x = 0, y = 0;
+    if (!p.is_array() || p.size() < 2 || !coordinate(p[0], x) || !coordinate(p[1], y)) {
         problem = "a position is not an array of at least 2 numbers";
         return false;
     }
-    ring.push_back(p[0].get<double>());
-    ring.push_back(p[1].get<double>());
+    ring.push_back(x);
+    ring.push_back(y);
     return true;
+}
+
+/// Length of the valid UTF-8 sequence at text[i] (1 to 4), or 0 when the bytes there are not one.
+size_t utf8Length(const std::string& text, size_t i) {
+    const auto byte = [&](size_t k) { return k < text.size() ? static_cast<unsigned char>(text[k]) : 0u; };
+    const unsigned c = byte(i);
+    const auto cont = [&](size_t k) { return (byte(k) & 0xC0u) == 0x80u; };
+    if (c < 0x80) return 1;
+    if (c >= 0xC2 && c <= 0xDF) return cont(i + 1) ? 2 : 0;
+    if (c >= 0xE0 && c <= 0xEF) {
+        const unsigned d = byte(i + 1);
+        if ((c == 0xE0 && d < 0xA0) || (c == 0xED && d > 0x9F)) return 0;  // overlong, surrogate
+        return cont(i + 1) && cont(i + 2) ? 3 : 0;
+    }
+    if (c >= 0xF0 && c <= 0xF4) {
+        const unsigned d = byte(i + 1);
+        if ((c == 0xF0 && d < 0x90) || (c == 0xF4 && d > 0x8F)) return 0;
+        return cont(i + 1) && cont(i + 2) && cont(i + 3) ? 4 : 0;
+    }
+    return 0;
+}
+
+/// Text that nlohmann's strict parser reads, from what GeoJSON writers put out:
+/// - JSON has no NaN or infinity, but some writers (Python's json module among them) put the
+///   literals NaN, Infinity and -Infinity where a number is not finite. Outside strings they
+///   become null, so that the file parses and the feature holding them is named and skipped
+///   by the geometry check instead of the whole file being refused;
+/// - inside strings, a byte that does not start valid UTF-8 (a Latin-1 export, say) is taken
+///   as the Latin-1 character it is, instead of refusing the file.
+/// Lines do not change; columns after a replacement shift by its length difference.
+std::string readableJson(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    const auto boundary = [&](size_t i) { return i >= text.size() || !std::isalnum(static_cast<unsigned char>(text[i])); };
+    bool inString = false;
+    for (size_t i = 0; i < text.size();) {
+        const char c = text[i];
+        if (inString) {
+            const size_t n = utf8Length(text, i);
+            if (n == 0) {  // Latin-1 byte 0x80-0xFF as U+0080-U+00FF
+                const unsigned b = static_cast<unsigned char>(c);
+                out += char(0xC0 | (b >> 6));
+                out += char(0x80 | (b & 0x3F));
+                ++i;
+                continue;
+            }
+            if (c == '\\' && i + 1 < text.size()) {
+                out.append(text, i, 2);
+                i += 2;
+                continue;
+            }
+            if (c == '"') inString = false;
+            out.append(text, i, n);
+            i += n;
+            continue;
+        }
+        if (c == '"') {
+            inString = true;
+            out += c;
+            ++i;
+            continue;
+        }
+        const bool start = i == 0 || boundary(i - 1);
+        bool replaced = false;
+        for (const char* word : {"-Infinity", "Infinity", "NaN"}) {
+            const size_t n = std::strlen(word);
+            if (start && text.compare(i, n, word) == 0 && boundary(i + n)) {
+                out += "null";
+                i += n;
+                replaced = true;
+                break;
+            }
+        }
+        if (!replaced) out += text[i++];
+    }
+    return out;
 }
 
 bool readPolygonCoordinates(const Json& rings, Polygon2D& poly, size_t index, size_t count, std::string& problem) {
@@ -152,7 +238,7 @@ bool readGeoJson(const std::string& text, GeoReadResult& out, std::string& error
     Json root;
     JsonLines lines;
     lines.arrayKey = "features";
-    if (!parseJson(text, root, error, 256, &lines)) {
+    if (!parseJson(readableJson(text), root, error, 256, &lines)) {
         error = "malformed JSON: " + error;
         return false;
     }

@@ -62,53 +62,118 @@ private:
     const char** lastRead_;
 };
 
-/// Line numbers of ever later positions in one text, counted incrementally.
+/// Line and column of ever later positions in one text, counted incrementally.
 class LineCounter {
 public:
-    explicit LineCounter(const char* begin) : at_(begin) {}
+    explicit LineCounter(const char* begin) : at_(begin), lineStart_(begin) {}
     int lineOf(const char* p) {
-        for (; at_ < p; ++at_) line_ += *at_ == '\n';
+        for (; at_ < p; ++at_)
+            if (*at_ == '\n') {
+                ++line_;
+                lineStart_ = at_ + 1;
+            }
         return line_;
+    }
+    /// "line L, column C" of p (1-based).
+    std::string where(const char* p) {
+        const int line = lineOf(p);
+        return "line " + std::to_string(line) + ", column " + std::to_string(p - lineStart_ + 1);
     }
 
 private:
     const char* at_;
+    const char* lineStart_;
     int line_ = 1;
+};
+
+/// nlohmann's DOM builder with a depth limit and the lines of JsonLines. A SAX handler, not a
+/// parse callback: with a callback nlohmann rescans a container's earlier elements at every
+/// close, which is quadratic in the number of elements.
+class TrackingSax {
+public:
+    using number_integer_t = Json::number_integer_t;
+    using number_unsigned_t = Json::number_unsigned_t;
+    using number_float_t = Json::number_float_t;
+    using string_t = Json::string_t;
+    using binary_t = Json::binary_t;
+
+    TrackingSax(Json& out, int maxDepth, JsonLines* lines, const char* text, const char*& lastRead)
+        : dom_(out, true), maxDepth_(maxDepth), lines_(lines), counter_(text), lastRead_(lastRead) {}
+
+    bool null() { return scalar() && dom_.null(); }
+    bool boolean(bool v) { return scalar() && dom_.boolean(v); }
+    bool number_integer(number_integer_t v) { return scalar() && dom_.number_integer(v); }
+    bool number_unsigned(number_unsigned_t v) { return scalar() && dom_.number_unsigned(v); }
+    bool number_float(number_float_t v, const string_t& text) { return scalar() && dom_.number_float(v, text); }
+    bool string(string_t& v) { return scalar() && dom_.string(v); }
+    bool binary(binary_t& v) { return scalar() && dom_.binary(v); }
+    bool start_object(std::size_t n) { return open(true) && dom_.start_object(n); }
+    bool key(string_t& k) {
+        if (depth_ == 1) topKey_ = k;
+        return dom_.key(k);
+    }
+    bool end_object() {
+        --depth_;
+        return dom_.end_object();
+    }
+    bool start_array(std::size_t n) { return open(false) && dom_.start_array(n); }
+    bool end_array() {
+        --depth_;
+        return dom_.end_array();
+    }
+    bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) {
+        return dom_.parse_error(position, token, e);  // throws (exceptions allowed)
+    }
+
+private:
+    bool inTrackedArray() const { return lines_ && depth_ == 2 && !topKey_.empty() && topKey_ == lines_->arrayKey; }
+    bool scalar() {
+        if (inTrackedArray()) lines_->elementLines.push_back(0);
+        return true;
+    }
+    bool open(bool object) {
+        if (depth_ >= maxDepth_)
+            throw TooDeep(counter_.where(lastRead_) + ": nesting deeper than " + std::to_string(maxDepth_) + " levels");
+        if (lines_ && depth_ == 0) lines_->rootLine = counter_.lineOf(lastRead_);
+        if (inTrackedArray()) lines_->elementLines.push_back(object ? counter_.lineOf(lastRead_) : 0);
+        ++depth_;
+        return true;
+    }
+
+    nlohmann::detail::json_sax_dom_parser<Json> dom_;
+    int maxDepth_;
+    JsonLines* lines_;
+    LineCounter counter_;
+    const char*& lastRead_;
+    int depth_ = 0;
+    std::string topKey_;  ///< the top-level object's member being parsed
 };
 
 }  // namespace
 
 bool parseJson(const std::string& text, Json& out, std::string& error, int maxDepth, JsonLines* lines) {
     const char* lastRead = text.data();
-    LineCounter counter(text.data());
-    std::string topKey;  // the top-level object's member being parsed
     if (lines) {
         lines->rootLine = 0;
         lines->elementLines.clear();
     }
-    const Json::parser_callback_t callback = [&](int depth, Json::parse_event_t event, Json& parsed) {
-        const bool opens = event == Json::parse_event_t::object_start || event == Json::parse_event_t::array_start;
-        if (opens && depth >= maxDepth)
-            throw TooDeep("nesting deeper than " + std::to_string(maxDepth) + " levels");
-        if (!lines) return true;
-        if (event == Json::parse_event_t::key && depth == 1) topKey = parsed.is_string() ? parsed.get<std::string>() : "";
-        if (depth == 0 && opens && lines->rootLine == 0) lines->rootLine = counter.lineOf(lastRead);
-        if (depth == 2 && !topKey.empty() && topKey == lines->arrayKey) {
-            if (event == Json::parse_event_t::object_start) lines->elementLines.push_back(counter.lineOf(lastRead));
-            else if (event == Json::parse_event_t::array_start) lines->elementLines.push_back(0);
-            else if (event == Json::parse_event_t::value) lines->elementLines.push_back(0);  // a scalar element
-        }
-        return true;
-    };
+    out = Json();
     try {
-        out = Json::parse(TrackingIterator(text.data(), &lastRead), TrackingIterator(text.data() + text.size(), &lastRead),
-                          callback);
+        TrackingSax sax(out, maxDepth, lines, text.data(), lastRead);
+        Json::sax_parse(TrackingIterator(text.data(), &lastRead), TrackingIterator(text.data() + text.size(), &lastRead),
+                        &sax);
         return true;
-    } catch (const Json::parse_error& e) {
+    } catch (const Json::exception& e) {
         // "[json.exception.parse_error.101] parse error at line 3, column 23: syntax error ..."
         std::string what = e.what();
         const size_t at = what.find(" at line ");
-        error = at == std::string::npos ? what : what.substr(at + 4);
+        if (at != std::string::npos) {
+            error = what.substr(at + 4);
+        } else {
+            LineCounter counter(text.data());  // e.g. a number out of range: say where it stopped
+            const size_t tag = what.find("] ");
+            error = counter.where(lastRead) + ": " + (tag == std::string::npos ? what : what.substr(tag + 2));
+        }
     } catch (const std::exception& e) {
         error = e.what();
     }

@@ -302,7 +302,8 @@ WorldSummary generateWorld(const WorldSettings& settings, const std::function<vo
         throw std::invalid_argument("world: the object count must be in 1.." + std::to_string(kMaxWorldObjects));
     WorldSummary summary;
     const uint64_t columns = gridColumns(settings.objectCount);
-    summary.extent = double(columns) * kWorldBlockSize;
+    // Rows of `columns` blocks, filled until the count is reached; the last rows may be short
+    // or, when blocks hold fewer objects than the mean, one more than the columns.
     for (uint64_t block = 0; summary.objects < settings.objectCount; ++block) {
         Block b(settings.seed, block, columns);
         ++summary.blocks;
@@ -314,6 +315,8 @@ WorldSummary generateWorld(const WorldSettings& settings, const std::function<vo
             emit(o);
         }
     }
+    const uint64_t rows = (summary.blocks + columns - 1) / columns;
+    summary.extent = double(std::max(rows, columns)) * kWorldBlockSize;
     return summary;
 }
 
@@ -422,10 +425,15 @@ bool writeWorldGlb(const WorldSettings& settings, const std::string& path, World
     json += std::string((4 - (jsonLength + json.size()) % 4) % 4, ' ');  // chunks are 4-byte aligned
     flush(true);
     const uint64_t total = 12 + 8 + jsonLength + 8 + binLength;
-    if (total > UINT32_MAX) {
-        error = path + ": the world needs " + std::to_string(total) + " bytes, more than a GLB can hold (4 GiB)";
+    // A file cut short is not left behind under the name asked for.
+    const auto failWith = [&](const std::string& why) {
+        glb.close();
+        std::remove(path.c_str());
+        error = why;
         return false;
-    }
+    };
+    if (total > UINT32_MAX)
+        return failWith(path + ": the world needs " + std::to_string(total) + " bytes, more than a GLB can hold (4 GiB)");
     glb.le32(uint32_t(binLength));
     glb.write("BIN\0", 4);
     // Pass two: the bytes, object by object (float32 positions, then uint32 indices).
@@ -446,19 +454,16 @@ bool writeWorldGlb(const WorldSettings& settings, const std::string& path, World
             glb.write(bytes.data(), bytes.size());
         });
     } catch (const std::exception& e) {
-        error = e.what();
-        return false;
+        return failWith(e.what());
     }
-    if (!glb.seekStart()) {
-        error = path + ": cannot seek";
-        return false;
-    }
+    if (!glb.seekStart()) return failWith(path + ": cannot seek");
     glb.write("glTF", 4);
     glb.le32(2);
     glb.le32(uint32_t(total));
     glb.le32(uint32_t(jsonLength));
     glb.write("JSON", 4);
     if (!glb.close()) {
+        std::remove(path.c_str());
         error = path + ": write error (disk full?)";
         return false;
     }

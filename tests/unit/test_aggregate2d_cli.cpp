@@ -65,6 +65,17 @@ TEST(Aggregate2DCli, BadInputIsNamedWithFeatureAndLine) {
          "{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"Polygon\", \"coordinates\": [[[0,0],[1,0],[1,1],[0,0]]]}},\n"
          "{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"MultiPolygon\", \"coordinates\": []}}\n]}",
          0, {"feature 2 (line 3)", "empty geometry"}},
+        {"nan json", "m.geojson",
+         "{\"type\": \"FeatureCollection\", \"features\": [\n"
+         "{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"Polygon\", \"coordinates\": [[[0,0],[1,0],[1,1],[0,0]]]}},\n"
+         "{\"type\": \"Feature\", \"properties\": {\"name\": \"NaN Infinity\"}, \"geometry\": {\"type\": \"Polygon\", "
+         "\"coordinates\": [[[3,0],[NaN,0],[4,Infinity],[3,0]]]}}\n]}",
+         0, {"feature 2 \"NaN Infinity\" (line 3)", "not a finite number"}},
+        {"latin-1 json", "n.geojson",
+         "{\"type\": \"FeatureCollection\", \"features\": [\n"
+         "{\"type\": \"Feature\", \"properties\": {\"name\": \"Caf\xe9\"}, \"geometry\": {\"type\": \"Point\", \"coordinates\": [1, 2]}},\n"
+         "{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"Polygon\", \"coordinates\": [[[0,0],[1,0],[1,1],[0,0]]]}}\n]}",
+         0, {"feature 1 \"Caf\xc3\xa9\" (line 2)", "unsupported geometry type 'Point'"}},
         {"nothing usable", "k.wkt", "POLYGON((3 0, 5 2, 5 0, 3 1, 3 0))\n", 3, {"line 1", "self-intersecting"}},
         {"missing file", "l.txt", "", 2, {"cannot open"}},
     };

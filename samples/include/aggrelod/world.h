@@ -3,8 +3,9 @@
 // (samples/world.cpp): terrain, towns, forests, fields and roads, generated one block at a
 // time and streamed to a GLB file without holding the world in memory.
 //
-// The world is a square grid of blocks of kWorldBlockSize x kWorldBlockSize metres (z up,
-// like every sample scene), filled row by row until the requested object count is reached.
+// The world is a grid of blocks of kWorldBlockSize x kWorldBlockSize metres (z up, like every
+// sample scene), ceil(sqrt(count / 24)) blocks per row (24 objects per block on average),
+// filled row by row until the requested object count is reached: about a square.
 // Each block is generated from its own random stream (the seed and the block's row and
 // column), so a block's content does not depend on the others: the block at row r, column c is
 // the same in every world that has it (the last block of a world may be cut short by the
@@ -48,7 +49,7 @@ struct WorldSummary {
     uint64_t triangles = 0;
     uint64_t vertices = 0;
     uint64_t blocks = 0;
-    double extent = 0;  ///< side of the square the blocks are laid out in, metres
+    double extent = 0;  ///< the longer side of the blocks' rectangle, metres
 };
 
 /// Generates the world block by block and calls `emit` once per object, in a fixed order
