@@ -267,7 +267,7 @@ std::string floatText(float v) {
 
 class GlbFile {
 public:
-    explicit GlbFile(const std::string& path) : path_(path), file_(std::fopen(path.c_str(), "wb")) {}
+    explicit GlbFile(const std::string& path) : file_(std::fopen(path.c_str(), "wb")) {}
     ~GlbFile() {
         if (file_) std::fclose(file_);
     }
@@ -280,7 +280,6 @@ public:
         const unsigned char b[4] = {uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16), uint8_t(v >> 24)};
         write(b, 4);
     }
-    uint64_t position() const { return file_ ? uint64_t(std::ftell(file_)) : 0; }
     bool seekStart() { return file_ && std::fseek(file_, 0, SEEK_SET) == 0; }
     bool close() {
         if (!file_) return false;
@@ -290,7 +289,6 @@ public:
     }
 
 private:
-    std::string path_;
     std::FILE* file_;
     bool failed_ = false;
 };
