@@ -50,11 +50,11 @@ std::string lowerExtension(const std::string& path) {
 }
 
 /// A levels.glb as a runtime file: every mesh node one root leaf standing for one "object".
-bool buildParamsFromLevels(const std::vector<io::LevelsGlbNode>& nodes, runtime::BuildParams& params,
+bool buildParamsFromLevels(const std::vector<io::LevelsGlbNode>& nodes, runtime::BuildArrays& params,
                            std::string& error) {
     for (size_t i = 0; i < nodes.size(); ++i) {
         const io::LevelsGlbNode& n = nodes[i];
-        runtime::BuildNode b;
+        runtime::NodeRecord b;
         b.firstSource = uint32_t(params.sourceObjects.size());
         b.sourceCount = 1;
         params.sourceObjects.push_back(uint32_t(i));
@@ -71,8 +71,8 @@ bool buildParamsFromLevels(const std::vector<io::LevelsGlbNode>& nodes, runtime:
             lo[k % 3] = std::min(lo[k % 3], v);
             hi[k % 3] = std::max(hi[k % 3], v);
         }
-        io::RenderMesh mesh;  // the writer wants normals; the panels colour by group
-        if (!io::buildRenderMesh(positions, n.indices, {}, mesh)) {
+        RenderMesh mesh;  // the writer wants normals; the panels colour by group
+        if (!buildRenderMesh(positions, n.indices, {}, mesh)) {
             error = "node '" + n.name + "' has a triangle index out of range";
             return false;
         }
@@ -124,14 +124,14 @@ bool RenderScene::open(const std::string& path, std::string& error) {
     std::vector<io::LevelsGlbNode> glbNodes;
     if (ext == ".glb" || ext == ".gltf") {
         if (!io::readLevelsGlb(path, glbNodes, error)) return false;
-        runtime::BuildParams params;
+        runtime::BuildArrays params;
         params.toolVersion = "render";
         if (!buildParamsFromLevels(glbNodes, params, error)) {
             error = path + ": " + error;
             return false;
         }
         std::vector<uint8_t> bytes;
-        if (!runtime::writeRuntimeFile(params, bytes, error)) {
+        if (!runtime::writeRuntimeFile(params.params(), bytes, error)) {
             error = path + ": " + error;
             return false;
         }

@@ -1,15 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: hierarchy nodes -> runtime BuildParams -> scene.aglod (docs/design.md §4).
+// aggrelod bake: hierarchy nodes -> the runtime contract (module) -> scene.aglod (docs/design.md §4).
 #include "runtime_export.h"
 
-#include <aggrelod/disjoint_sets.h>
+#include <aggrelod/hierarchy_export.h>
 
 #include <algorithm>
-#include <array>
-#include <cmath>
 #include <cstdio>
-#include <limits>
-#include <numeric>
 
 namespace aggrelod::io {
 
@@ -22,194 +18,16 @@ uint64_t settingsHash(const std::string& text) {
     return h;
 }
 
-namespace {
-
-using Vec3 = std::array<double, 3>;
-Vec3 sub(const float* a, const float* b) { return {double(a[0]) - b[0], double(a[1]) - b[1], double(a[2]) - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double length(const Vec3& a) { return std::sqrt(dot(a, a)); }
-
-}  // namespace
-
-bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
-                     const std::vector<float>& faceColors, RenderMesh& out) {
-    out = RenderMesh{};
-    const size_t vertexCount = positions.size() / 3, cornerCount = indices.size(), faceCount = cornerCount / 3;
-    if (cornerCount % 3 != 0) return false;
-    for (uint32_t v : indices)
-        if (v >= vertexCount) return false;
-
-    // Per face: unit normal (zero when degenerate) and encoded colour.
-    std::vector<Vec3> faceNormal(faceCount);
-    std::vector<std::array<uint8_t, 4>> faceColour(faceCount, {255, 255, 255, 255});
-    const bool coloured = faceColors.size() == 4 * faceCount;
-    for (size_t f = 0; f < faceCount; ++f) {
-        const float* a = &positions[3 * size_t(indices[3 * f])];
-        const float* b = &positions[3 * size_t(indices[3 * f + 1])];
-        const float* c = &positions[3 * size_t(indices[3 * f + 2])];
-        const Vec3 n = cross(sub(b, a), sub(c, a));
-        const double l = length(n);
-        faceNormal[f] = l > 0 && std::isfinite(l) ? Vec3{n[0] / l, n[1] / l, n[2] / l} : Vec3{0, 0, 0};
-        if (coloured) runtime::encodeColorSrgb8(&faceColors[4 * f], faceColour[f].data());
-    }
-
-    // Corners of one vertex are joined across smooth edges shared by exactly two faces.
-    // Edges sorted by (low vertex, high vertex, face): deterministic, no hashing.
-    struct EdgeUse {
-        uint32_t lo, hi, corner;  // corner = 3 * face + slot of the edge's start
-    };
-    std::vector<EdgeUse> edges(cornerCount);
-    for (uint32_t c = 0; c < cornerCount; ++c) {
-        const uint32_t a = indices[c], b = indices[c - c % 3 + (c + 1) % 3];
-        edges[c] = {std::min(a, b), std::max(a, b), c};
-    }
-    std::sort(edges.begin(), edges.end(), [](const EdgeUse& x, const EdgeUse& y) {
-        return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.corner < y.corner;
-    });
-    const double cosCrease = std::cos(kCreaseAngleDegrees * 3.14159265358979323846 / 180.0);
-    DisjointSets group(cornerCount);  // the smallest corner of a group is its root
-    for (size_t i = 0; i < edges.size();) {
-        size_t j = i;
-        while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
-        if (j - i == 2) {
-            const uint32_t c1 = edges[i].corner, c2 = edges[i + 1].corner;
-            const uint32_t f1 = c1 / 3, f2 = c2 / 3;
-            if (f1 != f2 && faceColour[f1] == faceColour[f2] && dot(faceNormal[f1], faceNormal[f2]) >= cosCrease) {
-                // Both corners at each end of the edge: start and end of the edge in each face.
-                const uint32_t e1 = c1 - c1 % 3 + (c1 + 1) % 3, e2 = c2 - c2 % 3 + (c2 + 1) % 3;
-                const uint32_t a1 = indices[c1];
-                group.unite(c1, indices[c2] == a1 ? c2 : e2);
-                group.unite(e1, indices[c2] == a1 ? e2 : c2);
-            }
-        }
-        i = j;
-    }
-
-    // Angle-weighted normal sums per group (accumulated at the group's root corner), and per
-    // input vertex for groups made only of degenerate faces.
-    std::vector<Vec3> sum(cornerCount, Vec3{0, 0, 0}), vertexSum(vertexCount, Vec3{0, 0, 0});
-    for (uint32_t c = 0; c < cornerCount; ++c) {
-        const uint32_t f = c / 3;
-        const float* p = &positions[3 * size_t(indices[c])];
-        const Vec3 u = sub(&positions[3 * size_t(indices[3 * f + (c + 1) % 3])], p);
-        const Vec3 w = sub(&positions[3 * size_t(indices[3 * f + (c + 2) % 3])], p);
-        const double lu = length(u), lw = length(w);
-        if (!(lu > 0 && lw > 0) || faceNormal[f] == Vec3{0, 0, 0}) continue;
-        const double angle = std::acos(std::clamp(dot(u, w) / (lu * lw), -1.0, 1.0));
-        Vec3& s = sum[group.find(c)];
-        Vec3& vs = vertexSum[indices[c]];
-        for (int k = 0; k < 3; ++k) {
-            s[k] += angle * faceNormal[f][k];
-            vs[k] += angle * faceNormal[f][k];
-        }
-    }
-
-    std::vector<uint32_t> outputOf(cornerCount, runtime::kNoIndex);
-    out.indices.resize(cornerCount);
-    for (uint32_t c = 0; c < cornerCount; ++c) {
-        const uint32_t root = group.find(c);
-        if (outputOf[root] == runtime::kNoIndex) {
-            outputOf[root] = uint32_t(out.positions.size() / 3);
-            const float* p = &positions[3 * size_t(indices[c])];
-            out.positions.insert(out.positions.end(), p, p + 3);
-            Vec3 n = sum[root];
-            if (!(length(n) > 1e-12)) n = vertexSum[indices[c]];
-            const double l = length(n);
-            if (!(l > 1e-12) || !std::isfinite(l)) n = {0, 0, 1};
-            else n = {n[0] / l, n[1] / l, n[2] / l};
-            for (int k = 0; k < 3; ++k) out.normals.push_back(float(n[k]));
-            const std::array<uint8_t, 4>& colour = faceColour[c / 3];
-            out.colors.insert(out.colors.end(), colour.begin(), colour.end());
-        }
-        out.indices[c] = outputOf[root];
-    }
-    return true;
-}
-
-bool fillBuildParams(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
-                     uint64_t hash, const std::string& toolVersion, runtime::BuildParams& params,
-                     std::string& error) {
-    params = runtime::BuildParams{};
-    params.settingsHash = hash;
-    params.toolVersion = toolVersion;
-    for (const InputObject& o : objects) params.objectNames.push_back(o.name);
-    size_t totalChildren = 0, totalSources = 0, totalPositions = 0, totalIndices = 0;
-    std::vector<RenderMesh> meshes(nodes.nodes.size());
-    for (size_t i = 0; i < nodes.nodes.size(); ++i) {
-        const HierarchyNode& n = nodes.nodes[i];
-        if (!buildRenderMesh(n.positions, n.indices, n.faceColors, meshes[i])) {
-            error = "node " + std::to_string(i) + ": a triangle index is out of range";
-            return false;
-        }
-        totalChildren += n.children.size();
-        totalSources += n.sources.size();
-        totalPositions += meshes[i].positions.size();
-        totalIndices += n.indices.size();
-    }
-    const size_t limit = std::numeric_limits<uint32_t>::max() - 1;
-    if (nodes.nodes.size() > limit || totalChildren > limit || totalSources > limit || totalPositions / 3 > limit ||
-        totalIndices > limit) {
-        error = "the hierarchy is too large for the runtime file (more than 2^32 nodes, vertices or indices)";
-        return false;
-    }
-    params.nodes.reserve(nodes.nodes.size());
-    params.childIndices.reserve(totalChildren);
-    params.sourceObjects.reserve(totalSources);
-    params.positions.reserve(totalPositions);
-    params.normals.reserve(totalPositions);
-    params.colors.reserve(totalPositions / 3 * 4);
-    params.indices.reserve(totalIndices);
-    for (size_t i = 0; i < nodes.nodes.size(); ++i) {
-        const HierarchyNode& n = nodes.nodes[i];
-        RenderMesh& mesh = meshes[i];
-        runtime::BuildNode b;
-        b.parent = n.parent == kNoNode ? runtime::kNoIndex : n.parent;
-        b.firstChild = static_cast<uint32_t>(params.childIndices.size());
-        b.childCount = static_cast<uint32_t>(n.children.size());
-        params.childIndices.insert(params.childIndices.end(), n.children.begin(), n.children.end());
-        b.firstSource = static_cast<uint32_t>(params.sourceObjects.size());
-        b.sourceCount = static_cast<uint32_t>(n.sources.size());
-        params.sourceObjects.insert(params.sourceObjects.end(), n.sources.begin(), n.sources.end());
-        b.firstVertex = static_cast<uint32_t>(params.positions.size() / 3);
-        b.vertexCount = static_cast<uint32_t>(mesh.positions.size() / 3);
-        params.positions.insert(params.positions.end(), mesh.positions.begin(), mesh.positions.end());
-        params.normals.insert(params.normals.end(), mesh.normals.begin(), mesh.normals.end());
-        params.colors.insert(params.colors.end(), mesh.colors.begin(), mesh.colors.end());
-        b.firstIndex = static_cast<uint32_t>(params.indices.size());
-        b.indexCount = static_cast<uint32_t>(mesh.indices.size());
-        params.indices.insert(params.indices.end(), mesh.indices.begin(), mesh.indices.end());
-        mesh = RenderMesh{};  // keep the peak memory near one copy of the arrays
-        b.level = n.leaf ? runtime::kLeafLevel
-                  : n.objectLod >= 1 ? runtime::kObjectLodLevel
-                  : n.coarserStep >= 1 ? runtime::kCoarserLevel
-                                     : static_cast<uint32_t>(n.firstLevel);
-        b.delta = static_cast<float>(n.delta);
-        // Float-representable by construction (hierarchy_nodes.h): the casts are exact.
-        b.geometricError = static_cast<float>(n.geometricError);
-        for (int k = 0; k < 3; ++k) {
-            b.boundsMin[k] = static_cast<float>(n.boundsMin[k]);
-            b.boundsMax[k] = static_cast<float>(n.boundsMax[k]);
-            b.sphereCenter[k] = static_cast<float>(n.sphereCenter[k]);
-        }
-        b.sphereRadius = static_cast<float>(n.sphereRadius);
-        params.nodes.push_back(b);
-    }
-    return true;
-}
-
 bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                        uint64_t hash, const std::string& toolVersion, const std::string& path,
                        std::string& error) {
-    runtime::BuildParams params;
-    if (!fillBuildParams(nodes, objects, hash, toolVersion, params, error)) {
+    runtime::BuildArrays arrays;
+    if (!exportHierarchy(nodes, objects, hash, toolVersion, arrays, error)) {
         error = path + ": " + error;
         return false;
     }
     std::vector<uint8_t> bytes;
-    if (!runtime::writeRuntimeFile(params, bytes, error)) {
+    if (!runtime::writeRuntimeFile(arrays.params(), bytes, error)) {
         error = path + ": " + error;
         return false;
     }

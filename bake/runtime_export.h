@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// aggrelod bake: the hierarchy nodes (module) turned into the runtime's flat BuildParams,
-// and the bytes of OUTDIR/scene.aglod (docs/design.md §4).
+// aggrelod bake: the bytes of OUTDIR/scene.aglod, from the hierarchy nodes through the
+// module's export (aggrelod/hierarchy_export.h) and the runtime's writer (docs/design.md §4).
 #pragma once
 
-#include <aggrelod/hierarchy_nodes.h>
-#include <aggrelod/runtime_build.h>
+#include <aggrelod/hierarchy_export.h>
 
 #include <cstdint>
 #include <string>
@@ -15,44 +14,7 @@ namespace aggrelod::io {
 /// 64-bit FNV-1a of `text` (the canonical text of the bake settings).
 uint64_t settingsHash(const std::string& text);
 
-/// Faces meeting at a dihedral angle (between their normals) of more than this are a crease:
-/// their shared vertices are split, each side gets its own normal. 60 degrees keeps box edges
-/// and steep roof ridges crisp and smooths the coarse facets of rounded proxies (a distant
-/// clump of trees should not look like a cut gem).
-constexpr double kCreaseAngleDegrees = 60.0;
-
-/// A mesh ready to draw: one normal and one colour per vertex.
-struct RenderMesh {
-    std::vector<float> positions;   ///< 3 per vertex, world units; copies of the input's, bit-identical
-    std::vector<float> normals;     ///< 3 per vertex, unit, outward
-    std::vector<uint8_t> colors;    ///< 4 per vertex, runtime::encodeColorSrgb8 of the face colour
-    std::vector<uint32_t> indices;  ///< 3 per triangle, the input's triangles in the same order
-};
-
-/// Builds the render vertices of a triangle mesh (positions 3 * vertexCount floats, world
-/// units; indices 3 * triangleCount). `faceColors`: linear RGBA per triangle (4 *
-/// triangleCount floats) or empty for white. Each input vertex becomes one output vertex per
-/// group of its corners that are joined across edges shared by exactly two triangles of the
-/// same encoded colour whose normals differ by at most kCreaseAngleDegrees. A group's
-/// normal is the angle-weighted sum of its faces' unit normals (Thuermer & Wuethrich), so it
-/// does not depend on how a flat region is triangulated; degenerate triangles add nothing
-/// (a vertex without any usable face gets +z). Output vertices are numbered in order of
-/// first use by the triangles: deterministic. Returns false (out empty) when an index is out
-/// of range or indices.size() is not a multiple of 3.
-bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
-                     const std::vector<float>& faceColors, RenderMesh& out);
-
-/// Fills `params` from `nodes` (node i of the file = nodes.nodes[i]; leaves carry the
-/// original object's triangles, aggregates and per-object LODs their simplified proxy, as
-/// float world coordinates, with normals and the node's faceColors through buildRenderMesh).
-/// Levels: leaves kLeafLevel, per-object LOD nodes (objectLod >= 1) kObjectLodLevel,
-/// aggregates their firstLevel. Returns false with a message when a count does not fit 32
-/// bits or an index is out of range.
-bool fillBuildParams(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
-                     uint64_t settingsHash, const std::string& toolVersion,
-                     runtime::BuildParams& params, std::string& error);
-
-/// fillBuildParams + runtime::writeRuntimeFile + writing `path` (the caller renames it into
+/// exportHierarchy + runtime::writeRuntimeFile + writing `path` (the caller renames it into
 /// place). Deterministic: the same nodes give the same bytes.
 bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                        uint64_t settingsHash, const std::string& toolVersion, const std::string& path,

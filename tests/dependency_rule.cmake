@@ -4,7 +4,9 @@
 #
 # - no file under runtime/ includes TetGen, CGAL, tinygltf, nlohmann-json, meshoptimizer, GEOS, GLM or any
 #   header of module/;
-# - no file under module/ includes tinygltf or any header of runtime/;
+# - no file under module/ includes tinygltf or any header of runtime/ but the contract,
+#   aggrelod/runtime_build.h (standard library only: the module emits it, the runtime's writer
+#   consumes it);
 # - no file under planning/ includes TetGen, CGAL, GMP/MPFR, tinygltf, meshoptimizer, GEOS,
 #   GLM, CLI11, stb or any header of module/, bake/ or samples/ (it may use the runtime with
 #   its collision part, OMPL and the standard library);
@@ -101,6 +103,9 @@ if(module_headers AND runtime_headers)
   list(REMOVE_ITEM module_only ${runtime_headers})
   list(REMOVE_ITEM runtime_only ${module_headers})
 endif()
+# The bake -> runtime contract: the one runtime header the module may include.
+set(runtime_forbidden_in_module ${runtime_only})
+list(REMOVE_ITEM runtime_forbidden_in_module "aggrelod/runtime_build.h" "runtime_build.h")
 
 # Bare names of the bake's and the samples' headers (bake/*.h, samples/include/aggrelod/*.h).
 set(bake_headers "")
@@ -116,7 +121,7 @@ check_includes(runtime
   "${module_only}")
 check_includes(module
   "(^|/)tiny_gltf\\.h$|(^|/)runtime/"
-  "${runtime_only}")
+  "${runtime_forbidden_in_module}")
 if(EXISTS "${SOURCE_DIR}/planning")
   # planning/ may use the runtime (with its collision part), OMPL and the standard library.
   # A name that is also a runtime or planning header cannot be told apart: leave it out.

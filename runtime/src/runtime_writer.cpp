@@ -9,7 +9,6 @@
 #include "aglod_layout.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -38,65 +37,50 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
         return false;
     }
     constexpr uint64_t kMaxU32 = std::numeric_limits<uint32_t>::max();
-    if (params.positions.size() % 3 != 0) {
-        error = "positions: " + std::to_string(params.positions.size()) +
-                " floats is not a multiple of 3";
+    // A null pointer with a non-zero count would be read from: refuse it.
+    if ((!params.nodes && params.nodeCount) || (!params.childIndices && params.childIndexCount) ||
+        (!params.sourceObjects && params.sourceObjectCount) || (!params.positions && params.positionCount) ||
+        (!params.normals && params.normalCount) || (!params.colors && params.colorCount) ||
+        (!params.indices && params.indexCount) || (!params.objectNames && params.objectCount)) {
+        error = "an array has a count but no data";
         return false;
     }
-    if (params.normals.size() != params.positions.size()) {
-        error = "normals: " + std::to_string(params.normals.size()) + " floats for " +
-                std::to_string(params.positions.size()) + " position floats (one normal per vertex)";
+    if (params.positionCount % 3 != 0) {
+        error = "positions: " + std::to_string(params.positionCount) + " floats is not a multiple of 3";
         return false;
     }
-    if (params.colors.size() / 4 != params.positions.size() / 3 || params.colors.size() % 4 != 0) {
-        error = "colors: " + std::to_string(params.colors.size()) + " bytes for " +
-                std::to_string(params.positions.size() / 3) + " vertices (4 bytes per vertex)";
+    if (params.normalCount != params.positionCount) {
+        error = "normals: " + std::to_string(params.normalCount) + " floats for " +
+                std::to_string(params.positionCount) + " position floats (one normal per vertex)";
+        return false;
+    }
+    if (params.colorCount / 4 != params.positionCount / 3 || params.colorCount % 4 != 0) {
+        error = "colors: " + std::to_string(params.colorCount) + " bytes for " +
+                std::to_string(params.positionCount / 3) + " vertices (4 bytes per vertex)";
         return false;
     }
     if (params.toolVersion.size() >= kToolVersionSize) {
-        error = "tool version '" + params.toolVersion + "' is longer than " +
+        error = "tool version '" + std::string(params.toolVersion) + "' is longer than " +
                 std::to_string(kToolVersionSize - 1) + " bytes";
         return false;
     }
-    if (params.nodes.size() >= kMaxU32 || params.childIndices.size() > kMaxU32 ||
-        params.sourceObjects.size() > kMaxU32 || params.positions.size() / 3 > kMaxU32 ||
-        params.indices.size() > kMaxU32 || params.objectNames.size() > kMaxU32) {
+    if (params.nodeCount >= kMaxU32 || params.childIndexCount > kMaxU32 || params.sourceObjectCount > kMaxU32 ||
+        params.positionCount / 3 > kMaxU32 || params.indexCount > kMaxU32 || params.objectCount > kMaxU32) {
         error = "an array has more than 2^32-1 elements";
         return false;
     }
 
-    // Node records: the same fields as BuildNode, in the on-disk order.
-    std::vector<NodeRecord> records(params.nodes.size());
+    // The node records are the file's own layout: written as given.
     std::vector<uint32_t> roots;
-    for (size_t i = 0; i < params.nodes.size(); ++i) {
-        const BuildNode& b = params.nodes[i];
-        NodeRecord& r = records[i];
-        r.parent = b.parent;
-        r.firstChild = b.firstChild;
-        r.childCount = b.childCount;
-        r.firstSource = b.firstSource;
-        r.sourceCount = b.sourceCount;
-        r.firstVertex = b.firstVertex;
-        r.vertexCount = b.vertexCount;
-        r.firstIndex = b.firstIndex;
-        r.indexCount = b.indexCount;
-        r.level = b.level;
-        r.delta = b.delta;
-        r.geometricError = b.geometricError;
-        for (int k = 0; k < 3; ++k) {
-            r.boundsMin[k] = b.boundsMin[k];
-            r.boundsMax[k] = b.boundsMax[k];
-            r.sphereCenter[k] = b.sphereCenter[k];
-        }
-        r.sphereRadius = b.sphereRadius;
-        if (b.parent == kNoIndex) roots.push_back(static_cast<uint32_t>(i));
-    }
+    for (size_t i = 0; i < params.nodeCount; ++i)
+        if (params.nodes[i].parent == kNoIndex) roots.push_back(static_cast<uint32_t>(i));
 
     // Object names: {offset, length} pairs into one blob.
     std::vector<uint32_t> nameRanges;
     std::string blob;
-    nameRanges.reserve(params.objectNames.size() * 2);
-    for (const std::string& name : params.objectNames) {
+    nameRanges.reserve(params.objectCount * 2);
+    for (size_t i = 0; i < params.objectCount; ++i) {
+        const std::string& name = params.objectNames[i];
         if (blob.size() + name.size() > kMaxU32) {
             error = "object names exceed 4 GiB";
             return false;
@@ -108,16 +92,16 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
 
     const SectionSource sources[kSectionCount + 1] = {
         {nullptr, 0},
-        {records.data(), records.size()},
+        {params.nodes, params.nodeCount},
         {roots.data(), roots.size()},
-        {params.childIndices.data(), params.childIndices.size()},
-        {params.sourceObjects.data(), params.sourceObjects.size()},
-        {params.positions.data(), params.positions.size() / 3},
-        {params.indices.data(), params.indices.size()},
+        {params.childIndices, params.childIndexCount},
+        {params.sourceObjects, params.sourceObjectCount},
+        {params.positions, params.positionCount / 3},
+        {params.indices, params.indexCount},
         {nameRanges.data(), nameRanges.size() / 2},
         {blob.data(), blob.size()},
-        {params.normals.data(), params.normals.size() / 3},
-        {params.colors.data(), params.colors.size() / 4},
+        {params.normals, params.normalCount / 3},
+        {params.colors, params.colorCount / 4},
     };
 
     size_t offsets[kSectionCount + 1] = {};
@@ -160,23 +144,6 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
         return false;
     }
     return true;
-}
-
-namespace {
-float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-float linearToSrgb(float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f; }
-uint8_t toByte(float unit) { return static_cast<uint8_t>(std::lround(unit * 255.0f)); }
-float clampUnit(float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; }  // NaN -> 0
-}  // namespace
-
-void encodeColorSrgb8(const float linear[4], uint8_t out[4]) {
-    for (int k = 0; k < 3; ++k) out[k] = toByte(linearToSrgb(clampUnit(linear[k])));
-    out[3] = toByte(clampUnit(linear[3]));
-}
-
-void decodeColorSrgb8(const uint8_t encoded[4], float linear[4]) {
-    for (int k = 0; k < 3; ++k) linear[k] = srgbToLinear(encoded[k] / 255.0f);
-    linear[3] = encoded[3] / 255.0f;
 }
 
 }  // namespace aggrelod::runtime

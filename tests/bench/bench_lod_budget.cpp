@@ -242,11 +242,11 @@ bool runScene(const Options& o, const std::string& name) {
         std::printf("bake FAILED: %s\n", b.problem.c_str());
         return false;
     }
-    runtime::BuildParams params;
+    runtime::BuildArrays params;
     std::string error;
     std::vector<uint8_t> bytes;
     runtime::RuntimeFile file;
-    if (!io::fillBuildParams(b.nodes, objects, 0, "bench", params, error) ||
+    if (!exportHierarchy(b.nodes, objects, 0, "bench", params, error) ||
         !runtime::writeRuntimeFile(params, bytes, error) ||
         runtime::RuntimeFile::openMemory(bytes.data(), bytes.size(), file, error) != runtime::FileStatus::Ok) {
         std::printf("runtime file FAILED: %s\n", error.c_str());

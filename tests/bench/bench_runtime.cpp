@@ -57,7 +57,7 @@ struct Loaded {
     RuntimeFile file;
 };
 
-static bool load(const BuildParams& p, Loaded& out) {
+static bool load(const BuildArrays& p, Loaded& out) {
     std::string error;
     if (!writeRuntimeFile(p, out.bytes, error) ||
         RuntimeFile::openMemory(out.bytes.data(), out.bytes.size(), out.file, error) != FileStatus::Ok) {
@@ -259,7 +259,7 @@ static void benchOpen(size_t targetMegabytes) {
         std::vector<uint8_t> bytes;
         std::string error;
         {
-            const BuildParams p = aggrelod::testing::makeSyntheticHierarchy(objects, 3, 4);
+            const BuildArrays p = aggrelod::testing::makeSyntheticHierarchy(objects, 3, 4);
             if (!writeRuntimeFile(p, bytes, error)) {
                 std::fprintf(stderr, "bench_runtime: %s\n", error.c_str());
                 return;

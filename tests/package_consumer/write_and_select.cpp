@@ -25,7 +25,7 @@ void check(bool ok, const char* what) {
 }
 
 // A closed box mesh, 4 vertices per face (own normal per face), outward winding.
-void appendBox(BuildParams& p, BuildNode& node, const float lo[3], const float hi[3]) {
+void appendBox(BuildArrays& p, NodeRecord& node, const float lo[3], const float hi[3]) {
     static const int corners[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                                       {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     static const float normals[6][3] = {{0, 0, -1}, {0, 0, 1}, {0, -1, 0}, {0, 1, 0}, {-1, 0, 0}, {1, 0, 0}};
@@ -60,12 +60,12 @@ void appendBox(BuildParams& p, BuildNode& node, const float lo[3], const float h
 
 // Two unit boxes 3 apart on x (objects "left" and "right") under one aggregate whose proxy is
 // their common bounding box.
-BuildParams twoBoxScene() {
-    BuildParams p;
+BuildArrays twoBoxScene() {
+    BuildArrays p;
     p.objectNames = {"left", "right"};
     const float lo[2][3] = {{0, 0, 0}, {3, 0, 0}}, hi[2][3] = {{1, 1, 1}, {4, 1, 1}};
     for (uint32_t o = 0; o < 2; ++o) {
-        BuildNode leaf;
+        NodeRecord leaf;
         leaf.parent = 2;
         leaf.level = kLeafLevel;
         leaf.firstSource = static_cast<uint32_t>(p.sourceObjects.size());
@@ -74,7 +74,7 @@ BuildParams twoBoxScene() {
         appendBox(p, leaf, lo[o], hi[o]);
         p.nodes.push_back(leaf);
     }
-    BuildNode root;
+    NodeRecord root;
     root.level = 0;
     root.delta = 1.0f;
     root.firstChild = 0;

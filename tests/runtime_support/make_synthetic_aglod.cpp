@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "aglod_make_synthetic: need objects >= 1 and branching >= 2\n");
         return 2;
     }
-    const aggrelod::runtime::BuildParams params =
+    const aggrelod::runtime::BuildArrays params =
         aggrelod::testing::makeSyntheticHierarchy(objects, seed, branching);
     std::vector<uint8_t> bytes;
     std::string error;

@@ -26,7 +26,7 @@ struct SyntheticBox {
 /// Appends a closed, outward 12-triangle box mesh to `p` (4 vertices per face, so each face
 /// has its own normal, as the bake splits at creases), sets node's vertex/index ranges. The
 /// faces get colour `rgba` (the file's encoded bytes), the top face a lighter one.
-inline void appendBoxMesh(runtime::BuildParams& p, runtime::BuildNode& node, const float lo[3],
+inline void appendBoxMesh(runtime::BuildArrays& p, runtime::NodeRecord& node, const float lo[3],
                           const float hi[3], const uint8_t rgba[4] = nullptr) {
     static const uint8_t kWhite[4] = {255, 255, 255, 255};
     if (!rgba) rgba = kWhite;
@@ -73,7 +73,7 @@ inline std::vector<SyntheticBox> makeCityBoxes(uint32_t count, uint32_t seed, fl
 
 namespace detail {
 struct HierarchyBuilder {
-    runtime::BuildParams& p;
+    runtime::BuildArrays& p;
     const std::vector<SyntheticBox>& boxes;
     uint32_t branching;
     float errorScale;
@@ -81,7 +81,7 @@ struct HierarchyBuilder {
 
     // Builds the subtree over objects ids[first, last); returns its node index and height.
     std::pair<uint32_t, uint32_t> build(std::vector<uint32_t>& ids, size_t first, size_t last) {
-        runtime::BuildNode node;
+        runtime::NodeRecord node;
         if (last - first == 1) {
             const uint32_t o = ids[first];
             const SyntheticBox& b = boxes[o];
@@ -102,7 +102,7 @@ struct HierarchyBuilder {
             // Per-object LOD chain: simplified versions of this one object (the same box here),
             // each a little coarser and with a slightly larger sphere than the node below.
             for (uint32_t j = 1; j <= objectLodChain; ++j) {
-                runtime::BuildNode lod = p.nodes[below];
+                runtime::NodeRecord lod = p.nodes[below];
                 lod.level = runtime::kObjectLodLevel;
                 lod.firstChild = static_cast<uint32_t>(p.childIndices.size());
                 lod.childCount = 1;
@@ -155,7 +155,7 @@ struct HierarchyBuilder {
         }
         for (uint32_t c : kids) {
             p.childIndices.push_back(c);
-            const runtime::BuildNode& cn = p.nodes[c];
+            const runtime::NodeRecord& cn = p.nodes[c];
             for (int k = 0; k < 3; ++k) {
                 node.boundsMin[k] = std::min(node.boundsMin[k], cn.boundsMin[k]);
                 node.boundsMax[k] = std::max(node.boundsMax[k], cn.boundsMax[k]);
@@ -169,7 +169,7 @@ struct HierarchyBuilder {
         double diag2 = 0;
         for (int k = 0; k < 3; ++k) diag2 += double(node.boundsMax[k] - node.boundsMin[k]) * (node.boundsMax[k] - node.boundsMin[k]);
         for (uint32_t c : kids) {
-            const runtime::BuildNode& cn = p.nodes[c];
+            const runtime::NodeRecord& cn = p.nodes[c];
             double d2 = 0;
             for (int k = 0; k < 3; ++k) d2 += double(cn.sphereCenter[k] - node.sphereCenter[k]) * (cn.sphereCenter[k] - node.sphereCenter[k]);
             radius = std::max(radius, std::sqrt(d2) + cn.sphereRadius);
@@ -184,7 +184,7 @@ struct HierarchyBuilder {
         return {self, height};
     }
 
-    static void finishSphereOfBox(runtime::BuildNode& node) {
+    static void finishSphereOfBox(runtime::NodeRecord& node) {
         double d2 = 0;
         for (int k = 0; k < 3; ++k) {
             node.sphereCenter[k] = 0.5f * (node.boundsMin[k] + node.boundsMax[k]);
@@ -202,10 +202,10 @@ struct HierarchyBuilder {
 /// values mimic proxies that hug their originals, as the bake's). `objectLodChain` > 0 puts
 /// that many per-object LOD nodes (level kObjectLodLevel, one source, errors rising) between
 /// every leaf and its aggregate.
-inline runtime::BuildParams makeSyntheticHierarchy(uint32_t objectCount, uint32_t seed,
+inline runtime::BuildArrays makeSyntheticHierarchy(uint32_t objectCount, uint32_t seed,
                                                    uint32_t branching = 4, uint32_t roots = 1,
                                                    float errorScale = 1.0f, uint32_t objectLodChain = 0) {
-    runtime::BuildParams p;
+    runtime::BuildArrays p;
     const std::vector<SyntheticBox> boxes = makeCityBoxes(objectCount, seed);
     for (uint32_t i = 0; i < objectCount; ++i) p.objectNames.push_back("box" + std::to_string(i));
     std::vector<uint32_t> ids(objectCount);

@@ -192,7 +192,7 @@ TEST(RuntimeCApi, NodeMeshIsAViewOfTheFile) {
 }
 
 TEST(RuntimeCApi, NodeNormalsAndColorsAreViewsOfTheFile) {
-    const aggrelod::runtime::BuildParams p = makeSyntheticHierarchy(40, 9, 4, 1, 1.0f, 1);
+    const aggrelod::runtime::BuildArrays p = makeSyntheticHierarchy(40, 9, 4, 1, 1.0f, 1);
     std::vector<uint8_t> bytes;
     std::string error;
     ASSERT_TRUE(aggrelod::runtime::writeRuntimeFile(p, bytes, error)) << error;
@@ -200,7 +200,7 @@ TEST(RuntimeCApi, NodeNormalsAndColorsAreViewsOfTheFile) {
     ASSERT_EQ(aglod_open_memory(bytes.data(), bytes.size(), &file), AGLOD_OK) << aglod_last_error();
     size_t objectLods = 0;
     for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
-        const aggrelod::runtime::BuildNode& b = p.nodes[n];
+        const aggrelod::runtime::NodeRecord& b = p.nodes[n];
         const float* normals = nullptr;
         const uint8_t* colors = nullptr;
         uint32_t normalCount = 0, colorCount = 0, vertexCount = 0;

@@ -57,7 +57,7 @@ void sphere(int subdivisions, std::vector<float>& p, std::vector<uint32_t>& t) {
         for (double c : x) p.push_back(float(c));
 }
 
-void expectCornersKeepPositions(const std::vector<float>& p, const std::vector<uint32_t>& t, const io::RenderMesh& m) {
+void expectCornersKeepPositions(const std::vector<float>& p, const std::vector<uint32_t>& t, const RenderMesh& m) {
     ASSERT_EQ(m.indices.size(), t.size());
     for (size_t i = 0; i < t.size(); ++i)
         for (int k = 0; k < 3; ++k)
@@ -77,8 +77,8 @@ TEST(RuntimeExport, CubeCornersAreSplitIntoFaceNormals) {
     std::vector<float> p;
     std::vector<uint32_t> t;
     cube(-1.0f, 2.0f, p, t);
-    io::RenderMesh m;
-    ASSERT_TRUE(io::buildRenderMesh(p, t, {}, m));
+    RenderMesh m;
+    ASSERT_TRUE(buildRenderMesh(p, t, {}, m));
     expectCornersKeepPositions(p, t, m);
     EXPECT_EQ(m.positions.size() / 3, 24u);  // 90 degree edges: 3 copies of each corner
     for (size_t i = 0; i < t.size(); ++i) {
@@ -100,8 +100,8 @@ TEST(RuntimeExport, SmoothSurfaceKeepsSharedVerticesWithRadialNormals) {
     std::vector<float> p;
     std::vector<uint32_t> t;
     sphere(3, p, t);  // 512 triangles, dihedral angles well under the crease angle
-    io::RenderMesh m;
-    ASSERT_TRUE(io::buildRenderMesh(p, t, {}, m));
+    RenderMesh m;
+    ASSERT_TRUE(buildRenderMesh(p, t, {}, m));
     expectCornersKeepPositions(p, t, m);
     EXPECT_EQ(m.positions.size(), p.size());
     for (size_t v = 0; v < m.positions.size(); v += 3) {
@@ -116,8 +116,8 @@ TEST(RuntimeExport, ColourBoundariesSplitEvenOnAFlatSurfaceAndColoursAreSrgb) {
     const std::vector<float> p = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
     const std::vector<uint32_t> t = {0, 1, 2, 0, 2, 3};
     const std::vector<float> colours = {1, 0, 0, 1, 0, 0, 0.5f, 1};
-    io::RenderMesh m;
-    ASSERT_TRUE(io::buildRenderMesh(p, t, colours, m));
+    RenderMesh m;
+    ASSERT_TRUE(buildRenderMesh(p, t, colours, m));
     expectCornersKeepPositions(p, t, m);
     EXPECT_EQ(m.positions.size() / 3, 6u);
     for (size_t v = 0; v < m.normals.size(); v += 3) EXPECT_EQ(m.normals[v + 2], 1.0f);
@@ -131,23 +131,23 @@ TEST(RuntimeExport, ColourBoundariesSplitEvenOnAFlatSurfaceAndColoursAreSrgb) {
     }
     // The same colour on both: the square stays 4 vertices with one normal.
     const std::vector<float> same = {0.2f, 0.4f, 0.6f, 1, 0.2f, 0.4f, 0.6f, 1};
-    ASSERT_TRUE(io::buildRenderMesh(p, t, same, m));
+    ASSERT_TRUE(buildRenderMesh(p, t, same, m));
     EXPECT_EQ(m.positions.size() / 3, 4u);
     // Bad input is refused, never read out of bounds.
-    EXPECT_FALSE(io::buildRenderMesh(p, {0, 1, 7}, {}, m));
-    EXPECT_FALSE(io::buildRenderMesh(p, {0, 1}, {}, m));
+    EXPECT_FALSE(buildRenderMesh(p, {0, 1, 7}, {}, m));
+    EXPECT_FALSE(buildRenderMesh(p, {0, 1}, {}, m));
     EXPECT_TRUE(m.positions.empty());
 }
 
 TEST(RuntimeExport, CreaseAngleDecidesBetweenSmoothAndSplit) {
     // Two triangles hinged on the x axis, opened by an angle below or above the crease angle.
-    for (double degrees : {io::kCreaseAngleDegrees - 5, io::kCreaseAngleDegrees + 5}) {
+    for (double degrees : {kCreaseAngleDegrees - 5, kCreaseAngleDegrees + 5}) {
         const double a = degrees * 3.14159265358979 / 180;
         const std::vector<float> p = {0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0.5f, float(-std::cos(a)), float(std::sin(a))};
         const std::vector<uint32_t> t = {0, 1, 2, 1, 0, 3};
-        io::RenderMesh m;
-        ASSERT_TRUE(io::buildRenderMesh(p, t, {}, m));
-        EXPECT_EQ(m.positions.size() / 3, degrees < io::kCreaseAngleDegrees ? 4u : 6u) << degrees;
+        RenderMesh m;
+        ASSERT_TRUE(buildRenderMesh(p, t, {}, m));
+        EXPECT_EQ(m.positions.size() / 3, degrees < kCreaseAngleDegrees ? 4u : 6u) << degrees;
     }
 }
 
@@ -200,9 +200,9 @@ TEST(RuntimeExport, FileCarriesNormalsColoursAndPerObjectLodLevels) {
     nodes.nodes[group].parent = root;
     nodes.roots = {root};
 
-    runtime::BuildParams params;
+    runtime::BuildArrays params;
     std::string error;
-    ASSERT_TRUE(io::fillBuildParams(nodes, objects, 7, "test", params, error)) << error;
+    ASSERT_TRUE(exportHierarchy(nodes, objects, 7, "test", params, error)) << error;
     std::vector<uint8_t> bytes;
     ASSERT_TRUE(runtime::writeRuntimeFile(params, bytes, error)) << error;
     runtime::RuntimeFile file;
@@ -216,8 +216,8 @@ TEST(RuntimeExport, FileCarriesNormalsColoursAndPerObjectLodLevels) {
     // Every node: 24 split vertices with the positions of its cube, normals and colours read
     // back as built; red where the node has red faces, white elsewhere.
     for (uint32_t i = 0; i < file.nodeCount(); ++i) {
-        io::RenderMesh expected;
-        ASSERT_TRUE(io::buildRenderMesh(nodes.nodes[i].positions, nodes.nodes[i].indices, nodes.nodes[i].faceColors, expected));
+        RenderMesh expected;
+        ASSERT_TRUE(buildRenderMesh(nodes.nodes[i].positions, nodes.nodes[i].indices, nodes.nodes[i].faceColors, expected));
         const auto v = file.vertices(i), n = file.normals(i);
         const auto c = file.colors(i);
         ASSERT_EQ(v.size, 72u);
@@ -240,8 +240,8 @@ TEST(RuntimeExport, FileCarriesNormalsColoursAndPerObjectLodLevels) {
     runtime::cutAtLevel(file, runtime::kLeafLevel, cut);
     EXPECT_EQ(cut, (std::vector<uint32_t>{red, plain}));
     // Deterministic.
-    runtime::BuildParams again;
-    ASSERT_TRUE(io::fillBuildParams(nodes, objects, 7, "test", again, error));
+    runtime::BuildArrays again;
+    ASSERT_TRUE(exportHierarchy(nodes, objects, 7, "test", again, error));
     std::vector<uint8_t> bytesAgain;
     ASSERT_TRUE(runtime::writeRuntimeFile(again, bytesAgain, error));
     EXPECT_EQ(bytes, bytesAgain);

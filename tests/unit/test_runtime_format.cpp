@@ -23,7 +23,7 @@ using aggrelod::testing::makeSyntheticHierarchy;
 
 namespace {
 
-std::vector<uint8_t> writeOrDie(const BuildParams& p) {
+std::vector<uint8_t> writeOrDie(const BuildArrays& p) {
     std::vector<uint8_t> bytes;
     std::string error;
     EXPECT_TRUE(writeRuntimeFile(p, bytes, error)) << error;
@@ -54,7 +54,7 @@ void resign(std::vector<uint8_t>& bytes) {
 }  // namespace
 
 TEST(RuntimeFormat, RoundTripKeepsEveryField) {
-    const BuildParams p = makeSyntheticHierarchy(300, 7, 3, 2);
+    const BuildArrays p = makeSyntheticHierarchy(300, 7, 3, 2);
     const std::vector<uint8_t> bytes = writeOrDie(p);
     ASSERT_EQ(bytes.size() % 32, 0u);
     RuntimeFile file;
@@ -67,7 +67,7 @@ TEST(RuntimeFormat, RoundTripKeepsEveryField) {
     ASSERT_EQ(file.objectCount(), p.objectNames.size());
     std::vector<uint32_t> roots;
     for (uint32_t i = 0; i < p.nodes.size(); ++i) {
-        const BuildNode& b = p.nodes[i];
+        const NodeRecord& b = p.nodes[i];
         const NodeRecord& r = file.node(i);
         EXPECT_EQ(r.parent, b.parent);
         EXPECT_EQ(r.level, b.level);
@@ -100,7 +100,7 @@ TEST(RuntimeFormat, RoundTripKeepsEveryField) {
 }
 
 TEST(RuntimeFormat, WriterIsDeterministicAndFileOpensFromDisk) {
-    const BuildParams p = makeSyntheticHierarchy(200, 3);
+    const BuildArrays p = makeSyntheticHierarchy(200, 3);
     const std::vector<uint8_t> a = writeOrDie(p), b = writeOrDie(p);
     EXPECT_EQ(a, b);
     const std::string path = std::string(AGGRELOD_TEST_TMP) + "/roundtrip.aglod";
@@ -137,40 +137,40 @@ TEST(RuntimeFormat, SectionsAreAlignedAndLittleEndianHeader) {
 }
 
 TEST(RuntimeFormat, WriterRefusesInconsistentHierarchies) {
-    const BuildParams good = makeSyntheticHierarchy(40, 2);
+    const BuildArrays good = makeSyntheticHierarchy(40, 2);
     struct Case {
         const char* what;
-        void (*breakIt)(BuildParams&);
+        void (*breakIt)(BuildArrays&);
         const char* expected;
     };
     const Case cases[] = {
-        {"child with another parent", [](BuildParams& p) { p.nodes[p.childIndices[0]].parent = p.childIndices[1]; }, "bad tree"},
-        {"source out of range", [](BuildParams& p) { p.sourceObjects[0] = 9999; }, "index out of range"},
-        {"error not monotone", [](BuildParams& p) { p.nodes[0].geometricError = 1e6f; }, "bad tree"},
-        {"child outside parent", [](BuildParams& p) { p.nodes[0].boundsMax[0] += 1e4f; p.nodes[0].sphereCenter[0] += 1e4f; }, "bad tree"},
-        {"triangle index too big", [](BuildParams& p) { p.indices[0] = 100; }, "index out of range"},
-        {"NaN radius", [](BuildParams& p) { p.nodes[1].sphereRadius = std::nanf(""); }, "bad value"},
-        {"object in no leaf", [](BuildParams& p) { p.objectNames.push_back("orphan"); }, "bad tree"},
-        {"cycle", [](BuildParams& p) {
+        {"child with another parent", [](BuildArrays& p) { p.nodes[p.childIndices[0]].parent = p.childIndices[1]; }, "bad tree"},
+        {"source out of range", [](BuildArrays& p) { p.sourceObjects[0] = 9999; }, "index out of range"},
+        {"error not monotone", [](BuildArrays& p) { p.nodes[0].geometricError = 1e6f; }, "bad tree"},
+        {"child outside parent", [](BuildArrays& p) { p.nodes[0].boundsMax[0] += 1e4f; p.nodes[0].sphereCenter[0] += 1e4f; }, "bad tree"},
+        {"triangle index too big", [](BuildArrays& p) { p.indices[0] = 100; }, "index out of range"},
+        {"NaN radius", [](BuildArrays& p) { p.nodes[1].sphereRadius = std::nanf(""); }, "bad value"},
+        {"object in no leaf", [](BuildArrays& p) { p.objectNames.push_back("orphan"); }, "bad tree"},
+        {"cycle", [](BuildArrays& p) {
              // Make the root a child of its first child: no parentless node is left.
              const uint32_t root = static_cast<uint32_t>(p.nodes.size() - 1);
              p.nodes[root].parent = p.childIndices[p.nodes[root].firstChild];
          }, "bad tree"},
-        {"child range past the array", [](BuildParams& p) { p.nodes.back().firstChild = 1u << 30; }, "index out of range"},
-        {"NaN normal", [](BuildParams& p) { p.normals[7] = std::nanf(""); }, "bad value"},
-        {"infinite normal", [](BuildParams& p) { p.normals[3] = INFINITY; }, "bad value"},
-        {"normal not of unit length", [](BuildParams& p) { p.normals[0] *= 1.01f, p.normals[1] *= 1.01f, p.normals[2] *= 1.01f; }, "bad value"},
-        {"zero normal", [](BuildParams& p) { std::fill(p.normals.end() - 3, p.normals.end(), 0.0f); }, "bad value"},
-        {"one normal missing", [](BuildParams& p) { p.normals.resize(p.normals.size() - 3); }, "normals"},
-        {"one colour missing", [](BuildParams& p) { p.colors.resize(p.colors.size() - 4); }, "colors"},
-        {"leaf with an aggregate level", [](BuildParams& p) { p.nodes[0].level = 0; }, "bad value"},
-        {"inner node with the leaf level", [](BuildParams& p) { p.nodes.back().level = kLeafLevel; }, "bad value"},
-        {"per-object LOD of several objects", [](BuildParams& p) { p.nodes.back().level = kObjectLodLevel; }, "bad value"},
-        {"level out of range", [](BuildParams& p) { p.nodes.back().level = kMaxAggregateLevel; }, "bad value"},
-        {"coarser version with two children", [](BuildParams& p) { p.nodes.back().level = kCoarserLevel; }, "coarser version"},
+        {"child range past the array", [](BuildArrays& p) { p.nodes.back().firstChild = 1u << 30; }, "index out of range"},
+        {"NaN normal", [](BuildArrays& p) { p.normals[7] = std::nanf(""); }, "bad value"},
+        {"infinite normal", [](BuildArrays& p) { p.normals[3] = INFINITY; }, "bad value"},
+        {"normal not of unit length", [](BuildArrays& p) { p.normals[0] *= 1.01f, p.normals[1] *= 1.01f, p.normals[2] *= 1.01f; }, "bad value"},
+        {"zero normal", [](BuildArrays& p) { std::fill(p.normals.end() - 3, p.normals.end(), 0.0f); }, "bad value"},
+        {"one normal missing", [](BuildArrays& p) { p.normals.resize(p.normals.size() - 3); }, "normals"},
+        {"one colour missing", [](BuildArrays& p) { p.colors.resize(p.colors.size() - 4); }, "colors"},
+        {"leaf with an aggregate level", [](BuildArrays& p) { p.nodes[0].level = 0; }, "bad value"},
+        {"inner node with the leaf level", [](BuildArrays& p) { p.nodes.back().level = kLeafLevel; }, "bad value"},
+        {"per-object LOD of several objects", [](BuildArrays& p) { p.nodes.back().level = kObjectLodLevel; }, "bad value"},
+        {"level out of range", [](BuildArrays& p) { p.nodes.back().level = kMaxAggregateLevel; }, "bad value"},
+        {"coarser version with two children", [](BuildArrays& p) { p.nodes.back().level = kCoarserLevel; }, "coarser version"},
     };
     for (const Case& c : cases) {
-        BuildParams p = good;
+        BuildArrays p = good;
         c.breakIt(p);
         std::vector<uint8_t> bytes;
         std::string error;
@@ -262,7 +262,7 @@ SectionEntry sectionEntry(const std::vector<uint8_t>& bytes, uint32_t kind) {
 
 TEST(RuntimeFormat, NormalsAndColorsSectionsAreOnePerVertex) {
     using namespace aggrelod::runtime::layout;
-    const BuildParams p = makeSyntheticHierarchy(30, 9);
+    const BuildArrays p = makeSyntheticHierarchy(30, 9);
     const std::vector<uint8_t> bytes = writeOrDie(p);
     const SectionEntry positions = sectionEntry(bytes, kPositions), normals = sectionEntry(bytes, kNormals),
                        colors = sectionEntry(bytes, kColors);
@@ -377,7 +377,7 @@ TEST(RuntimeFormat, ColorEncodingIsSrgbWithLinearAlpha) {
 }
 
 TEST(RuntimeFormat, PerObjectLodNodesAreAcceptedAndRoundTrip) {
-    const BuildParams p = makeSyntheticHierarchy(50, 12, 3, 1, 1.0f, 2);
+    const BuildArrays p = makeSyntheticHierarchy(50, 12, 3, 1, 1.0f, 2);
     const std::vector<uint8_t> bytes = writeOrDie(p);
     RuntimeFile file;
     std::string message;
@@ -406,4 +406,33 @@ TEST(RuntimeFormat, MisalignedBufferIsRefused) {
     std::string message;
     EXPECT_EQ(RuntimeFile::openMemory(shifted.data() + 4, good.size(), file, message), FileStatus::Misaligned);
     EXPECT_FALSE(file.isOpen());
+}
+
+// The contract is views of arrays the caller owns: arrays elsewhere than in a BuildArrays
+// (here copies in other vectors) give the same bytes, the file's node records are written as
+// given, and a count without data is refused instead of read.
+TEST(RuntimeFormat, ParamsAreViewsOfTheCallersArrays) {
+    const BuildArrays arrays = makeSyntheticHierarchy(40, 5);
+    const std::vector<uint8_t> expected = writeOrDie(arrays);
+    const std::vector<NodeRecord> nodes = arrays.nodes;
+    const std::vector<float> positions = arrays.positions;
+    BuildParams p = arrays.params();
+    p.nodes = nodes.data();
+    p.positions = positions.data();
+    std::vector<uint8_t> bytes;
+    std::string error;
+    ASSERT_TRUE(writeRuntimeFile(p, bytes, error)) << error;
+    EXPECT_EQ(bytes, expected);
+    RuntimeFile file;
+    std::string message;
+    ASSERT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), file, message), FileStatus::Ok) << message;
+    ASSERT_EQ(file.nodeCount(), nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i)
+        EXPECT_EQ(std::memcmp(&file.node(uint32_t(i)), &nodes[i], sizeof(NodeRecord)), 0) << "node " << i;
+
+    BuildParams missing = arrays.params();
+    missing.indices = nullptr;
+    EXPECT_FALSE(writeRuntimeFile(missing, bytes, error));
+    EXPECT_NE(error.find("count but no data"), std::string::npos) << error;
+    EXPECT_TRUE(bytes.empty());
 }

@@ -26,7 +26,7 @@ namespace at = aggrelod::testing;
 
 namespace {
 
-std::vector<uint8_t> writeOrDie(const BuildParams& p) {
+std::vector<uint8_t> writeOrDie(const BuildArrays& p) {
     std::vector<uint8_t> bytes;
     std::string error;
     EXPECT_TRUE(writeRuntimeFile(p, bytes, error)) << error;
@@ -59,13 +59,13 @@ NodeRecord* nodesOf(std::vector<uint8_t>& bytes, uint64_t& count) {
 
 /// A valid chain: one leaf under `depth - 1` per-object LOD nodes, each with one child;
 /// every node has its own source entry.
-BuildParams makeChain(uint32_t depth) {
-    BuildParams p;
+BuildArrays makeChain(uint32_t depth) {
+    BuildArrays p;
     p.objectNames = {"deep"};
     p.nodes.resize(depth);
     const float lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
     for (uint32_t k = 0; k < depth; ++k) {
-        BuildNode& n = p.nodes[k];
+        NodeRecord& n = p.nodes[k];
         n.firstSource = uint32_t(p.sourceObjects.size());
         n.sourceCount = 1;
         p.sourceObjects.push_back(0);
@@ -137,7 +137,7 @@ TEST(RuntimeHostile, SharedVertexAndIndexRangesAreRefused) {
 
 TEST(RuntimeHostile, SharedRangesCostLinearTime) {
     // The forgery of the report: many nodes sharing one large index range. Refused quickly.
-    BuildParams p = makeSyntheticHierarchy(2000, 5);
+    BuildArrays p = makeSyntheticHierarchy(2000, 5);
     std::vector<uint8_t> bytes = writeOrDie(p);
     uint64_t count = 0;
     NodeRecord* nodes = nodesOf(bytes, count);
@@ -158,7 +158,7 @@ TEST(RuntimeHostile, ChildLevelMustBeBelowItsParents) {
     // Chains of per-object LODs are the one exception.
     std::string chainMessage;
     EXPECT_EQ(openCopy(writeOrDie(makeChain(5)), chainMessage), FileStatus::Ok) << chainMessage;
-    const BuildParams p = makeSyntheticHierarchy(60, 4);
+    const BuildArrays p = makeSyntheticHierarchy(60, 4);
     std::vector<uint8_t> bytes = writeOrDie(p);
     uint64_t count = 0;
     NodeRecord* nodes = nodesOf(bytes, count);

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<uint8_t> bytesOf(const BuildParams& p) {
+std::vector<uint8_t> bytesOf(const BuildArrays& p) {
     std::vector<uint8_t> bytes;
     std::string error;
     EXPECT_TRUE(writeRuntimeFile(p, bytes, error)) << error;

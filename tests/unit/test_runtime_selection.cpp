@@ -22,7 +22,7 @@ namespace {
 struct OpenedHierarchy {
     std::vector<uint8_t> bytes;
     RuntimeFile file;
-    explicit OpenedHierarchy(const BuildParams& p) {
+    explicit OpenedHierarchy(const BuildArrays& p) {
         std::string error;
         EXPECT_TRUE(writeRuntimeFile(p, bytes, error)) << error;
         EXPECT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), file, error), FileStatus::Ok) << error;
@@ -256,14 +256,14 @@ TEST(RuntimeSelection, ExactWithSpheresThatNestOnlyWithinTheFileSlack) {
     // inside its refine sphere on the side away from its parent's centre (where the file's
     // raw sse is larger for the child than for the parent: near-tie decisions). Incremental
     // and full selection must agree at every frame, with an exact cover.
-    BuildParams p = makeSyntheticHierarchy(600, 21, 2, 1, 0.02f);
+    BuildArrays p = makeSyntheticHierarchy(600, 21, 2, 1, 0.02f);
     for (size_t i = 0; i < p.nodes.size(); ++i) {  // children come first (post-order)
-        BuildNode& node = p.nodes[i];
+        NodeRecord& node = p.nodes[i];
         if (node.childCount == 0) continue;
         node.geometricError = 1.0f;
         double reach = 0;
         for (uint32_t k = 0; k < node.childCount; ++k) {
-            const BuildNode& c = p.nodes[p.childIndices[node.firstChild + k]];
+            const NodeRecord& c = p.nodes[p.childIndices[node.firstChild + k]];
             double d2 = 0;
             for (int a = 0; a < 3; ++a) d2 += std::pow(double(c.sphereCenter[a]) - node.sphereCenter[a], 2);
             reach = std::max(reach, std::sqrt(d2) + c.sphereRadius);

@@ -1,12 +1,18 @@
 // SPDX-License-Identifier: MIT
 // aggrelod runtime: the whole contract between the bake and the runtime (as Recast's
-// dtNavMeshCreateParams). The bake fills one BuildParams with flat arrays; writeRuntimeFile
-// turns it into the versioned `.aglod` blob that the runtime reads in place (docs/design.md §4).
-// Standard library only.
+// dtNavMeshCreateParams). The module fills a BuildArrays (aggrelod/hierarchy_export.h); its
+// BuildParams view of pointers and counts goes to writeRuntimeFile, which turns it into the
+// versioned `.aglod` blob that the runtime reads in place (docs/design.md §4). The one node
+// record is the file's own. Standard library only: the one runtime header the module may
+// include (it links nothing of the runtime).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace aggrelod::runtime {
@@ -14,12 +20,13 @@ namespace aggrelod::runtime {
 /// No parent / no index.
 constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
 
-/// One node of the hierarchy. Leaves are the original objects (geometricError 0, level
-/// kLeafLevel); inner nodes are aggregates (proxies, level 0, 1, ...) or simplified versions
-/// of one object (level kObjectLodLevel, between a leaf and its first aggregate). Ranges
-/// index the arrays of BuildParams.
-struct BuildNode {
-    uint32_t parent = kNoIndex;      ///< index into BuildParams::nodes; kNoIndex for roots
+/// One node of the hierarchy, exactly as the file stores it (88 bytes, little-endian; the
+/// reader's RuntimeFile::node returns it in place). Leaves are the original objects
+/// (geometricError 0, level kLeafLevel); inner nodes are aggregates (proxies, level 0, 1, ...)
+/// or simplified versions of one object (level kObjectLodLevel, between a leaf and its first
+/// aggregate). Ranges index the arrays of BuildParams (and of the file).
+struct NodeRecord {
+    uint32_t parent = kNoIndex;      ///< index into the nodes; kNoIndex for roots
     uint32_t firstChild = 0;         ///< range [firstChild, firstChild+childCount) in childIndices
     uint32_t childCount = 0;
     uint32_t firstSource = 0;        ///< range in sourceObjects: original objects this node stands for
@@ -38,6 +45,7 @@ struct BuildNode {
     float sphereCenter[3] = {0, 0, 0};  ///< bounding sphere, contains the children's
     float sphereRadius = 0.0f;
 };
+static_assert(sizeof(NodeRecord) == 88, "NodeRecord is the on-disk layout");
 
 /// Level of the leaves (the original objects).
 constexpr uint32_t kLeafLevel = 0xFFFFu;
@@ -62,22 +70,68 @@ constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
 constexpr double kNestingSlack = 1e-5;
 constexpr double kSphereMargin = 1e-6;
 
-/// Everything the runtime file holds. Arrays are owned by the caller.
+/// Everything the runtime file holds, as views of arrays the caller owns (pointer and count;
+/// a null pointer is allowed with a count of 0). The whole contract between the bake and the
+/// runtime; BuildArrays owns such arrays and hands out this view.
 struct BuildParams {
-    std::vector<BuildNode> nodes;        ///< parents may come before or after children
-    std::vector<uint32_t> childIndices;  ///< node indices
-    std::vector<uint32_t> sourceObjects; ///< original object indices in [0, objectNames.size())
-    std::vector<float> positions;        ///< xyz per vertex, world units (3 floats per vertex)
-    /// Unit normal per vertex (3 floats per vertex, same count as positions), outward; a mesh
-    /// vertex on a crease or a colour boundary is split into one vertex per side.
+    const NodeRecord* nodes = nullptr;  ///< parents may come before or after children
+    size_t nodeCount = 0;
+    const uint32_t* childIndices = nullptr;  ///< node indices
+    size_t childIndexCount = 0;
+    const uint32_t* sourceObjects = nullptr;  ///< original object indices in [0, objectCount)
+    size_t sourceObjectCount = 0;
+    const float* positions = nullptr;  ///< xyz per vertex, world units (3 floats per vertex)
+    const float* normals = nullptr;    ///< unit, outward, 3 floats per vertex (normalCount == positionCount)
+    const uint8_t* colors = nullptr;   ///< base colour, 4 bytes per vertex (encodeColorSrgb8)
+    size_t positionCount = 0;          ///< floats in positions (3 per vertex)
+    size_t normalCount = 0;            ///< floats in normals
+    size_t colorCount = 0;             ///< bytes in colors (4 per vertex)
+    const uint32_t* indices = nullptr; ///< 3 per triangle, relative to the node's firstVertex
+    size_t indexCount = 0;
+    const std::string* objectNames = nullptr;  ///< name of each original object (UTF-8)
+    size_t objectCount = 0;
+    uint64_t settingsHash = 0;         ///< hash of the bake settings (for cache invalidation)
+    std::string_view toolVersion;      ///< e.g. "0.1.0"
+};
+
+/// Arrays behind a BuildParams, owned (what the bake fills; field meanings as in BuildParams).
+struct BuildArrays {
+    std::vector<NodeRecord> nodes;
+    std::vector<uint32_t> childIndices;
+    std::vector<uint32_t> sourceObjects;
+    std::vector<float> positions;
+    /// A mesh vertex on a crease or a colour boundary is split into one vertex per side.
     std::vector<float> normals;
-    /// Base colour per vertex, 4 bytes per vertex: RGB sRGB-encoded (as an SRGB8_ALPHA8
-    /// texel), alpha linear; see encodeColorSrgb8 / decodeColorSrgb8.
+    /// RGB sRGB-encoded (as an SRGB8_ALPHA8 texel), alpha linear; see encodeColorSrgb8.
     std::vector<uint8_t> colors;
-    std::vector<uint32_t> indices;       ///< 3 per triangle, relative to the node's firstVertex
-    std::vector<std::string> objectNames;///< name of each original object (UTF-8)
-    uint64_t settingsHash = 0;           ///< hash of the bake settings (for cache invalidation)
-    std::string toolVersion;             ///< e.g. "0.1.0"
+    std::vector<uint32_t> indices;
+    std::vector<std::string> objectNames;
+    uint64_t settingsHash = 0;
+    std::string toolVersion;
+
+    /// Views of these arrays (valid while they are neither resized nor destroyed).
+    BuildParams params() const {
+        BuildParams p;
+        p.nodes = nodes.data();
+        p.nodeCount = nodes.size();
+        p.childIndices = childIndices.data();
+        p.childIndexCount = childIndices.size();
+        p.sourceObjects = sourceObjects.data();
+        p.sourceObjectCount = sourceObjects.size();
+        p.positions = positions.data();
+        p.positionCount = positions.size();
+        p.normals = normals.data();
+        p.normalCount = normals.size();
+        p.colors = colors.data();
+        p.colorCount = colors.size();
+        p.indices = indices.data();
+        p.indexCount = indices.size();
+        p.objectNames = objectNames.data();
+        p.objectCount = objectNames.size();
+        p.settingsHash = settingsHash;
+        p.toolVersion = toolVersion;
+        return p;
+    }
 };
 
 /// Serialises params into a `.aglod` blob (little-endian, 16-byte aligned sections,
@@ -100,11 +154,26 @@ struct BuildParams {
 /// - child error <= parent error (exact), child sphere and box inside the parent's (slack
 ///   kNestingSlack relative to the parent's coordinates).
 bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error);
+/// The same for arrays the caller holds as a BuildArrays.
+inline bool writeRuntimeFile(const BuildArrays& arrays, std::vector<uint8_t>& bytes, std::string& error) {
+    return writeRuntimeFile(arrays.params(), bytes, error);
+}
 
 /// Linear RGBA in [0, 1] (glTF baseColorFactor / COLOR_0 meaning; clamped, NaN -> 0) to the
 /// file's colour bytes: RGB through the sRGB transfer function, alpha linear, rounded to
 /// nearest. decodeColorSrgb8 is its inverse up to that rounding (exact for the 256 codes).
-void encodeColorSrgb8(const float linear[4], uint8_t out[4]);
-void decodeColorSrgb8(const uint8_t encoded[4], float linear[4]);
+/// Inline: the bake encodes with the same code the runtime decodes with, without linking it.
+inline void encodeColorSrgb8(const float linear[4], uint8_t out[4]) {
+    auto clampUnit = [](float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; };  // NaN -> 0
+    auto toByte = [](float unit) { return static_cast<uint8_t>(std::lround(unit * 255.0f)); };
+    auto linearToSrgb = [](float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f; };
+    for (int k = 0; k < 3; ++k) out[k] = toByte(linearToSrgb(clampUnit(linear[k])));
+    out[3] = toByte(clampUnit(linear[3]));
+}
+inline void decodeColorSrgb8(const uint8_t encoded[4], float linear[4]) {
+    auto srgbToLinear = [](float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); };
+    for (int k = 0; k < 3; ++k) linear[k] = srgbToLinear(encoded[k] / 255.0f);
+    linear[3] = encoded[3] / 255.0f;
+}
 
 }  // namespace aggrelod::runtime

@@ -39,22 +39,6 @@ enum class FileStatus : uint32_t {
 /// Short English name of a status, e.g. "checksum mismatch".
 const char* toString(FileStatus status);
 
-/// One node as stored in the file (88 bytes, little-endian, same fields as BuildNode).
-struct NodeRecord {
-    uint32_t parent;
-    uint32_t firstChild, childCount;    ///< range in children()
-    uint32_t firstSource, sourceCount;  ///< range in sourceObjects()
-    uint32_t firstVertex, vertexCount;  ///< range in positions/normals/colors, counted in vertices
-    uint32_t firstIndex, indexCount;    ///< range in indices(); relative to firstVertex
-    uint32_t level;                     ///< aggregate level; kLeafLevel / kObjectLodLevel / kCoarserLevel
-    float delta;                        ///< world units
-    float geometricError;               ///< world units, >= every child's
-    float boundsMin[3], boundsMax[3];   ///< world units, contains the children's
-    float sphereCenter[3];
-    float sphereRadius;
-};
-static_assert(sizeof(NodeRecord) == 88, "NodeRecord is the on-disk layout");
-
 /// A read-only array view (pointer + count) into the file.
 template <class T>
 struct Span {
