@@ -4,6 +4,7 @@
 // graph. Built once per bake; levels only read it.
 #pragma once
 
+#include "neighbourhood_graph.h"
 #include "tetgen_backend.h"
 
 #include <cstdint>
@@ -11,12 +12,9 @@
 
 namespace aggrelod::detail {
 
-/// Statistics of one neighbourhood-graph edge (a < b).
-struct ModelPair {
-    uint32_t a = 0, b = 0;
-    uint32_t edgeCount = 0;         ///< free-space triangulation edges joining a and b
-    double meanEdge = 0;            ///< mean of their lengths
-    double sigmaEdge = 0;           ///< population standard deviation of their lengths
+/// One neighbourhood-graph edge in 3D: the shared pair record (models, edge lengths) and the
+/// distances that can weigh it.
+struct ModelPair : GraphPair {
     double shortestEdge = 0;        ///< the paper's weight (cdt distance)
     int shortestEdgeVertexA = -1;   ///< its endpoint on a (tet mesh vertex)
     int shortestEdgeVertexB = -1;   ///< its endpoint on b
@@ -26,12 +24,7 @@ struct ModelPair {
     uint32_t closestTriangleA = ~0u; ///< triangle of a's surface holding closestA (~0u: unknown)
     uint32_t closestTriangleB = ~0u;
     double weight = 0;              ///< the one used for grouping (exact or cdt)
-    uint32_t firstLength = 0;       ///< this pair's edge lengths: FreeSpace::lengths[firstLength .. + edgeCount)
 };
-
-/// tetEdgePair values that are not pair indices.
-constexpr int kSameModelEdge = -1;  ///< both ends on one model (or on Steiner points only)
-constexpr int kUnpairedEdge = -2;   ///< two models with no pair statistics
 
 struct FreeSpace {
     TetMesh mesh;
@@ -47,16 +40,7 @@ struct FreeSpace {
     /// tet can ever be on an aggregate's surface, so scans skip object interiors.
     std::vector<uint8_t> objectFaceMask;
     size_t modelCount = 0;
-    std::vector<double> lengths;        ///< per pair, ascending free-space edge lengths (see ModelPair)
-    std::vector<double> lengthPrefix;   ///< running sum of lengths within each pair
-    std::vector<double> lengthSqPrefix; ///< running sum of squared lengths within each pair
-
-    /// Mean and population standard deviation of pair p's edge lengths shorter than `limit`
-    /// (0, 0 when there is none). Returns how many edges were counted.
-    uint32_t edgeStatsBelow(const ModelPair& p, double limit, double& mean, double& sigma) const;
-
-    /// Index into `pairs` of (a, b) in any order, or -1.
-    int findPair(uint32_t a, uint32_t b) const;
+    PairEdgeLengths edgeLengths;    ///< per pair: its free-space edge lengths (see GraphPair)
 };
 
 }  // namespace aggrelod::detail

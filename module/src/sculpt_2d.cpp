@@ -39,18 +39,10 @@ EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const A
         in.delta = delta;
         in.minDistance = pair.minDistance;
         // sigma over the joining edges shorter than delta (see aggregate_function.cpp).
-        const double* lengths = space.pairLengths.data() + pair.firstLength;
-        const double* prefixSum = space.pairPrefixSum.data() + pair.firstPrefix;
-        const double* prefixSumSquares = space.pairPrefixSumSquares.data() + pair.firstPrefix;
-        const size_t k = static_cast<size_t>(std::lower_bound(lengths, lengths + pair.lengthCount, delta) - lengths);
-        auto stats = [&](size_t count, double& mean, double& sigma) {
-            if (count == 0) { mean = sigma = 0; return; }
-            mean = prefixSum[count] / static_cast<double>(count);
-            sigma = std::sqrt(std::max(0.0, prefixSumSquares[count] / static_cast<double>(count) - mean * mean));
-        };
-        double meanAll = 0;
-        stats(k, in.meanEdgeLength, in.sigma);
-        stats(pair.lengthCount, meanAll, in.sigmaAllEdges);
+        const EdgeLengthStatistics shorter = space.edgeLengths.below(pair, delta);
+        in.meanEdgeLength = shorter.mean;
+        in.sigma = shorter.sigma;
+        in.sigmaAllEdges = space.edgeLengths.all(pair).sigma;
         limits.pair[p] = function(in);
     }
     // (A NaN limit never carves, so it is left out.)
@@ -102,7 +94,7 @@ struct Sculptor2D {
 
     double limitOf(int pairIndex) const {
         if (pairIndex >= 0) return limits.pair[pairIndex];
-        return pairIndex == kSameModelEdge2D ? limits.sameModel : limits.unpaired;
+        return pairIndex == kSameModelEdge ? limits.sameModel : limits.unpaired;
     }
 
     // The fan of least total area among the slot's walks whose faces are all kept in the

@@ -627,29 +627,6 @@ struct BorrowedBuffers {
 };
 }  // namespace
 
-int FreeSpace::findPair(uint32_t a, uint32_t b) const {
-    if (a > b) std::swap(a, b);
-    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(a, b),
-                               [](const ModelPair& p, const std::pair<uint32_t, uint32_t>& key) {
-                                   return std::tie(p.a, p.b) < std::tie(key.first, key.second);
-                               });
-    if (it == pairs.end() || it->a != a || it->b != b) return -1;
-    return static_cast<int>(it - pairs.begin());
-}
-
-uint32_t FreeSpace::edgeStatsBelow(const ModelPair& p, double limit, double& mean, double& sigma) const {
-    const double* begin = lengths.data() + p.firstLength;
-    const double* end = begin + p.edgeCount;
-    const uint32_t n = static_cast<uint32_t>(std::lower_bound(begin, end, limit) - begin);
-    mean = sigma = 0;
-    if (n == 0) return 0;
-    const double sum = lengthPrefix[p.firstLength + n - 1];
-    const double sumSq = lengthSqPrefix[p.firstLength + n - 1];
-    mean = sum / n;
-    sigma = std::sqrt(std::max(0.0, sumSq / n - mean * mean));
-    return n;
-}
-
 void precomputeTetEdges(FreeSpace& space, int threadCount) {
     const TetMesh& mesh = space.mesh;
     const size_t tetCount = mesh.tetCount();
@@ -687,7 +664,7 @@ void precomputeTetEdges(FreeSpace& space, int threadCount) {
             if (mv < 0) mv = mu;
             int pair = kSameModelEdge;
             if (mu >= 0 && mu != mv) {
-                pair = space.findPair(static_cast<uint32_t>(mu), static_cast<uint32_t>(mv));
+                pair = findPair(space.pairs, static_cast<uint32_t>(mu), static_cast<uint32_t>(mv));
                 if (pair < 0) pair = kUnpairedEdge;
             }
             space.tetEdgePair[6 * t + e] = pair;
@@ -710,8 +687,10 @@ EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const Aggrega
         AggregateFunctionInput pin;
         pin.delta = delta;
         pin.minDistance = distance == DistanceMode::Exact ? pair.exactDistance : pair.shortestEdge;
-        space.edgeStatsBelow(pair, delta, pin.meanEdgeLength, pin.sigma);
-        pin.sigmaAllEdges = pair.sigmaEdge;
+        const EdgeLengthStatistics shorter = space.edgeLengths.below(pair, delta);
+        pin.meanEdgeLength = shorter.mean;
+        pin.sigma = shorter.sigma;
+        pin.sigmaAllEdges = space.edgeLengths.all(pair).sigma;
         limits.pair[p] = function(pin);
     }
     return limits;

@@ -107,6 +107,10 @@ struct SolidMeasures {
     double sphericity = 0;   ///< pi^(1/3) (6V)^(2/3) / A of the total V and A; 1 for one sphere
 };
 
+/// pi^(1/3) (6 V)^(2/3) / A for a volume V (units^3, negative counts as 0) and area A
+/// (units^2); 0 when A == 0. The 3D counterpart of circularity().
+double sphericity(double volume, double area);
+
 /// One aggregate: the watertight proxy of one group of models at one level.
 struct Aggregate {
     std::vector<double> positions;       ///< 3 * vertexCount
