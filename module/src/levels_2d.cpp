@@ -27,23 +27,23 @@ void buildLevels2D(const std::vector<Feature2D>& features, const Settings2D& set
     // F of every pair at every level: a custom function (user code) on the calling thread, the
     // built-in ones inside the parallel level loop below.
     const size_t levelCount = deltas.size();
-    std::vector<EdgeLimits2D> primaryLimits(levelCount), constantLimits(levelCount), adaptiveLimits(levelCount);
+    std::vector<EdgeLimits> primaryLimits(levelCount), constantLimits(levelCount), adaptiveLimits(levelCount);
     const bool limitsInLevels = !settings.customFunction;
     for (size_t li = 0; li < levelCount && !limitsInLevels; ++li) {
-        if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
+        if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits(space, deltas[li], primary);
         if (settings.computeBaselines) {
-            constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
-            adaptiveLimits[li] = computeEdgeLimits2D(space, deltas[li], adaptive);
+            constantLimits[li] = computeEdgeLimits(space, deltas[li], constant);
+            adaptiveLimits[li] = computeEdgeLimits(space, deltas[li], adaptive);
         }
     }
     // Levels are independent: sculpted in parallel, each writing only its own slot.
     out.levels.resize(levelCount);
     auto buildLevel = [&](size_t li) {
         if (limitsInLevels) {
-            if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits2D(space, deltas[li], primary);
+            if (settings.shape == Shape2D::Sculpted) primaryLimits[li] = computeEdgeLimits(space, deltas[li], primary);
             if (settings.computeBaselines) {
-                constantLimits[li] = computeEdgeLimits2D(space, deltas[li], constant);
-                adaptiveLimits[li] = computeEdgeLimits2D(space, deltas[li], adaptive);
+                constantLimits[li] = computeEdgeLimits(space, deltas[li], constant);
+                adaptiveLimits[li] = computeEdgeLimits(space, deltas[li], adaptive);
             }
         }
         Level2D& level = out.levels[li];

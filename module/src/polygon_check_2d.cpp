@@ -4,6 +4,8 @@
 // the lower-left corner of their boxes' overlap), so the check is near-linear.
 #include "polygon_check_2d.h"
 
+#include "radix_sort.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -143,11 +145,9 @@ void sortGridEntries(std::vector<std::pair<long long, uint32_t>>& entries, size_
         std::sort(entries.begin(), entries.end());
         return;
     }
-    std::vector<uint32_t> start(cellCount + 1, 0);
-    for (const auto& e : entries) ++start[static_cast<size_t>(e.first) + 1];
-    for (size_t c = 0; c < cellCount; ++c) start[c + 1] += start[c];
-    std::vector<std::pair<long long, uint32_t>> sorted(entries.size());
-    for (const auto& e : entries) sorted[start[static_cast<size_t>(e.first)]++] = e;
+    std::vector<uint32_t> start;
+    std::vector<std::pair<long long, uint32_t>> sorted;
+    countingSortByBucket(entries, cellCount, [](const std::pair<long long, uint32_t>& e) { return e.first; }, start, sorted);
     entries = std::move(sorted);
 }
 

@@ -13,6 +13,7 @@
 // otherwise they touch at a point and come out as two polygons of one MultiPolygon.
 #include "sculpt_2d.h"
 
+#include "carve.h"
 #include "parallel_for.h"
 #include "polygon_check_2d.h"
 #include "radix_sort.h"
@@ -24,44 +25,12 @@
 #include <numeric>
 
 namespace aggrelod::detail {
-EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function) {
-    EdgeLimits2D limits;
-    AggregateFunctionInput same;
-    same.delta = delta;
-    same.sameModel = true;
-    limits.sameModel = function(same);
-    limits.unpaired = limits.sameModel;
-    limits.delta = delta;
-    limits.pair.resize(space.pairs.size());
-    for (size_t p = 0; p < space.pairs.size(); ++p) {
-        const ModelPair2D& pair = space.pairs[p];
-        AggregateFunctionInput in;
-        in.delta = delta;
-        in.minDistance = pair.minDistance;
-        // sigma over the joining edges shorter than delta (see aggregate_function.cpp).
-        const EdgeLengthStatistics shorter = space.edgeLengths.below(pair, delta);
-        in.meanEdgeLength = shorter.mean;
-        in.sigma = shorter.sigma;
-        in.sigmaAllEdges = space.edgeLengths.all(pair).sigma;
-        limits.pair[p] = function(in);
-    }
-    // (A NaN limit never carves, so it is left out.)
-    limits.smallest = INFINITY;
-    auto least = [&](double limit) {
-        if (limit < limits.smallest) limits.smallest = limit;
-    };
-    least(limits.sameModel);
-    least(limits.unpaired);
-    for (double limit : limits.pair) least(limit);
-    return limits;
-}
-
 namespace {
 
 struct Sculptor2D {
     const FreeSpace2D& space;
     const std::vector<uint32_t>& modelGroup;
-    const EdgeLimits2D& limits;
+    const EdgeLimits& limits;
     std::vector<int>& label;
     std::vector<char> isProtected;
 
@@ -147,22 +116,18 @@ struct Sculptor2D {
     // others are left off the stack (carving is monotone, so this changes nothing).
     bool mayCarve(int f) const { return space.faceLongest[f] > limits.smallest; }
 
+    // Step 2 (carve.h).
     void carve() {
-        const size_t faceCount = tri().faceCount();
-        std::vector<int> stack;
-        for (size_t f = 0; f < faceCount; ++f)
-            if (space.faceModel[f] < 0 && label[f] >= 0 && mayCarve(static_cast<int>(f))) stack.push_back(static_cast<int>(f));
-        while (!stack.empty()) {
-            const int f = stack.back();
-            stack.pop_back();
-            if (label[f] < 0 || isProtected[f] || !mustCarve(f)) continue;
-            const int group = label[f];
-            label[f] = -1;
-            for (int j = 0; j < 3; ++j) {
-                const int n = tri().neighbors[3 * f + j];
-                if (isKeptFree(n, group) && mayCarve(n)) stack.push_back(n);
-            }
-        }
+        const int faceCount = static_cast<int>(tri().faceCount());
+        carveFromOutside<3>(
+            label,
+            [&](auto&& push) {
+                for (int f = 0; f < faceCount; ++f) push(f);
+            },
+            [&](int f, int j) { return tri().neighbors[3 * f + j]; },
+            [&](int f) {
+                return space.faceModel[f] < 0 && label[f] >= 0 && !isProtected[f] && mayCarve(f) && mustCarve(f);
+            });
     }
 };
 
@@ -255,7 +220,7 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
     return fans;
 }
 
-void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
+void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits& limits,
                    const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel) {
     Sculptor2D s{space, modelGroup, limits, faceLabel, {}};
     s.initialLabels();

@@ -3,22 +3,12 @@
 // into OGC-valid polygons with holes.
 #pragma once
 
+#include "edge_limits.h"
 #include "free_space_2d.h"
 
 #include <vector>
 
 namespace aggrelod::detail {
-
-/// F of every model pair at one level (docs/design.md §2.4 step 3), evaluated once per level.
-struct EdgeLimits2D {
-    double sameModel = 0;      ///< F for an edge with both ends on one model
-    double unpaired = 0;       ///< F for an edge with a Steiner end
-    double delta = 0;          ///< the level threshold
-    std::vector<double> pair;  ///< per FreeSpace2D::pairs entry
-    double smallest = 0;       ///< the least of all these limits: no face whose edges are all this short is carved
-};
-
-EdgeLimits2D computeEdgeLimits2D(const FreeSpace2D& space, double delta, const AggregateFunction& function);
 
 /// The fans of free faces that can carry each merge's shortest connection to its two models
 /// (docs/design.md §2.4 step 4), walked once for all levels. The merges are kept in `order`, by their
@@ -43,7 +33,7 @@ ConnectionFans2D computeConnectionFans2D(const FreeSpace2D& space, const std::ve
 /// Labels every face with the group whose aggregate contains it (-1: in none).
 /// The first `joinedMerges` merges (those of this level) keep their shortest connection
 /// (docs/design.md §2.4 step 4), through `fans`.
-void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits2D& limits,
+void sculptLevel2D(const FreeSpace2D& space, const std::vector<uint32_t>& modelGroup, const EdgeLimits& limits,
                    const ConnectionFans2D& fans, size_t joinedMerges, std::vector<int>& faceLabel);
 
 /// Total area and boundary length of the labelled faces (all groups).

@@ -13,6 +13,7 @@
 // adjacency, Euclidean costs), so joined models always come out as one solid.
 #include "sculpt_3d.h"
 
+#include "carve.h"
 #include "parallel_for.h"
 #include "radix_sort.h"
 
@@ -545,27 +546,15 @@ struct Sculptor {
         return changed;
     }
 
-    // Removal is monotone (a removable tet stays removable until removed: removing a tet
-    // only exposes more facets), so the removed set does not depend on the order; a plain
-    // stack visits it in linear time.
+    // Step 2 (carve.h): only the active tets can be kept free ones.
     void carve() {
-        std::vector<int> stack;
-        for (int t : active) {
-            if (space.tetModel[t] >= 0 || label[t] < 0 || isProtected[t]) continue;
-            if (carvePriority(t) > 0) stack.push_back(t);
-        }
-        while (!stack.empty()) {
-            const int t = stack.back();
-            stack.pop_back();
-            if (label[t] < 0) continue;  // already removed
-            const int group = label[t];
-            label[t] = -1;
-            for (int j = 0; j < 4; ++j) {
-                int n = mesh.neighbors[4 * t + j];
-                if (!isKeptFree(n, group) || isProtected[n]) continue;
-                if (carvePriority(n) > 0) stack.push_back(n);
-            }
-        }
+        carveFromOutside<4>(
+            label,
+            [&](auto&& push) {
+                for (int t : active) push(t);
+            },
+            [&](int t, int j) { return mesh.neighbors[4 * t + j]; },
+            [&](int t) { return space.tetModel[t] < 0 && label[t] >= 0 && !isProtected[t] && carvePriority(t) > 0; });
     }
 };
 
@@ -670,30 +659,6 @@ void precomputeTetEdges(FreeSpace& space, int threadCount) {
             space.tetEdgePair[6 * t + e] = pair;
         }
     });
-}
-
-EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
-                             DistanceMode distance) {
-    EdgeLimits limits;
-    AggregateFunctionInput in;
-    in.delta = delta;
-    in.sameModel = true;
-    limits.sameModel = function(in);
-    in.sameModel = false;
-    limits.unpaired = function(in);
-    limits.pair.resize(space.pairs.size());
-    for (size_t p = 0; p < space.pairs.size(); ++p) {
-        const ModelPair& pair = space.pairs[p];
-        AggregateFunctionInput pin;
-        pin.delta = delta;
-        pin.minDistance = distance == DistanceMode::Exact ? pair.exactDistance : pair.shortestEdge;
-        const EdgeLengthStatistics shorter = space.edgeLengths.below(pair, delta);
-        pin.meanEdgeLength = shorter.mean;
-        pin.sigma = shorter.sigma;
-        pin.sigmaAllEdges = space.edgeLengths.all(pair).sigma;
-        limits.pair[p] = function(pin);
-    }
-    return limits;
 }
 
 void sculptLevel(const FreeSpace& space, const LevelShapeRequest& request, std::vector<int>& tetLabel,

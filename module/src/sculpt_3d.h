@@ -3,6 +3,7 @@
 // aggregate surfaces (docs/design.md §2.4 step 5).
 #pragma once
 
+#include "edge_limits.h"
 #include "free_space.h"
 
 #include <aggrelod/aggregate3d.h>
@@ -20,21 +21,9 @@ struct ProtectedConnection {
     double pointB[3] = {0, 0, 0};
 };
 
-/// F of every model pair at one level, evaluated once (the carving loop only looks it up,
-/// so levels can be sculpted on several threads without calling user code there).
-struct EdgeLimits {
-    double sameModel = 0;       ///< F for an edge with both ends on one model (or Steiner points)
-    double unpaired = 0;        ///< F for two models with no free-space edge statistics
-    std::vector<double> pair;   ///< per FreeSpace::pairs entry
-};
-
 /// Fills space.tetEdgeLength, tetEdgePair and surfaceTetsOfModel (after the pairs are
 /// built): every level then only looks them up. threadCount: as Settings3D::threadCount.
 void precomputeTetEdges(FreeSpace& space, int threadCount);
-
-/// Evaluates `function` for every pair at threshold delta (docs/design.md §2.4 step 3).
-EdgeLimits computeEdgeLimits(const FreeSpace& space, double delta, const AggregateFunction& function,
-                             DistanceMode distance);
 
 /// Buffers that sculptLevel and extractSurfaces reuse from one level to the next (each call
 /// fills them afresh: reuse never changes a result, it only saves allocating and

@@ -183,6 +183,12 @@ struct Hierarchy3D {
     std::vector<uint32_t> leftOutObjects;
 };
 
+/// The 3D result types under the names of their 2D counterparts (Measures2D, Aggregate2D,
+/// Level2D); the same types.
+using Measures3D = SolidMeasures;
+using Aggregate3D = Aggregate;
+using Level3D = Level;
+
 /// Bakes the whole hierarchy.
 /// Returns false (with an Error diagnostic in out.diagnostics) when baking cannot go on:
 /// no usable object, or the triangulator failed beyond recovery. Never throws for bad input.
