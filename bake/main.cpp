@@ -20,6 +20,7 @@
 #include <aggrelod/collision.h>
 #include <aggrelod/collision_shapes.h>
 #include <aggrelod/runtime_file.h>
+#include <aggrelod/tiled_bake_3d.h>
 
 #include <CLI/CLI.hpp>
 
@@ -28,6 +29,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -109,6 +111,7 @@ struct BakeOptions {
     int objectDepth = -1;               ///< >= 0: each node at this depth, with its subtree, is one object
     bool includeAnimated = false;
     bool allowExternalUris = false;
+    std::string tileSize;               ///< empty: untiled; "auto" or a length: tiled bake
 };
 
 /// The settings that shape the outputs, as canonical text (hashed into scene.aglod so that an
@@ -125,7 +128,9 @@ std::string settingsText(const BakeOptions& o) {
     text += buffer;
     std::snprintf(buffer, sizeof buffer, ";wrapoffset=%.17g;depth=%d;animated=%d", o.wrapOffset, o.objectDepth,
                   o.includeAnimated ? 1 : 0);
-    return text + ";solidify=" + o.solidify + ";support=" + o.support + buffer;
+    text += ";solidify=" + o.solidify + ";support=" + o.support + buffer;
+    if (!o.tileSize.empty()) text += ";tile=" + o.tileSize;  // only when tiled: untiled hashes stay as they were
+    return text;
 }
 
 CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
@@ -178,6 +183,17 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                   "Bake animated and skinned nodes at their rest pose (default: left out and listed)");
     cmd->add_flag("--allow-external-uris", o.allowExternalUris,
                   "Let buffer uris name files outside the input's folder (refused by default)");
+    cmd->add_option("--tile-size", o.tileSize,
+                    "Tiled bake for large worlds: cells of this side (scene units) baked one at a time for the levels "
+                    "up to an eighth of it, a quadtree of parent cells above; 'auto' tiles worlds of over 4,000 "
+                    "objects into cells of about 2,000 (default: one piece; see docs/command-line.md)")
+        ->check([](const std::string& v) -> std::string {
+            if (v == "auto") return {};
+            char* end = nullptr;
+            const double d = std::strtod(v.c_str(), &end);
+            if (end == v.c_str() || *end != '\0' || !(d > 0) || !std::isfinite(d)) return "expects 'auto' or a length > 0";
+            return {};
+        });
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
     cmd->add_flag("--constant-baseline", o.constantBaseline,
                   "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
@@ -394,7 +410,9 @@ int runBake(BakeOptions o) {
         progress.update(stage, fraction);
     };
     Hierarchy3D hierarchy;
-    const bool ok = buildHierarchy3D(scene.objects, settings, hierarchy);
+    const bool ok = o.tileSize.empty()
+                        ? buildHierarchy3D(scene.objects, settings, hierarchy)
+                        : buildTiledHierarchy3D(scene.objects, settings, o.tileSize == "auto" ? 0.0 : std::strtod(o.tileSize.c_str(), nullptr), hierarchy);
     HierarchyNodes nodes;
     std::string nodeError;
     bool nodesOk = false;

@@ -65,6 +65,21 @@ inline void computeBounds(const std::vector<double>& p, double b[6]) {
         }
 }
 
+/// Diagonal of the box of every finite coordinate of `objects` (0 when none): the scene size
+/// the relative tolerances are taken from.
+inline double finiteDiagonal(const std::vector<InputObject>& objects) {
+    double b[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (const InputObject& o : objects)
+        for (size_t i = 0; i + 2 < o.positions.size(); i += 3) {
+            if (!std::isfinite(o.positions[i]) || !std::isfinite(o.positions[i + 1]) || !std::isfinite(o.positions[i + 2])) continue;
+            for (int k = 0; k < 3; ++k) {
+                b[k] = std::min(b[k], o.positions[i + k]);
+                b[3 + k] = std::max(b[3 + k], o.positions[i + k]);
+            }
+        }
+    return b[0] <= b[3] ? std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2])) : 0.0;
+}
+
 inline bool boxesOverlap(const double* a, const double* b, double pad) {
     for (int k = 0; k < 3; ++k)
         if (a[k] > b[3 + k] + pad || b[k] > a[3 + k] + pad) return false;
@@ -113,6 +128,11 @@ inline SolidMeasures measuresOf(double volume, double area) {
     return m;
 }
 
+/// Per object, 1 when it is a support surface by the rule of Settings3D::support (see
+/// supportSpanFraction). bounds[i]: object i's box (min xyz, max xyz), nullptr when the
+/// object is unusable (never a support surface).
+std::vector<char> findSupportSurfaces(const std::vector<const double*>& bounds, const Settings3D& settings);
+
 /// A vertex of the neighbourhood graph: one object, or objects that touch.
 struct Model {
     std::vector<uint32_t> objects;    ///< ascending input indices
@@ -140,8 +160,12 @@ public:
         : objects_(objects), settings_(settings), out_(out), timer_(out.timings, settings.progress) {}
 
     bool run();
+    /// run() stops once the neighbourhood graph is built: out.merges holds its dendrogram
+    /// and out.levels stays empty (the tiled bake's first pass, for automatic thresholds).
+    void stopAfterGraph() { graphOnly_ = true; }
 
 private:
+    bool graphOnly_ = false;
     const std::vector<InputObject>& objects_;
     const Settings3D& settings_;
     Hierarchy3D& out_;

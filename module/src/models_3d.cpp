@@ -14,17 +14,7 @@ namespace aggrelod::detail {
 bool Baker3D::prepare() {
     timer_.begin("prepare");
     out_.diagnostics.clear();
-    // Scene size from finite coordinates, for relative tolerances.
-    double b[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-    for (const InputObject& o : objects_)
-        for (size_t i = 0; i + 2 < o.positions.size(); i += 3) {
-            if (!std::isfinite(o.positions[i]) || !std::isfinite(o.positions[i + 1]) || !std::isfinite(o.positions[i + 2])) continue;
-            for (int k = 0; k < 3; ++k) {
-                b[k] = std::min(b[k], o.positions[i + k]);
-                b[3 + k] = std::max(b[3 + k], o.positions[i + k]);
-            }
-        }
-    diagonal_ = b[0] <= b[3] ? std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2])) : 0.0;
+    diagonal_ = finiteDiagonal(objects_);  // scene size, for relative tolerances
     tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal_;
     const double areaEpsilon = 1e-14 * diagonal_ * diagonal_;
     for (const InputObject& o : objects_)

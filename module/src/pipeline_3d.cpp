@@ -39,6 +39,11 @@ bool Baker3D::run() {
         }
         buildGraph();
     }
+    if (graphOnly_) {
+        out_.merges = kruskalMerges(models_.size(), weighedGraph());
+        timer_.end();
+        return true;
+    }
     measureSolids();
     buildLevels();
     timer_.end();

@@ -3,6 +3,7 @@
 // nothing touching, blocks independent of the world's size, and a streamed GLB that the
 // validator accepts and the bake's reader reads back as generated.
 #include "scene_io.h"
+#include "generated_world.h"
 #include "test_support.h"
 
 #include <aggrelod/aggregate3d.h>
@@ -23,14 +24,7 @@ using namespace aggrelod::testing;
 
 namespace {
 
-std::vector<InputObject> world(uint64_t count, uint32_t seed = 1) {
-    std::vector<InputObject> objects;
-    samples::WorldSettings settings;
-    settings.objectCount = count;
-    settings.seed = seed;
-    samples::generateWorld(settings, [&](InputObject& o) { objects.push_back(o); });
-    return objects;
-}
+std::vector<InputObject> world(uint64_t count, uint32_t seed = 1) { return aggrelod::testing::generatedWorld(count, seed); }
 
 /// The part of an object's name after the block prefix "bRRRR_CCCC_".
 std::string kindOf(const std::string& name) {

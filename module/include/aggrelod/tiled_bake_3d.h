@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// aggrelod module: the tiled 3D bake for worlds too large for one triangulation
+// (docs/design.md §2.8; grid-cell HLOD as in Unreal's World Partition).
+//
+// The world is cut into square cells of side S along the scene's two longest axes. Each
+// cell is baked alone (buildHierarchy3D on its objects) for the levels with delta <= S / 8;
+// levels above are built by baking the cells' coarsest aggregates as objects in the parent
+// cells of a quadtree (parent cell of quadtree level j: 2^j x 2^j cells). The result is one
+// Hierarchy3D, as buildHierarchy3D gives, for buildHierarchyNodes and every writer.
+//
+// Cell rule: objects whose boxes come within S / 8 of each other (chains included) form a
+// cluster, and a cluster goes whole to the cell holding the box centre of its first object,
+// so no neighbour closer than a cell level's delta is cut off by a border. A cluster wider
+// than S along either axis is split instead: each of its objects goes to the cell of its own
+// box centre (TiledBakeReport counts them; groups there may differ from an untiled bake).
+// Support surfaces are found once on the whole world (Settings3D::support) and passed through.
+//
+// Units: world units. Determinism: cells and parent cells are baked one after another in a
+// fixed order (row-major cell index), so the result depends on the objects and settings only,
+// bit-identical for every thread count.
+#pragma once
+
+#include <aggrelod/aggregate3d.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace aggrelod {
+
+/// What the tiled bake did (also said in a Note diagnostic).
+struct TiledBakeReport {
+    double tileSize = 0;            ///< S, world units (the automatic choice when 0 was asked)
+    double cellTopDelta = 0;        ///< S / 8: cells bake the levels with delta up to this
+    size_t columns = 0, rows = 0;   ///< cells along the scene's longest and second axis
+    size_t cellCount = 0;           ///< cells baked (those holding objects)
+    size_t largestCellObjects = 0;  ///< objects in the fullest cell
+    int quadtreeDepth = 0;          ///< parent levels of cells above the cells
+    size_t parentBakeCount = 0;     ///< parent cells baked (those with two inputs or more)
+    size_t clusterCount = 0;
+    size_t splitClusterCount = 0;   ///< clusters wider than S, split by object centre
+    size_t splitClusterObjects = 0; ///< objects in them
+    bool tiled = false;             ///< false: the world fits one cell and was baked untiled
+};
+
+/// Objects per cell the automatic tile size aims at (tileSize == 0).
+constexpr size_t kAutomaticTileObjects = 2000;
+
+/// Bakes `objects` tiled. tileSize: S in world units (> 0), or 0 for the automatic choice:
+/// untiled up to 2 x kAutomaticTileObjects aggregated objects, else the S that puts about
+/// kAutomaticTileObjects objects in a cell of the world's footprint. A world that fits one
+/// cell is baked by buildHierarchy3D (same result). Explicit settings.deltas need at least one
+/// delta <= S / 8 (cells must have a level). Automatic deltas: a first pass builds each cell's
+/// neighbourhood graph; the automatic rule (Settings3D::automaticLevelCount) runs on all their
+/// merges up to S / 8, and every quadtree level adds one level at delta = S / 8 * 2^j.
+/// Returns false with an Error diagnostic as buildHierarchy3D does. Never throws for bad input.
+bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, double tileSize,
+                           Hierarchy3D& out, TiledBakeReport* report = nullptr);
+
+}  // namespace aggrelod

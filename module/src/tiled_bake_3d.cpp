@@ -1,0 +1,483 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The tiled 3D bake (docs/design.md §2.8): cells of the world baked alone for the fine
+// levels, a quadtree of parent cells aggregating their coarsest aggregates for the coarse
+// ones, combined into one Hierarchy3D. The cell rule and the thresholds are in
+// tiled_bake_3d.h.
+#include "baker_3d.h"
+
+#include <aggrelod/dendrogram.h>
+#include <aggrelod/disjoint_sets.h>
+#include <aggrelod/tiled_bake_3d.h>
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <string>
+
+namespace aggrelod {
+namespace {
+
+using detail::diag;
+using detail::fmt;
+
+/// Box (min xyz, max xyz) of the finite vertices an object's triangles use; false when none.
+bool objectBox(const InputObject& o, double b[6]) {
+    for (int k = 0; k < 3; ++k) {
+        b[k] = INFINITY;
+        b[3 + k] = -INFINITY;
+    }
+    bool any = false;
+    const size_t vertexCount = o.positions.size() / 3;
+    for (size_t t = 0; t + 2 < o.indices.size(); t += 3)
+        for (int c = 0; c < 3; ++c) {
+            const uint32_t v = o.indices[t + c];
+            if (v >= vertexCount) continue;
+            const double* p = &o.positions[3 * size_t(v)];
+            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return false;
+            for (int k = 0; k < 3; ++k) {
+                b[k] = std::min(b[k], p[k]);
+                b[3 + k] = std::max(b[3 + k], p[k]);
+            }
+            any = true;
+        }
+    return any;
+}
+
+/// Level totals from the aggregates (as buildLevels sums them).
+void totalLevel(Level& level) {
+    double volume = 0, area = 0;
+    level.volumeOriginal = level.volumeHull = 0;
+    level.triangleCount = 0;
+    for (const Aggregate& a : level.aggregates) {
+        volume += a.measures.volume;
+        area += a.measures.area;
+        level.volumeOriginal += a.volumeOriginal;
+        level.volumeHull += a.volumeHull;
+        level.triangleCount += a.indices.size() / 3;
+    }
+    level.measures = detail::measuresOf(volume, area);
+}
+
+void addTimings(Hierarchy3D& out, const Hierarchy3D& part) {
+    for (const auto& [stage, seconds] : part.timings) {
+        auto it = std::find_if(out.timings.begin(), out.timings.end(), [&](const auto& t) { return t.first == stage; });
+        if (it == out.timings.end()) out.timings.emplace_back(stage, seconds);
+        else it->second += seconds;
+    }
+}
+
+class TiledBaker {
+public:
+    TiledBaker(const std::vector<InputObject>& objects, const Settings3D& settings, Hierarchy3D& out,
+               TiledBakeReport& report)
+        : objects_(objects), settings_(settings), out_(out), report_(report) {}
+
+    bool run(double tileSize);
+
+private:
+    const std::vector<InputObject>& objects_;
+    const Settings3D& settings_;
+    Hierarchy3D& out_;
+    TiledBakeReport& report_;
+    std::vector<std::array<double, 6>> boxes_;
+    std::vector<char> usable_, support_;
+    int axes_[2] = {0, 1};
+    double origin_[2] = {0, 0};
+    double size_ = 0;
+    double tolerance_ = 0;
+    std::vector<uint32_t> cellOf_;                  ///< per object: its cell (row-major), aggregated objects only
+    std::map<uint32_t, std::vector<uint32_t>> cells_;  ///< cell -> its objects, ascending
+    std::vector<uint32_t> unusable_;                 ///< objects with no finite triangle
+
+    void findSupport();
+    void assignCells();
+    Settings3D cellSettings(const std::vector<double>& deltas) const;
+    std::vector<InputObject> cellObjects(const std::vector<uint32_t>& ids) const;
+    bool automaticCellDeltas(std::vector<double>& deltas);
+    bool fail(const Hierarchy3D& part, const std::string& where);
+};
+
+void TiledBaker::findSupport() {
+    const size_t n = objects_.size();
+    boxes_.resize(n);
+    usable_.assign(n, 0);
+    std::vector<const double*> bounds(n, nullptr);
+    for (size_t i = 0; i < n; ++i)
+        if (objectBox(objects_[i], boxes_[i].data())) {
+            usable_[i] = 1;
+            bounds[i] = boxes_[i].data();
+        } else {
+            unusable_.push_back(static_cast<uint32_t>(i));
+        }
+    support_ = detail::findSupportSurfaces(bounds, settings_);
+}
+
+void TiledBaker::assignCells() {
+    std::vector<uint32_t> ids;
+    for (uint32_t i = 0; i < objects_.size(); ++i)
+        if (usable_[i] && !support_[i]) ids.push_back(i);
+    cellOf_.assign(objects_.size(), UINT32_MAX);
+    const auto cellAt = [&](const double* box) {
+        size_t c[2];
+        for (int j = 0; j < 2; ++j) {
+            const double centre = 0.5 * (box[axes_[j]] + box[3 + axes_[j]]);
+            const double f = std::floor((centre - origin_[j]) / size_);
+            const size_t limit = j == 0 ? report_.columns : report_.rows;
+            c[j] = f <= 0 ? 0 : std::min(limit - 1, static_cast<size_t>(f));
+        }
+        return static_cast<uint32_t>(c[1] * report_.columns + c[0]);
+    };
+    // Clusters: boxes within the cells' top delta of each other, chained.
+    DisjointSets sets(ids.size());
+    for (auto [a, b] : detail::overlappingPairs(ids.size(), [&](uint32_t k) { return boxes_[ids[k]].data(); },
+                                                report_.cellTopDelta))
+        sets.unite(a, b);
+    std::map<uint32_t, std::vector<uint32_t>> clusters;  // root (smallest member) -> members, ascending
+    for (uint32_t k = 0; k < ids.size(); ++k) clusters[sets.find(k)].push_back(k);
+    report_.clusterCount = clusters.size();
+    for (const auto& [root, members] : clusters) {
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        for (uint32_t k : members)
+            for (int j = 0; j < 2; ++j) {
+                lo[j] = std::min(lo[j], boxes_[ids[k]][axes_[j]]);
+                hi[j] = std::max(hi[j], boxes_[ids[k]][3 + axes_[j]]);
+            }
+        const bool split = hi[0] - lo[0] > size_ || hi[1] - lo[1] > size_;
+        if (split) {
+            ++report_.splitClusterCount;
+            report_.splitClusterObjects += members.size();
+        }
+        const uint32_t cell = cellAt(boxes_[ids[root]].data());
+        for (uint32_t k : members) cellOf_[ids[k]] = split ? cellAt(boxes_[ids[k]].data()) : cell;
+    }
+    for (uint32_t i : ids) cells_[cellOf_[i]].push_back(i);
+    for (auto& [cell, members] : cells_) {
+        std::sort(members.begin(), members.end());
+        report_.largestCellObjects = std::max(report_.largestCellObjects, members.size());
+    }
+    report_.cellCount = cells_.size();
+}
+
+Settings3D TiledBaker::cellSettings(const std::vector<double>& deltas) const {
+    Settings3D s = settings_;
+    s.deltas = deltas;
+    s.support = SupportDetection::None;
+    s.supportObjects.clear();
+    s.touchTolerance = tolerance_;  // the whole world's, not the cell's
+    s.progress = nullptr;
+    return s;
+}
+
+std::vector<InputObject> TiledBaker::cellObjects(const std::vector<uint32_t>& ids) const {
+    std::vector<InputObject> cell;
+    cell.reserve(ids.size());
+    for (uint32_t i : ids) cell.push_back(objects_[i]);
+    return cell;
+}
+
+bool TiledBaker::fail(const Hierarchy3D& part, const std::string& where) {
+    for (Diagnostic d : part.diagnostics) {
+        if (d.severity == Diagnostic::Severity::Error) d.message = where + ": " + d.message;
+        out_.diagnostics.push_back(std::move(d));
+    }
+    return false;
+}
+
+// First pass for automatic thresholds: every cell's dendrogram, then the automatic rule
+// (visibleDeltas of the untiled bake) on all their merges up to the cells' top delta.
+bool TiledBaker::automaticCellDeltas(std::vector<double>& deltas) {
+    std::vector<Merge> merges;
+    size_t done = 0;
+    for (const auto& [cell, ids] : cells_) {
+        const std::vector<InputObject> objects = cellObjects(ids);
+        const Settings3D settings = cellSettings({});
+        Hierarchy3D part;
+        detail::Baker3D baker(objects, settings, part);
+        baker.stopAfterGraph();
+        if (!baker.run()) return fail(part, "tile " + std::to_string(cell));
+        for (const Merge& m : part.merges)
+            if (m.height <= report_.cellTopDelta) merges.push_back(m);
+        addTimings(out_, part);
+        if (settings_.progress) settings_.progress("tile graphs", double(++done) / double(cells_.size()));
+    }
+    std::sort(merges.begin(), merges.end(), [](const Merge& a, const Merge& b) { return a.height < b.height; });
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (const auto& [cell, ids] : cells_)
+        for (uint32_t i : ids)
+            for (int k = 0; k < 3; ++k) {
+                box[k] = std::min(box[k], boxes_[i][k]);
+                box[3 + k] = std::max(box[3 + k], boxes_[i][3 + k]);
+            }
+    const double diagonal = std::sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
+                                      (box[5] - box[2]) * (box[5] - box[2]));
+    std::vector<Merge> seen;
+    for (const Merge& m : merges)
+        if (m.height >= 1e-3 * diagonal) seen.push_back(m);
+    if (seen.empty()) seen = merges;
+    const int count = std::max(2, settings_.automaticLevelCount - report_.quadtreeDepth);
+    deltas = automaticDeltas(seen, count - 1);
+    if (!seen.empty() && seen.front().height > 0) deltas.insert(deltas.begin(), 0.5 * seen.front().height);
+    for (double& d : deltas) d = std::min(d, report_.cellTopDelta);
+    std::sort(deltas.begin(), deltas.end());
+    deltas.erase(std::unique(deltas.begin(), deltas.end()), deltas.end());
+    if (deltas.empty()) deltas.push_back(0.0);
+    return true;
+}
+
+bool TiledBaker::run(double tileSize) {
+    findSupport();
+    const double diagonal = detail::finiteDiagonal(objects_);  // as the untiled bake measures the scene
+    tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal;
+
+    // The footprint of the aggregated objects and its two longest axes.
+    double world[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    size_t aggregated = 0;
+    for (size_t i = 0; i < objects_.size(); ++i) {
+        if (!usable_[i] || support_[i]) continue;
+        ++aggregated;
+        for (int k = 0; k < 3; ++k) {
+            world[k] = std::min(world[k], boxes_[i][k]);
+            world[3 + k] = std::max(world[3 + k], boxes_[i][3 + k]);
+        }
+    }
+    if (aggregated == 0) return buildHierarchy3D(objects_, settings_, out_);
+    int axes[3] = {0, 1, 2};
+    std::stable_sort(axes, axes + 3, [&](int x, int y) { return world[3 + x] - world[x] > world[3 + y] - world[y]; });
+    axes_[0] = axes[0];
+    axes_[1] = axes[1];
+    const double extent[2] = {world[3 + axes_[0]] - world[axes_[0]], world[3 + axes_[1]] - world[axes_[1]]};
+    if (tileSize <= 0) {
+        if (aggregated <= 2 * kAutomaticTileObjects) return buildHierarchy3D(objects_, settings_, out_);
+        const double area = std::max(extent[0], 1e-300) * std::max(extent[1], extent[0] * 1e-3);
+        tileSize = std::sqrt(area * double(kAutomaticTileObjects) / double(aggregated));
+    }
+    size_ = tileSize;
+    report_.tileSize = tileSize;
+    report_.cellTopDelta = tileSize / 8;
+    for (int j = 0; j < 2; ++j) origin_[j] = world[axes_[j]];
+    const auto cellsAlong = [&](double e) {
+        const double c = std::ceil(e / tileSize);
+        return c < 1 ? size_t(1) : c > 65536 ? size_t(65536) : static_cast<size_t>(c);
+    };
+    report_.columns = cellsAlong(extent[0]);
+    report_.rows = cellsAlong(extent[1]);
+    if (report_.columns * report_.rows == 1) return buildHierarchy3D(objects_, settings_, out_);
+    report_.tiled = true;
+    while ((size_t(1) << report_.quadtreeDepth) < std::max(report_.columns, report_.rows)) ++report_.quadtreeDepth;
+
+    assignCells();
+    if (!unusable_.empty()) {  // reported (and left out) by the first cell's bake
+        std::vector<uint32_t>& first = cells_.begin()->second;
+        first.insert(first.end(), unusable_.begin(), unusable_.end());
+        std::sort(first.begin(), first.end());
+    }
+
+    // Thresholds: the cells' and those of each quadtree level j (delta <= S / 8 * 2^j).
+    std::vector<double> cellDeltas;
+    std::vector<std::vector<double>> parentDeltas(size_t(report_.quadtreeDepth) + 1);
+    if (!settings_.deltas.empty()) {
+        for (double d : settings_.deltas) {
+            if (d <= report_.cellTopDelta) {
+                cellDeltas.push_back(d);
+                continue;
+            }
+            int j = 1;
+            while (j < report_.quadtreeDepth && d > report_.cellTopDelta * std::ldexp(1.0, j)) ++j;
+            parentDeltas[size_t(j)].push_back(d);
+        }
+        if (cellDeltas.empty()) {
+            diag(out_, Diagnostic::Severity::Error, "",
+                 "a tiled bake with tile size " + fmt(tileSize) + " needs a delta of at most " +
+                     fmt(report_.cellTopDelta) + " (an eighth of the tile size) for the cells' levels");
+            return false;
+        }
+    } else {
+        if (!automaticCellDeltas(cellDeltas)) return false;
+        for (int j = 1; j <= report_.quadtreeDepth; ++j) parentDeltas[size_t(j)].push_back(report_.cellTopDelta * std::ldexp(1.0, j));
+    }
+
+    // Cells.
+    std::vector<Level> levels(cellDeltas.size());
+    for (size_t k = 0; k < levels.size(); ++k) levels[k].delta = cellDeltas[k];
+    std::vector<SolidReport> solids;
+    out_.objectModel.assign(objects_.size(), UINT32_MAX);
+    std::vector<char> leftOut(objects_.size(), 0);
+    size_t done = 0;
+    bool hasConstant = true;
+    for (const auto& [cell, ids] : cells_) {
+        const std::vector<InputObject> objects = cellObjects(ids);
+        const Settings3D settings = cellSettings(cellDeltas);
+        Hierarchy3D part;
+        if (!buildHierarchy3D(objects, settings, part)) return fail(part, "tile " + std::to_string(cell));
+        if (part.levels.size() != levels.size()) {
+            diag(out_, Diagnostic::Severity::Error, "", "tile " + std::to_string(cell) + ": the bake made " +
+                 std::to_string(part.levels.size()) + " levels where " + std::to_string(levels.size()) + " were asked");
+            return false;
+        }
+        for (size_t k = 0; k < levels.size(); ++k) {
+            hasConstant = hasConstant && part.levels[k].hasVolumeConstant;
+            levels[k].volumeConstant += part.levels[k].volumeConstant;
+            for (Aggregate& a : part.levels[k].aggregates) {
+                for (uint32_t& o : a.sourceObjects) o = ids[o];
+                levels[k].aggregates.push_back(std::move(a));
+            }
+        }
+        for (size_t o = 0; o < ids.size(); ++o)
+            if (part.objectModel[o] != UINT32_MAX) out_.objectModel[ids[o]] = static_cast<uint32_t>(out_.modelCount + part.objectModel[o]);
+        for (Merge m : part.merges) {
+            m.modelA += static_cast<uint32_t>(out_.modelCount);
+            m.modelB += static_cast<uint32_t>(out_.modelCount);
+            out_.merges.push_back(m);
+        }
+        out_.modelCount += part.modelCount;
+        for (SolidReport& r : part.solids) {
+            for (uint32_t& o : r.objects) o = ids[o];
+            solids.push_back(std::move(r));
+        }
+        for (uint32_t o : part.leftOutObjects) leftOut[ids[o]] = 1;
+        for (Diagnostic& d : part.diagnostics) out_.diagnostics.push_back(std::move(d));
+        addTimings(out_, part);
+        out_.tetrahedronCount += part.tetrahedronCount;
+        out_.inputTriangleCount += part.inputTriangleCount;
+        out_.originals.volume += part.originals.volume;
+        out_.originals.area += part.originals.area;
+        if (settings_.progress) settings_.progress("tiles", double(++done) / double(cells_.size()));
+    }
+    for (Level& level : levels) level.hasVolumeConstant = hasConstant;
+
+    // Parent cells, quadtree level by level: the coarsest aggregates so far are their objects.
+    const auto anchorColumnRow = [&](const Aggregate& a) {
+        const uint32_t cell = cellOf_[a.sourceObjects.front()];
+        return std::make_pair(cell % report_.columns, cell / report_.columns);
+    };
+    for (int j = 1; j <= report_.quadtreeDepth; ++j) {
+        const std::vector<double>& deltas = parentDeltas[size_t(j)];
+        if (deltas.empty()) continue;
+        const Level& top = levels.back();
+        std::map<std::pair<size_t, size_t>, std::vector<uint32_t>> parents;  // (row, column) -> top aggregates
+        for (uint32_t g = 0; g < top.aggregates.size(); ++g) {
+            const auto [column, row] = anchorColumnRow(top.aggregates[g]);
+            parents[{row >> j, column >> j}].push_back(g);
+        }
+        std::vector<Level> added(deltas.size());
+        for (size_t k = 0; k < added.size(); ++k) added[k].delta = deltas[k];
+        done = 0;
+        for (const auto& [where, inputs] : parents) {
+            std::vector<char> passed(inputs.size(), inputs.size() < 2);
+            if (inputs.size() >= 2) {
+                std::vector<InputObject> objects(inputs.size());
+                for (size_t i = 0; i < inputs.size(); ++i) {
+                    const Aggregate& a = top.aggregates[inputs[i]];
+                    objects[i].name = "aggregate of " + objects_[a.sourceObjects.front()].name +
+                                      (a.sourceObjects.size() > 1 ? " (+" + std::to_string(a.sourceObjects.size() - 1) + ")" : "");
+                    objects[i].id = static_cast<uint32_t>(i);
+                    objects[i].positions = a.positions;
+                    objects[i].indices = a.indices;
+                    objects[i].triangleColors = a.faceColors;
+                }
+                Settings3D settings = cellSettings(deltas);
+                Hierarchy3D part;
+                const std::string name = "parent tile " + std::to_string(j) + ":" + std::to_string(where.first) + "," +
+                                         std::to_string(where.second);
+                if (!buildHierarchy3D(objects, settings, part)) return fail(part, name);
+                ++report_.parentBakeCount;
+                for (uint32_t o : part.leftOutObjects) passed[o] = 1;
+                for (size_t k = 0; k < added.size() && k < part.levels.size(); ++k)
+                    for (Aggregate& a : part.levels[k].aggregates) {
+                        std::vector<uint32_t> sources;
+                        double volumeOriginal = 0;
+                        for (uint32_t i : a.sourceObjects) {
+                            const Aggregate& below = top.aggregates[inputs[i]];
+                            sources.insert(sources.end(), below.sourceObjects.begin(), below.sourceObjects.end());
+                            volumeOriginal += below.volumeOriginal;
+                        }
+                        std::sort(sources.begin(), sources.end());
+                        a.sourceObjects = std::move(sources);
+                        a.volumeOriginal = volumeOriginal;
+                        added[k].aggregates.push_back(std::move(a));
+                    }
+                for (Diagnostic& d : part.diagnostics)
+                    if (d.severity != Diagnostic::Severity::Note) out_.diagnostics.push_back(std::move(d));
+                addTimings(out_, part);
+                out_.tetrahedronCount += part.tetrahedronCount;
+            }
+            for (size_t i = 0; i < inputs.size(); ++i)
+                if (passed[i])
+                    for (Level& level : added) level.aggregates.push_back(top.aggregates[inputs[i]]);
+            if (settings_.progress)
+                settings_.progress("parent tiles", (double(j - 1) + double(++done) / double(parents.size())) / report_.quadtreeDepth);
+        }
+        for (Level& level : added) {
+            level.hasVolumeConstant = false;
+            levels.push_back(std::move(level));
+        }
+    }
+
+    for (Level& level : levels) {
+        std::sort(level.aggregates.begin(), level.aggregates.end(),
+                  [](const Aggregate& a, const Aggregate& b) { return a.sourceObjects.front() < b.sourceObjects.front(); });
+        const double constant = level.volumeConstant;
+        totalLevel(level);
+        level.volumeConstant = level.hasVolumeConstant ? constant : 0;
+    }
+    out_.levels = std::move(levels);
+    std::stable_sort(out_.merges.begin(), out_.merges.end(), [](const Merge& a, const Merge& b) { return a.height < b.height; });
+    std::sort(solids.begin(), solids.end(), [](const SolidReport& a, const SolidReport& b) { return a.objects.front() < b.objects.front(); });
+    out_.solids = std::move(solids);
+    for (uint32_t i = 0; i < objects_.size(); ++i) {
+        if (support_[i]) {  // counted in the originals as the untiled bake counts them
+            detail::PreparedObject prepared;
+            detail::prepareObject(objects_[i], 1e-14 * diagonal * diagonal, prepared, out_.diagnostics);
+            out_.supportObjects.push_back(i);
+            out_.inputTriangleCount += prepared.triangles.size() / 3;
+            out_.originals.volume += prepared.volume;
+            out_.originals.area += prepared.area;
+        }
+        if (leftOut[i]) out_.leftOutObjects.push_back(i);
+    }
+    out_.originals = detail::measuresOf(out_.originals.volume, out_.originals.area);
+    if (!out_.supportObjects.empty())
+        diag(out_, Diagnostic::Severity::Warning, detail::objectNames(objects_, out_.supportObjects, 20),
+             std::string(settings_.support == SupportDetection::Given ? "support surfaces as asked"
+                                                                      : "support surfaces (span the scene and meet most objects)") +
+                 ": kept out of aggregation and passed through unchanged (--support none aggregates them)");
+    std::string note = "tiled bake: tile size " + fmt(tileSize) + ", " + std::to_string(report_.columns) + " x " +
+                       std::to_string(report_.rows) + " cells, " + std::to_string(report_.cellCount) +
+                       " with objects (largest " + std::to_string(report_.largestCellObjects) + "), levels up to delta " +
+                       fmt(report_.cellTopDelta) + " baked per cell, " + std::to_string(report_.parentBakeCount) +
+                       " parent cells baked over " + std::to_string(report_.quadtreeDepth) + " quadtree levels";
+    if (report_.splitClusterCount)
+        note += "; " + std::to_string(report_.splitClusterCount) + " of " + std::to_string(report_.clusterCount) +
+                " clusters wider than a tile were split at cell borders (" + std::to_string(report_.splitClusterObjects) +
+                " objects): groups there may differ from an untiled bake";
+    diag(out_, Diagnostic::Severity::Note, "", note);
+    return true;
+}
+
+}  // namespace
+
+bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, double tileSize,
+                           Hierarchy3D& out, TiledBakeReport* report) {
+    out = Hierarchy3D{};
+    TiledBakeReport local;
+    TiledBakeReport& r = report ? *report : local;
+    r = TiledBakeReport{};
+    if (std::string problem; !validThresholds(settings.deltas, problem)) {
+        out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", problem});
+        return false;
+    }
+    if (!(tileSize >= 0) || !std::isfinite(tileSize)) {
+        out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", "tile size " + fmt(tileSize) +
+                                                                                  " is not a finite number >= 0"});
+        return false;
+    }
+    try {
+        TiledBaker baker(objects, settings, out, r);
+        return baker.run(tileSize);
+    } catch (const std::exception& e) {
+        out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", std::string("internal error: ") + e.what()});
+        return false;
+    }
+}
+
+}  // namespace aggrelod

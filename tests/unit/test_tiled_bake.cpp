@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The tiled bake (module/include/aggrelod/tiled_bake_3d.h) on generated open worlds, against
+// the untiled bake of the same world in the same run: the cells' levels group objects as the
+// untiled bake does (all but the groups near borders of clusters wider than a tile, whose
+// share is measured), every cut covers every object exactly once, proxies stay within their
+// certified budgets, and the result does not depend on the thread count.
+#include "generated_world.h"
+#include "test_support.h"
+
+#include <aggrelod/aggregate3d.h>
+#include <aggrelod/hierarchy_nodes.h>
+#include <aggrelod/tiled_bake_3d.h>
+#include <aggrelod/world.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace aggrelod;
+
+namespace {
+
+std::vector<InputObject> world(uint64_t count, uint32_t seed) { return aggrelod::testing::generatedWorld(count, seed); }
+
+/// The world's terrain tiles and roads as support surfaces (named ones: the generator's
+/// terrain is tiled per block, which the automatic rule does not take for a support).
+Settings3D worldSettings(const std::vector<InputObject>& objects, std::vector<double> deltas, int threads = 2) {
+    Settings3D s;
+    s.deltas = std::move(deltas);
+    s.threadCount = threads;
+    s.support = SupportDetection::Given;
+    for (uint32_t i = 0; i < objects.size(); ++i)
+        if (objects[i].name.find("terrain") != std::string::npos || objects[i].name.find("road") != std::string::npos)
+            s.supportObjects.push_back(i);
+    return s;
+}
+
+std::set<std::vector<uint32_t>> groupsOf(const Level& level) {
+    std::set<std::vector<uint32_t>> groups;
+    for (const Aggregate& a : level.aggregates) groups.insert(a.sourceObjects);
+    return groups;
+}
+
+std::string errors(const Hierarchy3D& h) {
+    std::string s;
+    for (const Diagnostic& d : h.diagnostics)
+        if (d.severity == Diagnostic::Severity::Error) s += d.object + ": " + d.message + "\n";
+    return s;
+}
+
+}  // namespace
+
+TEST(TiledBake, CellLevelsGroupAsUntiledAndEveryCutCoversEachObjectOnce) {
+    const std::vector<double> deltas{0.5, 1, 2, 4, 8, 16};
+    for (uint32_t seed : {1u, 7u}) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const std::vector<InputObject> objects = world(300, seed);
+        const Settings3D settings = worldSettings(objects, deltas);
+        Hierarchy3D untiled, tiled;
+        ASSERT_TRUE(buildHierarchy3D(objects, settings, untiled)) << errors(untiled);
+        TiledBakeReport report;
+        ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, tiled, &report)) << errors(tiled);
+        ASSERT_TRUE(report.tiled);
+        EXPECT_EQ(report.cellTopDelta, 6.0);
+        EXPECT_GT(report.cellCount, 4u);
+        EXPECT_GE(report.quadtreeDepth, 1);
+        ASSERT_EQ(tiled.levels.size(), untiled.levels.size());
+        EXPECT_EQ(tiled.supportObjects, untiled.supportObjects);
+        EXPECT_EQ(tiled.inputTriangleCount, untiled.inputTriangleCount);
+        EXPECT_NEAR(tiled.originals.volume, untiled.originals.volume, 1e-9 * untiled.originals.volume);
+
+        // The cells' levels: the groups of the untiled bake, but for those near a split cluster.
+        for (size_t k = 0; k < tiled.levels.size(); ++k) {
+            const std::set<std::vector<uint32_t>> a = groupsOf(untiled.levels[k]), b = groupsOf(tiled.levels[k]);
+            size_t differ = 0;
+            for (const auto& g : b) differ += a.count(g) ? 0 : 1;
+            const double share = double(differ) / double(b.size());
+            std::printf("seed %u level %zu delta %g: %zu untiled groups, %zu tiled, %zu differ (%.1f %%)%s\n", seed, k,
+                        tiled.levels[k].delta, a.size(), b.size(), differ, 100 * share,
+                        tiled.levels[k].delta <= report.cellTopDelta ? " [cell level]" : " [parent level]");
+            if (tiled.levels[k].delta <= report.cellTopDelta) {
+                if (report.splitClusterCount == 0) EXPECT_EQ(differ, 0u);
+                EXPECT_LE(share, 0.05) << "level " << k;
+            }
+            EXPECT_GE(b.size(), a.size()) << "a tiled level joins no more than the untiled one";
+        }
+
+        if (seed != 1) continue;  // the node tree (proxies) once: it is the slow part
+        // One node tree: every node's sources are the disjoint union of its children's, so any
+        // cut through the tree covers every object exactly once; certified errors within budget.
+        HierarchyNodes nodes;
+        std::string error;
+        ProxySettings proxies;
+        proxies.threadCount = 2;
+        ASSERT_TRUE(buildHierarchyNodes(tiled, objects, proxies, nodes, error)) << error;
+        std::vector<int> covered(objects.size(), 0);
+        for (uint32_t r : nodes.roots)
+            for (uint32_t o : nodes.nodes[r].sources) ++covered[o];
+        for (size_t o = 0; o < objects.size(); ++o)
+            if (!std::binary_search(tiled.supportObjects.begin(), tiled.supportObjects.end(), uint32_t(o)))
+                EXPECT_EQ(covered[o], 1) << objects[o].name;
+        for (size_t i = nodes.objectCount; i < nodes.nodes.size(); ++i) {
+            const HierarchyNode& n = nodes.nodes[i];
+            std::vector<uint32_t> union_;
+            for (uint32_t c : n.children) union_.insert(union_.end(), nodes.nodes[c].sources.begin(), nodes.nodes[c].sources.end());
+            std::sort(union_.begin(), union_.end());
+            EXPECT_EQ(union_, n.sources) << "node " << i;
+            EXPECT_LE(n.error.bound(), n.budget * (1 + 1e-9)) << "node " << i;
+            EXPECT_FALSE(n.indices.empty()) << "node " << i;
+        }
+    }
+}
+
+TEST(TiledBake, SameResultForEveryThreadCount) {
+    const std::vector<InputObject> objects = world(200, 3);
+    Hierarchy3D one, two;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, worldSettings(objects, {1, 4, 12}, 1), 48.0, one)) << errors(one);
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, worldSettings(objects, {1, 4, 12}, 2), 48.0, two)) << errors(two);
+    ASSERT_EQ(one.levels.size(), two.levels.size());
+    for (size_t k = 0; k < one.levels.size(); ++k) {
+        ASSERT_EQ(one.levels[k].aggregates.size(), two.levels[k].aggregates.size());
+        for (size_t g = 0; g < one.levels[k].aggregates.size(); ++g) {
+            EXPECT_EQ(one.levels[k].aggregates[g].sourceObjects, two.levels[k].aggregates[g].sourceObjects);
+            EXPECT_EQ(one.levels[k].aggregates[g].positions, two.levels[k].aggregates[g].positions);
+            EXPECT_EQ(one.levels[k].aggregates[g].indices, two.levels[k].aggregates[g].indices);
+        }
+    }
+}
+
+TEST(TiledBake, AutomaticThresholdsSpanCellsAndQuadtree) {
+    const std::vector<InputObject> objects = world(200, 5);
+    Settings3D settings = worldSettings(objects, {});
+    Hierarchy3D h;
+    TiledBakeReport report;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, h, &report)) << errors(h);
+    ASSERT_TRUE(report.tiled);
+    size_t cellLevels = 0;
+    for (size_t k = 0; k < h.levels.size(); ++k) {
+        if (k) EXPECT_GT(h.levels[k].delta, h.levels[k - 1].delta);
+        cellLevels += h.levels[k].delta <= report.cellTopDelta ? 1 : 0;
+        if (k) EXPECT_LE(h.levels[k].aggregates.size(), h.levels[k - 1].aggregates.size());
+    }
+    EXPECT_GE(cellLevels, 2u);
+    EXPECT_EQ(h.levels.size() - cellLevels, size_t(report.quadtreeDepth));
+    EXPECT_GT(h.levels.front().aggregates.size(), h.levels.back().aggregates.size());
+}
+
+TEST(TiledBake, OneCellIsTheUntiledBake) {
+    const std::vector<InputObject> objects = world(60, 2);
+    const Settings3D settings = worldSettings(objects, {1, 4});
+    Hierarchy3D untiled, tiled;
+    TiledBakeReport report;
+    ASSERT_TRUE(buildHierarchy3D(objects, settings, untiled));
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 1e6, tiled, &report));
+    EXPECT_FALSE(report.tiled);
+    ASSERT_EQ(tiled.levels.size(), untiled.levels.size());
+    for (size_t k = 0; k < tiled.levels.size(); ++k)
+        for (size_t g = 0; g < tiled.levels[k].aggregates.size(); ++g)
+            EXPECT_EQ(tiled.levels[k].aggregates[g].positions, untiled.levels[k].aggregates[g].positions);
+}
+
+TEST(TiledBake, RefusesBadTileSizesAndThresholdsAboveTheCells) {
+    const std::vector<InputObject> objects = world(60, 2);
+    Hierarchy3D h;
+    EXPECT_FALSE(buildTiledHierarchy3D(objects, worldSettings(objects, {1}), -1.0, h));
+    EXPECT_NE(errors(h).find("tile size"), std::string::npos) << errors(h);
+    EXPECT_FALSE(buildTiledHierarchy3D(objects, worldSettings(objects, {1}), std::nan(""), h));
+    EXPECT_NE(errors(h).find("tile size"), std::string::npos) << errors(h);
+    EXPECT_FALSE(buildTiledHierarchy3D(objects, worldSettings(objects, {20, 40}), 48.0, h));
+    EXPECT_NE(errors(h).find("at most 6"), std::string::npos) << errors(h);
+    EXPECT_TRUE(h.levels.empty());
+}
