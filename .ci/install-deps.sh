@@ -23,9 +23,11 @@ packages=(
   mingw-w64 wine wine64
   libglfw3-dev libgl1-mesa-dri xvfb
   libbullet-dev
+  python3-distributed
   time
 )
 # time: GNU time, for the peak memory in tests/bench/bench_world.sh.
+# python3-distributed: Dask, for aggrelod-farm (bake/aggrelod_farm.py) and its tests (tests/farm).
 # libbullet-dev: a real physics engine for the test of collision.glb (tests/physics); tests only.
 # mingw-w64: the Windows cross build of the runtime (tests/windows); wine, wine64: run its unit
 # tests there.

@@ -15,6 +15,7 @@
 #endif
 #include "scene_io.h"
 #include "terminal.h"
+#include "tile_cache.h"
 #include "tiles_export.h"
 
 #include <aggrelod/collision.h>
@@ -112,6 +113,8 @@ struct BakeOptions {
     bool includeAnimated = false;
     bool allowExternalUris = false;
     std::string tileSize;               ///< empty: untiled; "auto" or a length: tiled bake
+    std::string tileCache;              ///< folder of the tiled bake's pieces (incremental rebake)
+    std::string tileTask;               ///< one piece only: plan, graph:N, cell:N, parent:J:ROW:COLUMN
 };
 
 /// The settings that shape the outputs, as canonical text (hashed into scene.aglod so that an
@@ -194,6 +197,13 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
             if (end == v.c_str() || *end != '\0' || !(d > 0) || !std::isfinite(d)) return "expects 'auto' or a length > 0";
             return {};
         });
+    cmd->add_option("--tile-cache", o.tileCache,
+                    "Keep the result of every piece of a tiled bake in this folder and read it back when the "
+                    "piece's input did not change: a rebake redoes only the cells that changed and their parents "
+                    "(needs --tile-size)");
+    cmd->add_option("--tile-task", o.tileTask,
+                    "Bake one piece of a tiled bake into --tile-cache and write no outputs: plan (print the pieces "
+                    "as JSON), graph:N, cell:N or parent:J:ROW:COLUMN; what aggrelod-farm runs on its workers");
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
     cmd->add_flag("--constant-baseline", o.constantBaseline,
                   "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
@@ -285,6 +295,14 @@ int runBake(BakeOptions o) {
     }
     if (!std::isfinite(o.touchTolerance) || (o.touchTolerance < 0 && o.touchTolerance != -1)) {
         printError("--touch-tolerance: must be a finite number >= 0");
+        return kUsage;
+    }
+    if ((!o.tileCache.empty() || !o.tileTask.empty()) && o.tileSize.empty()) {
+        printError(std::string(o.tileCache.empty() ? "--tile-task" : "--tile-cache") + " needs --tile-size");
+        return kUsage;
+    }
+    if (!o.tileTask.empty() && o.tileTask != "plan" && o.tileCache.empty()) {
+        printError("--tile-task " + o.tileTask + " needs --tile-cache (the folder its result goes to)");
         return kUsage;
     }
     std::sort(o.deltas.begin(), o.deltas.end());
@@ -379,6 +397,37 @@ int runBake(BakeOptions o) {
         return kFileError;
     }
 
+    // A tiled bake's cache and piece (--tile-cache, --tile-task).
+    TiledBakeOptions tiling;
+    TileCache tileCache;
+    if (!o.tileSize.empty()) tiling.tileSize = o.tileSize == "auto" ? 0.0 : std::strtod(o.tileSize.c_str(), nullptr);
+    if (!o.tileCache.empty()) {
+        tileCache = io::folderTileCache(o.tileCache);
+        tiling.cache = &tileCache;
+    }
+    if (!o.tileTask.empty()) {
+        unsigned long a = 0, b = 0, c = 0;
+        char tail = 0;
+        TileTask& t = tiling.task;
+        if (o.tileTask == "plan") {
+            t.kind = TileTask::Kind::Plan;
+        } else if (std::sscanf(o.tileTask.c_str(), "graph:%lu%c", &a, &tail) == 1 && a <= UINT32_MAX) {
+            t.kind = TileTask::Kind::Graph;
+            t.cell = static_cast<uint32_t>(a);
+        } else if (std::sscanf(o.tileTask.c_str(), "cell:%lu%c", &a, &tail) == 1 && a <= UINT32_MAX) {
+            t.kind = TileTask::Kind::Cell;
+            t.cell = static_cast<uint32_t>(a);
+        } else if (std::sscanf(o.tileTask.c_str(), "parent:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && a >= 1 && a <= 64 &&
+                   b <= UINT32_MAX && c <= UINT32_MAX) {
+            t.kind = TileTask::Kind::Parent;
+            t.level = static_cast<int>(a);
+            t.row = static_cast<uint32_t>(b);
+            t.column = static_cast<uint32_t>(c);
+        } else {
+            printError("--tile-task " + o.tileTask + ": expects plan, graph:N, cell:N or parent:J:ROW:COLUMN");
+            return kUsage;
+        }
+    }
     // Bake.
     cli::ProgressLine progress(!o.quiet && cli::stderrIsTerminal());
     Settings3D settings;
@@ -410,9 +459,38 @@ int runBake(BakeOptions o) {
         progress.update(stage, fraction);
     };
     Hierarchy3D hierarchy;
-    const bool ok = o.tileSize.empty()
-                        ? buildHierarchy3D(scene.objects, settings, hierarchy)
-                        : buildTiledHierarchy3D(scene.objects, settings, o.tileSize == "auto" ? 0.0 : std::strtod(o.tileSize.c_str(), nullptr), hierarchy);
+    TiledBakeReport tiled;
+    if (!o.tileTask.empty()) {  // one piece: into the cache, no outputs
+        const bool done = buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled);
+        progress.finish();
+        cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
+        if (!done) {
+            printError(o.scene + ": tile task " + o.tileTask + " failed");
+            return kBakeFailed;
+        }
+        if (tiling.task.kind == TileTask::Kind::Plan) {
+            std::string plan = "{\"tiled\": " + std::string(tiled.tiled ? "true" : "false") +
+                               ", \"graphs\": " + (tiled.automaticDeltas ? "true" : "false") + ", \"cells\": [";
+            for (size_t i = 0; i < tiled.cells.size(); ++i) plan += (i ? ", " : "") + std::to_string(tiled.cells[i]);
+            plan += "], \"parents\": [";
+            bool first = true;
+            for (size_t j = 0; j < tiled.parents.size(); ++j)
+                for (const auto& [row, column] : tiled.parents[j]) {
+                    plan += (first ? "[" : ", [") + std::to_string(j) + ", " + std::to_string(row) + ", " +
+                            std::to_string(column) + "]";
+                    first = false;
+                }
+            std::printf("%s]}\n", plan.c_str());
+        } else if (!o.quiet) {
+            std::printf("tile task %s: %zu pieces baked, %zu read from the cache\n", o.tileTask.c_str(),
+                        tiled.graphsBaked + tiled.cellsBaked + tiled.parentsBaked,
+                        tiled.graphsLoaded + tiled.cellsLoaded + tiled.parentsLoaded);
+        }
+        std::fflush(stdout);
+        return kOk;
+    }
+    const bool ok = o.tileSize.empty() ? buildHierarchy3D(scene.objects, settings, hierarchy)
+                                       : buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled);
     HierarchyNodes nodes;
     std::string nodeError;
     bool nodesOk = false;
@@ -495,6 +573,10 @@ int runBake(BakeOptions o) {
                     cli::formatNumber(hierarchy.originals.volume).c_str(),
                     cli::formatNumber(hierarchy.originals.sphericity).c_str());
         std::fputs(cli::formatLevelTable(hierarchy).c_str(), stdout);
+        if (tiled.tiled)
+            std::printf("tiles: %zu cells and %zu parent cells baked, %zu and %zu read from %s\n",
+                        tiled.cellsBaked, tiled.parentsBaked, tiled.cellsLoaded, tiled.parentsLoaded,
+                        o.tileCache.empty() ? "a cache (none given)" : o.tileCache.c_str());
         size_t proxyTriangles = 0, exactTriangles = 0;
         for (size_t i = nodes.objectCount; i < nodes.nodes.size(); ++i) {
             proxyTriangles += nodes.nodes[i].indices.size() / 3;

@@ -4,6 +4,7 @@
 // ones, combined into one Hierarchy3D. The cell rule and the thresholds are in
 // tiled_bake_3d.h.
 #include "baker_3d.h"
+#include "hierarchy_serialize.h"
 
 #include <aggrelod/dendrogram.h>
 #include <aggrelod/disjoint_sets.h>
@@ -11,7 +12,9 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <numeric>
 #include <string>
 
 namespace aggrelod {
@@ -68,15 +71,16 @@ void addTimings(Hierarchy3D& out, const Hierarchy3D& part) {
 
 class TiledBaker {
 public:
-    TiledBaker(const std::vector<InputObject>& objects, const Settings3D& settings, Hierarchy3D& out,
-               TiledBakeReport& report)
-        : objects_(objects), settings_(settings), out_(out), report_(report) {}
+    TiledBaker(const std::vector<InputObject>& objects, const Settings3D& settings, const TiledBakeOptions& options,
+               Hierarchy3D& out, TiledBakeReport& report)
+        : objects_(objects), settings_(settings), options_(options), out_(out), report_(report) {}
 
     bool run(double tileSize);
 
 private:
     const std::vector<InputObject>& objects_;
     const Settings3D& settings_;
+    const TiledBakeOptions& options_;
     Hierarchy3D& out_;
     TiledBakeReport& report_;
     std::vector<std::array<double, 6>> boxes_;
@@ -95,7 +99,86 @@ private:
     std::vector<InputObject> cellObjects(const std::vector<uint32_t>& ids) const;
     bool automaticCellDeltas(std::vector<double>& deltas);
     bool fail(const Hierarchy3D& part, const std::string& where);
+
+    // Pieces (cell graphs, cells, parent cells) and the cache (TileCache, TileTask).
+    using Kind = TileTask::Kind;
+    bool caching() const { return options_.cache && options_.cache->load && options_.cache->store && !settings_.customFunction; }
+    bool isTask(Kind k) const { return options_.task.kind == k; }
+    /// Whether this run needs cell `cell` (its graph, its levels).
+    bool needCell(uint32_t cell) const;
+    std::string cellKey(char kind, const std::vector<uint32_t>& ids, const Settings3D& settings) const;
+    /// The piece `key` from the cache, or baked by `bake` when `mayBake` (and then stored).
+    bool obtain(const std::string& key, const std::string& name, bool mayBake,
+                const std::function<bool(Hierarchy3D&)>& bake, Hierarchy3D& part, size_t& baked, size_t& loaded);
 };
+
+void hashSettings(detail::ContentHash& h, const Settings3D& s) {
+    h.text("aggrelod tile piece 1");
+    h.u64(uint64_t(s.function));
+    h.u64(uint64_t(s.distance));
+    h.f64(s.touchTolerance);
+    h.u64(s.computeHullBaseline);
+    h.u64(s.computeConstantBaseline);
+    h.u64(uint64_t(s.solidify));
+    h.f64(s.wrapOffset);
+    h.u64(uint64_t(s.automaticLevelCount));
+    h.values(s.deltas);
+}
+
+bool TiledBaker::needCell(uint32_t cell) const {
+    const TileTask& t = options_.task;
+    switch (t.kind) {
+    case Kind::Everything: return true;
+    case Kind::Plan: return false;
+    case Kind::Graph:
+    case Kind::Cell: return cell == t.cell;
+    case Kind::Parent:
+        return ((cell / report_.columns) >> t.level) == t.row && ((cell % report_.columns) >> t.level) == t.column;
+    }
+    return false;
+}
+
+std::string TiledBaker::cellKey(char kind, const std::vector<uint32_t>& ids, const Settings3D& settings) const {
+    detail::ContentHash h;
+    h.bytes(&kind, 1);
+    hashSettings(h, settings);
+    h.u64(ids.size());
+    for (uint32_t i : ids) {
+        const InputObject& o = objects_[i];
+        h.text(o.name);
+        h.u64(o.id);
+        h.values(o.positions);
+        h.values(o.indices);
+        h.values(o.triangleColors);
+    }
+    return h.hex();
+}
+
+bool TiledBaker::obtain(const std::string& key, const std::string& name, bool mayBake,
+                        const std::function<bool(Hierarchy3D&)>& bake, Hierarchy3D& part, size_t& baked, size_t& loaded) {
+    if (caching()) {
+        std::vector<uint8_t> bytes;
+        if (options_.cache->load(key, bytes) && detail::deserializeHierarchy(bytes, part)) {
+            part.timings.clear();  // not spent in this run
+            ++loaded;
+            return true;
+        }
+    }
+    if (!mayBake) {
+        diag(out_, Diagnostic::Severity::Error, "", "the tile cache holds no result for " + name + " (entry " + key +
+                                                        "): bake that piece first");
+        return false;
+    }
+    if (!bake(part)) return fail(part, name);
+    ++baked;
+    if (caching()) {
+        std::vector<uint8_t> bytes;
+        detail::serializeHierarchy(part, bytes);
+        if (!options_.cache->store(key, bytes))
+            diag(out_, Diagnostic::Severity::Warning, "", "could not store " + name + " in the tile cache");
+    }
+    return true;
+}
 
 void TiledBaker::findSupport() {
     const size_t n = objects_.size();
@@ -189,17 +272,27 @@ bool TiledBaker::automaticCellDeltas(std::vector<double>& deltas) {
     std::vector<Merge> merges;
     size_t done = 0;
     for (const auto& [cell, ids] : cells_) {
-        const std::vector<InputObject> objects = cellObjects(ids);
+        if (isTask(Kind::Graph) && cell != options_.task.cell) continue;  // the others are not this task's
         const Settings3D settings = cellSettings({});
         Hierarchy3D part;
-        detail::Baker3D baker(objects, settings, part);
-        baker.stopAfterGraph();
-        if (!baker.run()) return fail(part, "tile " + std::to_string(cell));
+        const auto bake = [&](Hierarchy3D& p) {
+            const std::vector<InputObject> objects = cellObjects(ids);
+            detail::Baker3D baker(objects, settings, p);
+            baker.stopAfterGraph();
+            if (!baker.run()) return false;
+            p.diagnostics.clear();  // the cell's bake reports them again
+            return true;
+        };
+        const bool mayBake = isTask(Kind::Everything) || isTask(Kind::Graph);
+        if (!obtain(cellKey('g', ids, settings), "the graph of tile " + std::to_string(cell), mayBake, bake, part,
+                    report_.graphsBaked, report_.graphsLoaded))
+            return false;
         for (const Merge& m : part.merges)
             if (m.height <= report_.cellTopDelta) merges.push_back(m);
         addTimings(out_, part);
         if (settings_.progress) settings_.progress("tile graphs", double(++done) / double(cells_.size()));
     }
+    if (isTask(Kind::Graph)) return true;
     std::sort(merges.begin(), merges.end(), [](const Merge& a, const Merge& b) { return a.height < b.height; });
     double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (const auto& [cell, ids] : cells_)
@@ -291,9 +384,27 @@ bool TiledBaker::run(double tileSize) {
                      fmt(report_.cellTopDelta) + " (an eighth of the tile size) for the cells' levels");
             return false;
         }
-    } else {
+    }
+    report_.automaticDeltas = settings_.deltas.empty();
+    if (isTask(Kind::Plan)) {  // the pieces, for running them apart (aggrelod-farm)
+        report_.parents.assign(size_t(report_.quadtreeDepth) + 1, {});
+        for (const auto& [cell, ids] : cells_) report_.cells.push_back(cell);
+        for (int j = 1; j <= report_.quadtreeDepth; ++j) {
+            if (!report_.automaticDeltas && parentDeltas[size_t(j)].empty()) continue;
+            auto& list = report_.parents[size_t(j)];
+            for (uint32_t cell : report_.cells)
+                list.emplace_back((cell / report_.columns) >> j, (cell % report_.columns) >> j);
+            std::sort(list.begin(), list.end());
+            list.erase(std::unique(list.begin(), list.end()), list.end());
+        }
+        return true;
+    }
+    if (report_.automaticDeltas) {
         if (!automaticCellDeltas(cellDeltas)) return false;
+        if (isTask(Kind::Graph)) return true;
         for (int j = 1; j <= report_.quadtreeDepth; ++j) parentDeltas[size_t(j)].push_back(report_.cellTopDelta * std::ldexp(1.0, j));
+    } else if (isTask(Kind::Graph)) {
+        return true;  // explicit thresholds: no graph pass
     }
 
     // Cells.
@@ -305,10 +416,14 @@ bool TiledBaker::run(double tileSize) {
     size_t done = 0;
     bool hasConstant = true;
     for (const auto& [cell, ids] : cells_) {
-        const std::vector<InputObject> objects = cellObjects(ids);
+        if (!needCell(cell)) continue;
         const Settings3D settings = cellSettings(cellDeltas);
         Hierarchy3D part;
-        if (!buildHierarchy3D(objects, settings, part)) return fail(part, "tile " + std::to_string(cell));
+        const auto bake = [&](Hierarchy3D& p) { return buildHierarchy3D(cellObjects(ids), settings, p); };
+        const bool mayBake = isTask(Kind::Everything) || isTask(Kind::Cell);
+        if (!obtain(cellKey('c', ids, settings), "tile " + std::to_string(cell), mayBake, bake, part, report_.cellsBaked,
+                    report_.cellsLoaded))
+            return false;
         if (part.levels.size() != levels.size()) {
             diag(out_, Diagnostic::Severity::Error, "", "tile " + std::to_string(cell) + ": the bake made " +
                  std::to_string(part.levels.size()) + " levels where " + std::to_string(levels.size()) + " were asked");
@@ -344,6 +459,7 @@ bool TiledBaker::run(double tileSize) {
         if (settings_.progress) settings_.progress("tiles", double(++done) / double(cells_.size()));
     }
     for (Level& level : levels) level.hasVolumeConstant = hasConstant;
+    if (isTask(Kind::Cell)) return true;
 
     // Parent cells, quadtree level by level: the coarsest aggregates so far are their objects.
     const auto anchorColumnRow = [&](const Aggregate& a) {
@@ -379,8 +495,44 @@ bool TiledBaker::run(double tileSize) {
                 Hierarchy3D part;
                 const std::string name = "parent tile " + std::to_string(j) + ":" + std::to_string(where.first) + "," +
                                          std::to_string(where.second);
-                if (!buildHierarchy3D(objects, settings, part)) return fail(part, name);
+                const bool target = isTask(Kind::Parent) && j == options_.task.level && where.first == options_.task.row &&
+                                    where.second == options_.task.column;
+                detail::ContentHash key;
+                key.bytes("p", 1);
+                hashSettings(key, settings);
+                for (size_t i = 0; i < inputs.size(); ++i) {
+                    const Aggregate& a = top.aggregates[inputs[i]];
+                    key.text(objects[i].name);
+                    key.values(a.sourceObjects);
+                    key.values(a.positions);
+                    key.values(a.indices);
+                    key.values(a.faceColors);
+                }
+                // Aggregates of neighbouring cells were shaped apart and may nearly touch, which
+                // TetGen can refuse: then once more with those closer than a thousandth of the
+                // level's delta as one model (they join at this level anyway), and if that fails
+                // too the inputs pass through unchanged, with a warning.
+                const auto bake = [&](Hierarchy3D& p) {
+                    if (buildHierarchy3D(objects, settings, p)) return true;
+                    Settings3D closer = settings;
+                    closer.touchTolerance = std::max(tolerance_, 1e-3 * deltas.front());
+                    std::vector<Diagnostic> first = p.diagnostics;
+                    if (buildHierarchy3D(objects, closer, p)) return true;
+                    p = Hierarchy3D{};
+                    p.leftOutObjects.resize(objects.size());
+                    std::iota(p.leftOutObjects.begin(), p.leftOutObjects.end(), 0u);
+                    std::string why;
+                    for (const Diagnostic& d : first)
+                        if (d.severity == Diagnostic::Severity::Error) why = d.message;
+                    diag(p, Diagnostic::Severity::Warning, "", name + " not aggregated (" + why + "): its " +
+                                                                  std::to_string(objects.size()) + " inputs pass through");
+                    return true;
+                };
+                if (!obtain(key.hex(), name, isTask(Kind::Everything) || target, bake, part, report_.parentsBaked,
+                            report_.parentsLoaded))
+                    return false;
                 ++report_.parentBakeCount;
+                if (target) return true;
                 for (uint32_t o : part.leftOutObjects) passed[o] = 1;
                 for (size_t k = 0; k < added.size() && k < part.levels.size(); ++k)
                     for (Aggregate& a : part.levels[k].aggregates) {
@@ -411,6 +563,7 @@ bool TiledBaker::run(double tileSize) {
             level.hasVolumeConstant = false;
             levels.push_back(std::move(level));
         }
+        if (isTask(Kind::Parent) && j == options_.task.level) return true;  // its target had one input: nothing to bake
     }
 
     for (Level& level : levels) {
@@ -458,6 +611,14 @@ bool TiledBaker::run(double tileSize) {
 
 bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, double tileSize,
                            Hierarchy3D& out, TiledBakeReport* report) {
+    TiledBakeOptions options;
+    options.tileSize = tileSize;
+    return buildTiledHierarchy3D(objects, settings, options, out, report);
+}
+
+bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings,
+                           const TiledBakeOptions& options, Hierarchy3D& out, TiledBakeReport* report) {
+    const double tileSize = options.tileSize;
     out = Hierarchy3D{};
     TiledBakeReport local;
     TiledBakeReport& r = report ? *report : local;
@@ -472,7 +633,7 @@ bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settin
         return false;
     }
     try {
-        TiledBaker baker(objects, settings, out, r);
+        TiledBaker baker(objects, settings, options, out, r);
         return baker.run(tileSize);
     } catch (const std::exception& e) {
         out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, "", std::string("internal error: ") + e.what()});

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -173,4 +174,145 @@ TEST(TiledBake, RefusesBadTileSizesAndThresholdsAboveTheCells) {
     EXPECT_FALSE(buildTiledHierarchy3D(objects, worldSettings(objects, {20, 40}), 48.0, h));
     EXPECT_NE(errors(h).find("at most 6"), std::string::npos) << errors(h);
     EXPECT_TRUE(h.levels.empty());
+}
+
+namespace {
+
+/// A TileCache in memory, counting what it was asked.
+struct MemoryCache {
+    std::map<std::string, std::vector<uint8_t>> entries;
+    TileCache cache() {
+        TileCache c;
+        c.load = [this](const std::string& key, std::vector<uint8_t>& bytes) {
+            auto it = entries.find(key);
+            if (it == entries.end()) return false;
+            bytes = it->second;
+            return true;
+        };
+        c.store = [this](const std::string& key, const std::vector<uint8_t>& bytes) {
+            entries[key] = bytes;
+            return true;
+        };
+        return c;
+    }
+};
+
+void expectSameLevels(const Hierarchy3D& a, const Hierarchy3D& b) {
+    ASSERT_EQ(a.levels.size(), b.levels.size());
+    for (size_t k = 0; k < a.levels.size(); ++k) {
+        ASSERT_EQ(a.levels[k].aggregates.size(), b.levels[k].aggregates.size()) << "level " << k;
+        for (size_t g = 0; g < a.levels[k].aggregates.size(); ++g) {
+            const Aggregate &x = a.levels[k].aggregates[g], &y = b.levels[k].aggregates[g];
+            EXPECT_EQ(x.sourceObjects, y.sourceObjects);
+            EXPECT_EQ(x.positions, y.positions);
+            EXPECT_EQ(x.indices, y.indices);
+            EXPECT_EQ(x.faceColors, y.faceColors);
+        }
+    }
+    EXPECT_EQ(a.objectModel, b.objectModel);
+    EXPECT_EQ(a.supportObjects, b.supportObjects);
+    EXPECT_EQ(a.diagnostics.size(), b.diagnostics.size());
+}
+
+}  // namespace
+
+TEST(TiledBake, CacheRebakesOnlyTheChangedCellAndItsParents) {
+    std::vector<InputObject> objects = world(200, 3);
+    const Settings3D settings = worldSettings(objects, {1, 4, 12, 24});
+    MemoryCache memory;
+    const TileCache cache = memory.cache();
+    TiledBakeOptions options;
+    options.tileSize = 48;
+    options.cache = &cache;
+    Hierarchy3D first, again, plain;
+    TiledBakeReport r1, r2;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, first, &r1)) << errors(first);
+    EXPECT_EQ(r1.cellsBaked, r1.cellCount);
+    EXPECT_EQ(r1.cellsLoaded, 0u);
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, again, &r2)) << errors(again);
+    EXPECT_EQ(r2.cellsBaked + r2.parentsBaked, 0u);
+    EXPECT_EQ(r2.cellsLoaded, r1.cellsBaked);
+    EXPECT_EQ(r2.parentsLoaded, r1.parentsBaked);
+    expectSameLevels(first, again);
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, plain));
+    expectSameLevels(first, plain);
+
+    // Move one object by 2 cm: only its cell and the parent cells above it are baked again.
+    size_t moved = 0;
+    while (moved + 1 < objects.size() && std::binary_search(settings.supportObjects.begin(), settings.supportObjects.end(),
+                                                            uint32_t(moved)))
+        ++moved;
+    ASSERT_FALSE(std::binary_search(settings.supportObjects.begin(), settings.supportObjects.end(), uint32_t(moved)));
+    for (size_t i = 0; i < objects[moved].positions.size(); i += 3) objects[moved].positions[i] += 0.02;
+    Hierarchy3D changed, fresh;
+    TiledBakeReport r3;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, changed, &r3)) << errors(changed);
+    EXPECT_EQ(r3.cellsBaked, 1u);
+    EXPECT_EQ(r3.cellsLoaded, r1.cellsBaked - 1);
+    EXPECT_LE(r3.parentsBaked, size_t(r3.quadtreeDepth) * 2);  // one parent per quadtree level and delta band
+    EXPECT_GT(r3.parentsLoaded, 0u);
+    std::printf("moved %s: %zu of %zu cells and %zu of %zu parent cells baked again\n", objects[moved].name.c_str(),
+                r3.cellsBaked, r3.cellsBaked + r3.cellsLoaded, r3.parentsBaked, r3.parentsBaked + r3.parentsLoaded);
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, fresh));
+    expectSameLevels(changed, fresh);
+
+    // A corrupted entry is refused and its piece baked again, with the same result.
+    for (auto& [key, bytes] : memory.entries) bytes[bytes.size() / 2] ^= 0x5a, bytes.resize(bytes.size() - 1);
+    Hierarchy3D repaired;
+    TiledBakeReport r4;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, repaired, &r4)) << errors(repaired);
+    EXPECT_EQ(r4.cellsLoaded + r4.parentsLoaded, 0u);
+    expectSameLevels(repaired, fresh);
+}
+
+TEST(TiledBake, PiecesBakedApartGiveTheWholeBake) {
+    const std::vector<InputObject> objects = world(200, 6);
+    for (const std::vector<double>& deltas : {std::vector<double>{1, 4, 12, 24}, std::vector<double>{}}) {
+        SCOPED_TRACE(deltas.empty() ? "automatic thresholds" : "explicit thresholds");
+        const Settings3D settings = worldSettings(objects, deltas);
+        MemoryCache memory;
+        const TileCache cache = memory.cache();
+        TiledBakeOptions options;
+        options.tileSize = 48;
+        options.cache = &cache;
+        options.task.kind = TileTask::Kind::Plan;
+        Hierarchy3D h;
+        TiledBakeReport plan;
+        ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, h, &plan)) << errors(h);
+        ASSERT_TRUE(plan.tiled);
+        ASSERT_FALSE(plan.cells.empty());
+        EXPECT_TRUE(h.levels.empty());
+        EXPECT_EQ(plan.automaticDeltas, deltas.empty());
+
+        // A parent before its cells: refused, naming what is missing.
+        for (size_t j = 1; j < plan.parents.size(); ++j)
+            if (!plan.parents[j].empty()) {
+                options.task = TileTask{TileTask::Kind::Parent, 0, int(j), plan.parents[j][0].first, plan.parents[j][0].second};
+                EXPECT_FALSE(buildTiledHierarchy3D(objects, settings, options, h));
+                EXPECT_NE(errors(h).find("the tile cache holds no result for"), std::string::npos) << errors(h);
+                break;
+            }
+        // Graphs, cells, then parents level by level (the order aggrelod-farm runs them in).
+        if (plan.automaticDeltas)
+            for (uint32_t cell : plan.cells) {
+                options.task = TileTask{TileTask::Kind::Graph, cell, 0, 0, 0};
+                ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, h)) << errors(h);
+            }
+        for (uint32_t cell : plan.cells) {
+            options.task = TileTask{TileTask::Kind::Cell, cell, 0, 0, 0};
+            ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, h)) << errors(h);
+        }
+        for (size_t j = 1; j < plan.parents.size(); ++j)
+            for (const auto& [row, column] : plan.parents[j]) {
+                options.task = TileTask{TileTask::Kind::Parent, 0, int(j), row, column};
+                ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, h)) << errors(h);
+            }
+        options.task = TileTask{};
+        Hierarchy3D whole, plain;
+        TiledBakeReport report;
+        ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, whole, &report)) << errors(whole);
+        EXPECT_EQ(report.graphsBaked + report.cellsBaked + report.parentsBaked, 0u) << "every piece was in the cache";
+        ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, plain)) << errors(plain);
+        expectSameLevels(whole, plain);
+    }
 }

@@ -23,6 +23,10 @@
 #include <aggrelod/aggregate3d.h>
 
 #include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace aggrelod {
@@ -40,6 +44,48 @@ struct TiledBakeReport {
     size_t splitClusterCount = 0;   ///< clusters wider than S, split by object centre
     size_t splitClusterObjects = 0; ///< objects in them
     bool tiled = false;             ///< false: the world fits one cell and was baked untiled
+    bool automaticDeltas = false;   ///< thresholds by the automatic rule (a graph pass per cell)
+    /// Pieces baked in this run and pieces read from the cache (TiledBakeOptions::cache).
+    size_t graphsBaked = 0, graphsLoaded = 0, cellsBaked = 0, cellsLoaded = 0, parentsBaked = 0, parentsLoaded = 0;
+    /// TileTask::Kind::Plan only: the cells holding objects (row-major index, ascending), and
+    /// per quadtree level j (index j; 0 unused) its parent cells (row, column) that may be baked.
+    std::vector<uint32_t> cells;
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> parents;
+};
+
+/// Where the tiled bake keeps the results of its pieces (cell graphs, cells, parent cells)
+/// between runs and between processes. A key (32 hex digits) names a piece's whole input: its
+/// objects (names, ids, meshes, colours) and the settings that shape it, so a piece whose
+/// input did not change is read back instead of baked (incremental rebake), and a stale entry
+/// is never used. Both functions may be called from the calling thread only.
+struct TileCache {
+    /// Fills `bytes` with the entry `key`; false when there is none.
+    std::function<bool(const std::string& key, std::vector<uint8_t>& bytes)> load;
+    /// Keeps `bytes` as entry `key`; false when it could not (the bake goes on, with a warning).
+    std::function<bool(const std::string& key, const std::vector<uint8_t>& bytes)> store;
+};
+
+/// One piece of a tiled bake, so that pieces can run in separate processes (aggrelod-farm).
+/// A piece reads what it depends on from the cache and fails, naming it, when it is missing:
+/// graphs (automatic thresholds only) before cells, cells before parents, quadtree level j
+/// before j + 1. Everything bakes what the cache lacks and returns the whole hierarchy.
+struct TileTask {
+    enum class Kind {
+        Everything,  ///< the whole bake (default)
+        Plan,        ///< nothing baked: TiledBakeReport::cells and ::parents list the pieces
+        Graph,       ///< the neighbourhood graph of cell `cell` (automatic thresholds)
+        Cell,        ///< the levels of cell `cell`
+        Parent       ///< the levels of parent cell (row, column) of quadtree level `level`
+    } kind = Kind::Everything;
+    uint32_t cell = 0;
+    int level = 0;
+    uint32_t row = 0, column = 0;
+};
+
+struct TiledBakeOptions {
+    double tileSize = 0;              ///< S (world units), or 0 for the automatic choice
+    const TileCache* cache = nullptr; ///< optional; not used with Settings3D::customFunction
+    TileTask task;                    ///< a piece only (the result then holds no levels)
 };
 
 /// Objects per cell the automatic tile size aims at (tileSize == 0).
@@ -55,5 +101,9 @@ constexpr size_t kAutomaticTileObjects = 2000;
 /// Returns false with an Error diagnostic as buildHierarchy3D does. Never throws for bad input.
 bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings, double tileSize,
                            Hierarchy3D& out, TiledBakeReport* report = nullptr);
+
+/// The same with a cache and, optionally, one piece only (TileTask).
+bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings,
+                           const TiledBakeOptions& options, Hierarchy3D& out, TiledBakeReport* report = nullptr);
 
 }  // namespace aggrelod

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The tiled bake's cache as a folder of files (tile_cache.h).
+#include "tile_cache.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
+#include <unistd.h>
+
+namespace aggrelod::io {
+
+namespace fs = std::filesystem;
+
+TileCache folderTileCache(const std::string& dir) {
+    TileCache cache;
+    cache.load = [dir](const std::string& key, std::vector<uint8_t>& bytes) {
+        const fs::path path = fs::path(dir) / (key + ".piece");
+        std::error_code ec;
+        const uintmax_t size = fs::file_size(path, ec);
+        if (ec || size > (uintmax_t(1) << 40)) return false;
+        std::ifstream in(path, std::ios::binary);
+        bytes.resize(static_cast<size_t>(size));
+        return bool(in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())));
+    };
+    cache.store = [dir](const std::string& key, const std::vector<uint8_t>& bytes) {
+        std::error_code ec;
+        fs::create_directories(dir, ec);
+        const fs::path path = fs::path(dir) / (key + ".piece");
+        const fs::path temporary = fs::path(dir) / (key + ".piece." + std::to_string(getpid()) + ".tmp");
+        {
+            std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+            if (!out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()))) return false;
+        }
+        fs::rename(temporary, path, ec);
+        if (!ec) return true;
+        std::error_code ignored;
+        fs::remove(temporary, ignored);
+        return false;
+    };
+    return cache;
+}
+
+}  // namespace aggrelod::io
