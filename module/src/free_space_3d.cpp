@@ -64,6 +64,16 @@ bool Baker3D::triangulate() {
                      std::string("TetGen's boundary recovery failed (") + outcome.message + "); succeeded with switch " + fallback);
             outcome = retry;
         }
+        if (outcome.status == TetgenStatus::ToleranceError) {
+            // Features below TetGen's relative tolerance (1e-8 of the box): once more with a
+            // finer one. Large inputs of fine detail meet it, e.g. the tiled bake's parents.
+            space_ = FreeSpace{};
+            TetgenOutcome retry = tetrahedralizePlc(plc, space_.mesh, "T1e-12");
+            if (retry.status == TetgenStatus::Ok)
+                diag(out_, Diagnostic::Severity::Note, "",
+                     "TetGen found features below its tolerance (" + outcome.message + "); succeeded with tolerance 1e-12");
+            outcome = retry;
+        }
         if (outcome.status == TetgenStatus::Ok) {
             timer_.begin("free space");
             space_.modelCount = models_.size();

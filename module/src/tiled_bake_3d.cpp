@@ -5,6 +5,8 @@
 // tiled_bake_3d.h.
 #include "baker_3d.h"
 #include "hierarchy_serialize.h"
+#include "parallel_for.h"
+#include "solidify.h"
 
 #include <aggrelod/dendrogram.h>
 #include <aggrelod/disjoint_sets.h>
@@ -92,6 +94,7 @@ private:
     std::vector<uint32_t> cellOf_;                  ///< per object: its cell (row-major), aggregated objects only
     std::map<uint32_t, std::vector<uint32_t>> cells_;  ///< cell -> its objects, ascending
     std::vector<uint32_t> unusable_;                 ///< objects with no finite triangle
+    bool keepOut_ = false;                           ///< the piece just baked is not to be cached
 
     void findSupport();
     void assignCells();
@@ -113,7 +116,7 @@ private:
 };
 
 void hashSettings(detail::ContentHash& h, const Settings3D& s) {
-    h.text("aggrelod tile piece 1");
+    h.text("aggrelod tile piece 3");
     h.u64(uint64_t(s.function));
     h.u64(uint64_t(s.distance));
     h.f64(s.touchTolerance);
@@ -169,9 +172,10 @@ bool TiledBaker::obtain(const std::string& key, const std::string& name, bool ma
                                                         "): bake that piece first");
         return false;
     }
+    keepOut_ = false;
     if (!bake(part)) return fail(part, name);
     ++baked;
-    if (caching()) {
+    if (caching() && !keepOut_) {
         std::vector<uint8_t> bytes;
         detail::serializeHierarchy(part, bytes);
         if (!options_.cache->store(key, bytes))
@@ -481,16 +485,25 @@ bool TiledBaker::run(double tileSize) {
         for (const auto& [where, inputs] : parents) {
             std::vector<char> passed(inputs.size(), inputs.size() < 2);
             if (inputs.size() >= 2) {
+                // The inputs: the coarsest aggregates so far, each wrapped (CGAL alpha wrap) at a
+                // scale of this level's delta. A wrap contains its aggregate, which contains
+                // its originals; it is light and clean where the exact aggregate carries every
+                // original face and the fine fill, which is what bounds a parent's
+                // triangulation. The proxies stage certifies every error against the originals.
+                const double alpha = deltas.front() / 8, offset = deltas.front() / 64;
                 std::vector<InputObject> objects(inputs.size());
-                for (size_t i = 0; i < inputs.size(); ++i) {
+                detail::parallelFor(inputs.size(), settings_.threadCount, [&](size_t i) {
                     const Aggregate& a = top.aggregates[inputs[i]];
                     objects[i].name = "aggregate of " + objects_[a.sourceObjects.front()].name +
                                       (a.sourceObjects.size() > 1 ? " (+" + std::to_string(a.sourceObjects.size() - 1) + ")" : "");
                     objects[i].id = static_cast<uint32_t>(i);
-                    objects[i].positions = a.positions;
-                    objects[i].indices = a.indices;
-                    objects[i].triangleColors = a.faceColors;
-                }
+                    std::string ignored;
+                    if (!detail::alphaWrap(a.positions, a.indices, alpha, offset, objects[i].positions, objects[i].indices, ignored)) {
+                        objects[i].positions = a.positions;  // the exact aggregate then
+                        objects[i].indices = a.indices;
+                        objects[i].triangleColors = a.faceColors;
+                    }
+                });
                 Settings3D settings = cellSettings(deltas);
                 Hierarchy3D part;
                 const std::string name = "parent tile " + std::to_string(j) + ":" + std::to_string(where.first) + "," +
@@ -526,6 +539,7 @@ bool TiledBaker::run(double tileSize) {
                         if (d.severity == Diagnostic::Severity::Error) why = d.message;
                     diag(p, Diagnostic::Severity::Warning, "", name + " not aggregated (" + why + "): its " +
                                                                   std::to_string(objects.size()) + " inputs pass through");
+                    keepOut_ = true;  // a later run tries again
                     return true;
                 };
                 if (!obtain(key.hex(), name, isTask(Kind::Everything) || target, bake, part, report_.parentsBaked,
