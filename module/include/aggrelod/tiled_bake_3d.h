@@ -4,9 +4,10 @@
 //
 // The world is cut into square cells of side S along the scene's two longest axes. Each
 // cell is baked alone (buildHierarchy3D on its objects) for the levels with delta <= S / 8;
-// levels above are built by baking the cells' coarsest aggregates as objects in the parent
-// cells of a quadtree (parent cell of quadtree level j: 2^j x 2^j cells). The result is one
-// Hierarchy3D, as buildHierarchy3D gives, for buildHierarchyNodes and every writer.
+// levels above are built by baking alpha wraps of the cells' coarsest aggregates as objects
+// in the parent cells of a quadtree (parent cell of quadtree level j: 2^j x 2^j cells; wrap
+// alpha delta / 8, offset delta / 64, so distances there are between wraps). The result is
+// one Hierarchy3D, as buildHierarchy3D gives, for buildHierarchyNodes and every writer.
 //
 // Cell rule: objects whose boxes come within S / 8 of each other (chains included) form a
 // cluster, and a cluster goes whole to the cell holding the box centre of its first object,
