@@ -492,18 +492,24 @@ bool TiledBaker::run(double tileSize) {
                 // triangulation. The proxies stage certifies every error against the originals.
                 const double alpha = deltas.front() / 8, offset = deltas.front() / 64;
                 std::vector<InputObject> objects(inputs.size());
-                detail::parallelFor(inputs.size(), settings_.threadCount, [&](size_t i) {
+                for (size_t i = 0; i < inputs.size(); ++i) {
                     const Aggregate& a = top.aggregates[inputs[i]];
                     objects[i].name = "aggregate of " + objects_[a.sourceObjects.front()].name +
                                       (a.sourceObjects.size() > 1 ? " (+" + std::to_string(a.sourceObjects.size() - 1) + ")" : "");
                     objects[i].id = static_cast<uint32_t>(i);
-                    std::string ignored;
-                    if (!detail::alphaWrap(a.positions, a.indices, alpha, offset, objects[i].positions, objects[i].indices, ignored)) {
-                        objects[i].positions = a.positions;  // the exact aggregate then
-                        objects[i].indices = a.indices;
-                        objects[i].triangleColors = a.faceColors;
-                    }
-                });
+                }
+                const auto wrapInputs = [&] {  // only when the piece is baked: the key is of the aggregates
+                    detail::parallelFor(inputs.size(), settings_.threadCount, [&](size_t i) {
+                        const Aggregate& a = top.aggregates[inputs[i]];
+                        std::string ignored;
+                        if (!detail::alphaWrap(a.positions, a.indices, alpha, offset, objects[i].positions,
+                                               objects[i].indices, ignored)) {
+                            objects[i].positions = a.positions;  // the exact aggregate then
+                            objects[i].indices = a.indices;
+                            objects[i].triangleColors = a.faceColors;
+                        }
+                    });
+                };
                 Settings3D settings = cellSettings(deltas);
                 Hierarchy3D part;
                 const std::string name = "parent tile " + std::to_string(j) + ":" + std::to_string(where.first) + "," +
@@ -526,6 +532,7 @@ bool TiledBaker::run(double tileSize) {
                 // level's delta as one model (they join at this level anyway), and if that fails
                 // too the inputs pass through unchanged, with a warning.
                 const auto bake = [&](Hierarchy3D& p) {
+                    wrapInputs();
                     if (buildHierarchy3D(objects, settings, p)) return true;
                     Settings3D closer = settings;
                     closer.touchTolerance = std::max(tolerance_, 1e-3 * deltas.front());
