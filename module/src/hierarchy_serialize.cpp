@@ -157,8 +157,8 @@ bool deserializeHierarchy(const std::vector<uint8_t>& bytes, Hierarchy3D& h) {
     Reader r(bytes);
     for (char c : kMagic)
         if (r.pod<char>() != c) return false;
-    // Smallest encoded sizes bound every count: a level is 8 + 8 + 3*8 + 4*8 + 1 + 8 bytes.
-    h.levels.resize(r.count(81));
+    // Smallest encoded sizes bound every count: a level is at least 8 + 8 + 3*8 + 3*8 + 1 + 8 bytes.
+    h.levels.resize(r.count(73));
     for (Level& l : h.levels) {
         l.delta = r.pod<double>();
         l.aggregates.resize(r.count(4 * 8 + 8 + 3 * 8 + 2 * 8 + 1));

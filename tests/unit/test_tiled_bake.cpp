@@ -5,6 +5,7 @@
 // share is measured), every cut covers every object exactly once, proxies stay within their
 // certified budgets, and the result does not depend on the thread count.
 #include "generated_world.h"
+#include "hierarchy_serialize.h"
 #include "test_support.h"
 
 #include <aggrelod/aggregate3d.h>
@@ -364,4 +365,36 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
     ASSERT_EQ(second.exitCode, 0) << second.describe();
     EXPECT_NE(second.out.find("tiles: 0 cells and 0 parent cells baked"), std::string::npos) << second.out;
     EXPECT_EQ(aggrelod::testing::readFile(dir / "out" / "scene.aglod"), aglod) << "a cached rebake gives the same file";
+}
+
+TEST(TiledBake, CacheEntriesRoundTripAndDamagedOnesAreRefused) {
+    const std::vector<InputObject> objects = world(40, 2);
+    Hierarchy3D h;
+    ASSERT_TRUE(buildHierarchy3D(objects, worldSettings(objects, {1, 4}), h)) << errors(h);
+    std::vector<uint8_t> bytes;
+    detail::serializeHierarchy(h, bytes);
+    Hierarchy3D back;
+    ASSERT_TRUE(detail::deserializeHierarchy(bytes, back));
+    std::vector<uint8_t> again;
+    detail::serializeHierarchy(back, again);
+    EXPECT_EQ(again, bytes);
+    expectSameLevels(h, back);
+    // Every truncation is refused; a flipped byte is refused or read as a result of the same
+    // layout (written again, it has the same size: no count was misread).
+    for (size_t cut = 0; cut < bytes.size(); cut += std::max<size_t>(1, bytes.size() / 997)) {
+        const std::vector<uint8_t> shorter(bytes.begin(), bytes.begin() + cut);
+        EXPECT_FALSE(detail::deserializeHierarchy(shorter, back)) << "cut at " << cut;
+        EXPECT_TRUE(back.levels.empty());
+    }
+    std::vector<uint8_t> longer = bytes;
+    longer.push_back(0);
+    EXPECT_FALSE(detail::deserializeHierarchy(longer, back));
+    for (size_t at = 0; at < bytes.size(); at += std::max<size_t>(1, bytes.size() / 499)) {
+        std::vector<uint8_t> flipped = bytes;
+        flipped[at] ^= 0xff;
+        if (!detail::deserializeHierarchy(flipped, back)) continue;
+        std::vector<uint8_t> rewritten;
+        detail::serializeHierarchy(back, rewritten);
+        EXPECT_EQ(rewritten.size(), flipped.size()) << "flipped byte " << at;
+    }
 }
