@@ -87,7 +87,9 @@ TEST(TiledBake, CellLevelsGroupAsUntiledAndEveryCutCoversEachObjectOnce) {
                         tiled.levels[k].delta, a.size(), b.size(), differ, 100 * share,
                         tiled.levels[k].delta <= report.cellTopDelta ? " [cell level]" : " [parent level]");
             if (tiled.levels[k].delta <= report.cellTopDelta) {
-                if (report.splitClusterCount == 0) EXPECT_EQ(differ, 0u);
+                if (report.splitClusterCount == 0) {
+                    EXPECT_EQ(differ, 0u);
+                }
                 EXPECT_LE(share, 0.05) << "level " << k;
                 EXPECT_GE(b.size(), a.size()) << "a cell level joins no more than the untiled one";
             }
@@ -105,8 +107,9 @@ TEST(TiledBake, CellLevelsGroupAsUntiledAndEveryCutCoversEachObjectOnce) {
         for (uint32_t r : nodes.roots)
             for (uint32_t o : nodes.nodes[r].sources) ++covered[o];
         for (size_t o = 0; o < objects.size(); ++o)
-            if (!std::binary_search(tiled.supportObjects.begin(), tiled.supportObjects.end(), uint32_t(o)))
+            if (!std::binary_search(tiled.supportObjects.begin(), tiled.supportObjects.end(), uint32_t(o))) {
                 EXPECT_EQ(covered[o], 1) << objects[o].name;
+            }
         for (size_t i = nodes.objectCount; i < nodes.nodes.size(); ++i) {
             const HierarchyNode& n = nodes.nodes[i];
             std::vector<uint32_t> union_;
@@ -144,9 +147,11 @@ TEST(TiledBake, AutomaticThresholdsSpanCellsAndQuadtree) {
     ASSERT_TRUE(report.tiled);
     size_t cellLevels = 0;
     for (size_t k = 0; k < h.levels.size(); ++k) {
-        if (k) EXPECT_GT(h.levels[k].delta, h.levels[k - 1].delta);
         cellLevels += h.levels[k].delta <= report.cellTopDelta ? 1 : 0;
-        if (k) EXPECT_LE(h.levels[k].aggregates.size(), h.levels[k - 1].aggregates.size());
+        if (k) {
+            EXPECT_GT(h.levels[k].delta, h.levels[k - 1].delta);
+            EXPECT_LE(h.levels[k].aggregates.size(), h.levels[k - 1].aggregates.size());
+        }
     }
     EXPECT_GE(cellLevels, 2u);
     EXPECT_EQ(h.levels.size() - cellLevels, size_t(report.quadtreeDepth));
