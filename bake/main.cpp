@@ -469,18 +469,7 @@ int runBake(BakeOptions o) {
             return kBakeFailed;
         }
         if (tiling.task.kind == TileTask::Kind::Plan) {
-            std::string plan = "{\"tiled\": " + std::string(tiled.tiled ? "true" : "false") +
-                               ", \"graphs\": " + (tiled.automaticDeltas ? "true" : "false") + ", \"cells\": [";
-            for (size_t i = 0; i < tiled.cells.size(); ++i) plan += (i ? ", " : "") + std::to_string(tiled.cells[i]);
-            plan += "], \"parents\": [";
-            bool first = true;
-            for (size_t j = 0; j < tiled.parents.size(); ++j)
-                for (const auto& [row, column] : tiled.parents[j]) {
-                    plan += (first ? "[" : ", [") + std::to_string(j) + ", " + std::to_string(row) + ", " +
-                            std::to_string(column) + "]";
-                    first = false;
-                }
-            std::printf("%s]}\n", plan.c_str());
+            std::printf("%s\n", io::tilePlanJson(tiled).c_str());
         } else if (!o.quiet) {
             std::printf("tile task %s: %zu pieces baked, %zu read from the cache\n", o.tileTask.c_str(),
                         tiled.graphsBaked + tiled.cellsBaked + tiled.parentsBaked,

@@ -2,6 +2,8 @@
 // The tiled bake's cache as a folder of files (tile_cache.h).
 #include "tile_cache.h"
 
+#include "json.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -40,6 +42,18 @@ TileCache folderTileCache(const std::string& dir) {
         return false;
     };
     return cache;
+}
+
+std::string tilePlanJson(const TiledBakeReport& plan) {
+    Json parents = Json::array();
+    for (size_t j = 0; j < plan.parents.size(); ++j)
+        for (const auto& [row, column] : plan.parents[j]) parents.push_back({j, row, column});
+    Json j;
+    j["tiled"] = plan.tiled;
+    j["graphs"] = plan.automaticDeltas;
+    j["cells"] = plan.cells;
+    j["parents"] = std::move(parents);
+    return j.dump();
 }
 
 }  // namespace aggrelod::io

@@ -13,4 +13,8 @@ namespace aggrelod::io {
 /// A TileCache over folder `dir` (created when missing). Entries are `dir/KEY.piece`.
 TileCache folderTileCache(const std::string& dir);
 
+/// The pieces of a tiled bake (TileTask::Kind::Plan's report) as one line of JSON:
+/// {"tiled": bool, "graphs": bool, "cells": [N...], "parents": [[J, ROW, COLUMN]...]}.
+std::string tilePlanJson(const TiledBakeReport& plan);
+
 }  // namespace aggrelod::io

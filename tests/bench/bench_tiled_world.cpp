@@ -7,6 +7,8 @@
 // peak memory, nodes; then, per level, how many tiled groups differ from the untiled ones;
 // and the checks of the tiled tree (every cut covers every object once: each node's sources
 // are the disjoint union of its children's; every certified error within its budget).
+#include "generated_world.h"
+
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/hierarchy_nodes.h>
 #include <aggrelod/tiled_bake_3d.h>
@@ -38,18 +40,9 @@ struct Options {
     std::vector<double> deltas{0.5, 1, 2, 4, 8, 16, 32, 64};
 };
 
-std::vector<InputObject> makeWorld(const Options& o) {
-    std::vector<InputObject> objects;
-    samples::WorldSettings s;
-    s.objectCount = o.objects;
-    s.seed = o.seed;
-    samples::generateWorld(s, [&](InputObject& x) { objects.push_back(x); });
-    return objects;
-}
-
 /// Bakes in this (child) process and writes the figures and the groups to `path`.
 int bakeInChild(const Options& o, bool tiled, const std::string& path) {
-    const std::vector<InputObject> objects = makeWorld(o);
+    const std::vector<InputObject> objects = aggrelod::testing::generatedWorld(o.objects, o.seed);
     Settings3D settings;
     settings.deltas = o.deltas;
     settings.threadCount = o.threads;

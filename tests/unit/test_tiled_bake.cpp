@@ -359,7 +359,8 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
 
     const auto plan = bake({"--tile-size", "48", "--tile-task", "plan", "--quiet"});
     ASSERT_EQ(plan.exitCode, 0) << plan.describe();
-    EXPECT_EQ(plan.out.rfind("{\"tiled\": true, \"graphs\": true, \"cells\": [", 0), 0u) << plan.out;
+    EXPECT_EQ(plan.out.rfind("{\"tiled\":true,\"graphs\":true,\"cells\":[", 0), 0u) << plan.out;
+    EXPECT_NE(plan.out.find("\"parents\":[[1,"), std::string::npos) << plan.out;
 
     const std::vector<std::string> cached{"--tile-size", "48", "--tile-cache", (dir / "cache").string(), "--delta", "1,4,12"};
     const auto first = bake(cached);
