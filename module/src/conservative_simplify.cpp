@@ -79,17 +79,15 @@ public:
         double lo[3], hi[3];
     };
 
-    /// Replaces the tree by a balanced one over `boxes` (face f has boxes[f]), split at the
-    /// median centroid along the longest axis; leafOut[f] = the leaf of face f. Incremental
-    /// inserts alone would let the tree degenerate on a large mesh.
-    void build(const std::vector<Box>& boxes, std::vector<uint32_t>& leafOut) {
+    /// Replaces the tree by a balanced one over `faces` (face f has boxes[f]), split at the
+    /// median centroid along the longest axis; leafOut[f] = the leaf of face f (kNone for
+    /// faces not listed). Incremental inserts alone would let the tree degenerate.
+    void build(const std::vector<Box>& boxes, std::vector<uint32_t> faces, std::vector<uint32_t>& leafOut) {
         nodes_.clear();
         free_.clear();
         root_ = kNone;
         leafOut.assign(boxes.size(), kNone);
-        if (boxes.empty()) return;
-        std::vector<uint32_t> faces(boxes.size());
-        for (uint32_t f = 0; f < faces.size(); ++f) faces[f] = f;
+        if (faces.empty()) return;
         root_ = buildRange(boxes, faces, 0, faces.size(), kNone, leafOut);
     }
 
@@ -159,6 +157,11 @@ public:
         return false;
     }
 
+    static bool overlap(const Box& a, const Box& b) {
+        for (int k = 0; k < 3; ++k)
+            if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+        return true;
+    }
     static Box merge(const Box& a, const Box& b) {
         Box m;
         for (int k = 0; k < 3; ++k) {
@@ -201,11 +204,6 @@ private:
         return at;
     }
     static double perimeter(const Box& b) { return (b.hi[0] - b.lo[0]) + (b.hi[1] - b.lo[1]) + (b.hi[2] - b.lo[2]); }
-    static bool overlap(const Box& a, const Box& b) {
-        for (int k = 0; k < 3; ++k)
-            if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
-        return true;
-    }
     uint32_t allocate() {
         uint32_t i;
         if (!free_.empty()) {
@@ -284,9 +282,7 @@ public:
             for (size_t v = 0; v < std::min(n, pinned->size()); ++v) locked_[v] |= (*pinned)[v];
         liveFaces_ = faces_.size();
         mark_.assign(n, 0);
-        std::vector<FaceTree::Box> boxes(faces_.size());
-        for (uint32_t f = 0; f < faces_.size(); ++f) boxes[f] = faceBox(f);
-        tree_.build(boxes, faceLeaf_);
+        rebuildTree();
     }
 
     /// Collapses while the cheapest collapse costs <= maxError and more than minTriangles
@@ -531,6 +527,19 @@ private:
         return true;
     }
 
+    void rebuildTree() {
+        std::vector<FaceTree::Box> boxes(faces_.size());
+        std::vector<uint32_t> live;
+        live.reserve(liveFaces_);
+        for (uint32_t f = 0; f < faces_.size(); ++f)
+            if (faceAlive_[f]) {
+                boxes[f] = faceBox(f);
+                live.push_back(f);
+            }
+        tree_.build(boxes, std::move(live), faceLeaf_);
+        treeChanges_ = 0;
+    }
+
     FaceTree::Box faceBox(uint32_t f) const {
         FaceTree::Box box;
         for (int k = 0; k < 3; ++k) box.lo[k] = INFINITY, box.hi[k] = -INFINITY;
@@ -545,35 +554,57 @@ private:
     /// vertex with it? Neighbours sharing a vertex are left to the fold test; the check keeps
     /// two parts of the surface pushed towards each other across a narrow gap from meeting.
     bool crossesOtherFaces(uint32_t a, uint32_t b, V3 position) {
+        // The new faces (every one holds a), and one query over the box around all of them.
+        newFaces_.clear();
+        FaceTree::Box all;
+        for (int k = 0; k < 3; ++k) all.lo[k] = INFINITY, all.hi[k] = -INFINITY;
         for (uint32_t f : scratchFaces_) {  // the faces around the edge, from evaluate()
             const auto& t = faces_[f];
             if ((t[0] == a || t[1] == a || t[2] == a) && (t[0] == b || t[1] == b || t[2] == b)) continue;
-            double corners[9];
-            uint32_t ids[3];
+            NewFace n;
+            for (int k = 0; k < 3; ++k) n.box.lo[k] = INFINITY, n.box.hi[k] = -INFINITY;
+            for (int k = 0; k < 3; ++k) {
+                n.ids[k] = (t[k] == a || t[k] == b) ? a : t[k];
+                const V3 q = (t[k] == a || t[k] == b) ? position : p_[t[k]];
+                n.corners[3 * k] = q.x, n.corners[3 * k + 1] = q.y, n.corners[3 * k + 2] = q.z;
+                for (int d = 0; d < 3; ++d) {
+                    n.box.lo[d] = std::min(n.box.lo[d], n.corners[3 * k + d]);
+                    n.box.hi[d] = std::max(n.box.hi[d], n.corners[3 * k + d]);
+                }
+            }
+            all = FaceTree::merge(all, n.box);
+            newFaces_.push_back(n);
+        }
+        if (newFaces_.empty()) return false;
+        return tree_.query(all, [&](uint32_t g) {
+            const auto& u = faces_[g];
+            // Faces around the edge share a with every new face: left to the fold test.
+            if (u[0] == a || u[1] == a || u[2] == a || u[0] == b || u[1] == b || u[2] == b) return false;
+            double other[9];
             FaceTree::Box box;
             for (int k = 0; k < 3; ++k) box.lo[k] = INFINITY, box.hi[k] = -INFINITY;
             for (int k = 0; k < 3; ++k) {
-                ids[k] = (t[k] == a || t[k] == b) ? a : t[k];
-                const V3 q = (t[k] == a || t[k] == b) ? position : p_[t[k]];
-                corners[3 * k] = q.x, corners[3 * k + 1] = q.y, corners[3 * k + 2] = q.z;
-                const double qq[3] = {q.x, q.y, q.z};
-                for (int d = 0; d < 3; ++d) box.lo[d] = std::min(box.lo[d], qq[d]), box.hi[d] = std::max(box.hi[d], qq[d]);
+                other[3 * k] = p_[u[k]].x, other[3 * k + 1] = p_[u[k]].y, other[3 * k + 2] = p_[u[k]].z;
+                for (int d = 0; d < 3; ++d) {
+                    box.lo[d] = std::min(box.lo[d], other[3 * k + d]);
+                    box.hi[d] = std::max(box.hi[d], other[3 * k + d]);
+                }
             }
-            const bool crossing = tree_.query(box, [&](uint32_t g) {
-                const auto& u = faces_[g];
-                for (uint32_t w : u)
-                    if (w == ids[0] || w == ids[1] || w == ids[2] || w == b) return false;
-                double other[9];
-                for (int k = 0; k < 3; ++k) other[3 * k] = p_[u[k]].x, other[3 * k + 1] = p_[u[k]].y, other[3 * k + 2] = p_[u[k]].z;
-                if (sharePosition(corners, other) || separatedByPlaneOf(corners, other) || separatedByPlaneOf(other, corners))
-                    return false;
+            for (const NewFace& n : newFaces_) {
+                if (!FaceTree::overlap(n.box, box)) continue;
+                if (u[0] == n.ids[1] || u[0] == n.ids[2] || u[1] == n.ids[1] || u[1] == n.ids[2] || u[2] == n.ids[1] ||
+                    u[2] == n.ids[2] || u[0] == n.ids[0] || u[1] == n.ids[0] || u[2] == n.ids[0])
+                    continue;  // shares a vertex: the fold test's
+                if (sharePosition(n.corners, other) || separatedByPlaneOf(n.corners, other) ||
+                    separatedByPlaneOf(other, n.corners))
+                    continue;
                 bool hit = false;
-                triangleTriangleDistance(corners, corners + 3, corners + 6, other, other + 3, other + 6, nullptr, nullptr, &hit);
-                return hit;
-            });
-            if (crossing) return true;
-        }
-        return false;
+                triangleTriangleDistance(n.corners, n.corners + 3, n.corners + 6, other, other + 3, other + 6, nullptr,
+                                         nullptr, &hit);
+                if (hit) return true;
+            }
+            return false;
+        });
     }
 
     void collapse(uint32_t a, uint32_t b, const Candidate& c) {
@@ -603,6 +634,10 @@ private:
             tree_.remove(faceLeaf_[f]);
             faceLeaf_[f] = tree_.insert(f, faceBox(f));
         }
+        // Inserts without rotations let the tree degrade: rebuild it balanced once as many
+        // faces were reinserted as are alive (amortised O(log n) per face).
+        treeChanges_ += listA.size();
+        if (treeChanges_ > liveFaces_ + 64) rebuildTree();
         vertexFaces_[b].clear();
         alive_[b] = 0;
         quadric_[a] += quadric_[b];
@@ -630,11 +665,18 @@ private:
     double epsilon_ = 0;
     bool started_ = false;
     std::vector<uint32_t> scratchFaces_, scratchNeighbours_;
+    struct NewFace {
+        double corners[9];
+        uint32_t ids[3];
+        FaceTree::Box box;
+    };
+    std::vector<NewFace> newFaces_;  ///< crossesOtherFaces' scratch
     std::vector<uint32_t> mark_;  ///< per vertex: markStamp_ when seen by the current link test
     uint32_t markStamp_ = 0;
     std::vector<Plane> planes_;
     FaceTree tree_;
     std::vector<uint32_t> faceLeaf_;
+    size_t treeChanges_ = 0;  ///< faces reinserted since the tree was last built
 };
 
 bool boxesOverlap(const TriangleBvh::Node& x, const TriangleBvh::Node& y) {

@@ -134,11 +134,13 @@ double roundingSlack(const std::vector<double>& exact, const std::vector<float>&
 ProxyError measureEnclosure(const std::vector<double>& exact, const std::vector<float>& positions,
                             const std::vector<uint32_t>& indices,
                             const std::vector<const detail::PreparedOriginal*>& originals, double tolerance,
-                            const ProxySettings& settings, double giveUpAbove) {
+                            const ProxySettings& settings, double giveUpAbove,
+                            detail::TriangleBoundCache* cache = nullptr) {
     detail::ProxyMeasureOptions options;
     options.enclosesOriginals = true;
     options.enclosureSlack = roundingSlack(exact, positions);
     options.giveUpAbove = giveUpAbove;
+    options.cache = cache;
     return detail::measureProxyErrorPrepared(positions, indices, originals, tolerance,
                                              settings.maxRefinementsPerDirection, options);
 }
@@ -194,45 +196,68 @@ bool hasCollapsedTriangle(const std::vector<float>& positions, const std::vector
     return false;
 }
 
-/// Few-faced convex polytopes around a closed mesh's convex hull (bounding_polytope.h), and
-/// the certified error of that hull against the originals: a polytope within d of the hull
-/// lies within d + that error of them, which picks the candidate before it is measured.
+/// Few-faced convex polytopes around a closed mesh's convex hull (bounding_polytope.h), each
+/// built and measured once, on demand. A polytope within d of the hull lies within d plus the
+/// hull's error of the originals; that error, estimated from below by the distance found at
+/// the hull's faces' centroids, screens the candidates before they are measured. No polytope
+/// does better than that distance (a point outside a hull face is no nearer the originals
+/// behind it than the face's point below it).
 class PolytopeSource {
 public:
     PolytopeSource(const std::vector<double>& positions, const std::vector<const detail::PreparedOriginal*>& originals,
-                   double tolerance, const ProxySettings& settings, double giveUpAbove)
-        : originals_(originals), settings_(settings) {
+                   const ProxySettings& settings, double giveUpAbove, detail::TriangleBoundCache* cache)
+        : originals_(originals), settings_(settings), cache_(cache) {
         if (settings.polytopeVertices < 4) return;
         std::vector<double> hullPositions;
         std::vector<uint32_t> hullIndices;
         if (!detail::convexHull3(positions, hullPositions, hullIndices)) return;
-        const std::vector<float> rounded = toFloats(hullPositions);
-        hullError_ = measureEnclosure(hullPositions, rounded, hullIndices, originals, tolerance, settings, giveUpAbove).bound();
-        if (!(hullError_ < giveUpAbove)) return;
+        for (size_t t = 0; t + 2 < hullIndices.size(); t += 3) {
+            double c[3];
+            for (int k = 0; k < 3; ++k)
+                c[k] = (hullPositions[3 * hullIndices[t] + k] + hullPositions[3 * hullIndices[t + 1] + k] +
+                        hullPositions[3 * hullIndices[t + 2] + k]) / 3.0;
+            double nearest = INFINITY;
+            for (const detail::PreparedOriginal* o : originals)
+                nearest = std::min(nearest, detail::closestPoint(o->bvh, c, nearest).distance);
+            hullReach_ = std::max(hullReach_, nearest);
+        }
+        if (!(hullReach_ < giveUpAbove)) return;
         enclosed_ = positions;
         polytopes_ = detail::boundingPolytopes(hullPositions, hullIndices, size_t(settings.polytopeVertices), 0.0);
+        measured_.resize(polytopes_.size());
     }
 
     /// The coarsest polytope whose certified error fits `budget`, with at most
     /// maxTriangles triangles; false when none does. n gets positions, indices and error.
-    bool coarsestWithin(double budget, size_t maxTriangles, double tolerance, HierarchyNode& n) const {
+    /// Callers ask for ascending budgets: each polytope's mesh is built and its error
+    /// measured once (again only when an earlier measurement gave up below the new budget).
+    bool coarsestWithin(double budget, size_t maxTriangles, double tolerance, HierarchyNode& n) {
         int tried = 0;
-        for (const detail::BoundingPolytope& p : polytopes_) {
+        for (size_t i = 0; i < polytopes_.size(); ++i) {
+            const detail::BoundingPolytope& p = polytopes_[i];
             if (2 * (p.vertices.size() / 3) > maxTriangles + 4) break;  // a triangulated polytope has 2V - 4 faces
-            if (!(p.distanceToHull + hullError_ <= budget)) continue;
-            std::vector<double> positions;
-            std::vector<uint32_t> indices;
-            if (!detail::boundingPolytopeMesh(p, enclosed_, positions, indices) || indices.size() / 3 > maxTriangles) continue;
-            HierarchyNode candidate;
-            candidate.positions = toFloats(positions);
-            candidate.indices = std::move(indices);
-            if (hasCollapsedTriangle(candidate.positions, candidate.indices)) continue;  // corners merged by float rounding
-            candidate.error = measureEnclosure(positions, candidate.positions, candidate.indices, originals_, tolerance,
-                                               settings_, budget);
-            if (candidate.error.bound() <= budget) {
-                n.positions = std::move(candidate.positions);
-                n.indices = std::move(candidate.indices);
-                n.error = candidate.error;
+            if (!(p.distanceToHull + hullReach_ <= budget)) continue;
+            Measured& m = measured_[i];
+            if (m.state == Measured::Unbuilt) {
+                std::vector<double> positions;
+                m.state = Measured::Unusable;
+                if (!detail::boundingPolytopeMesh(p, enclosed_, positions, m.indices)) continue;
+                m.positions = toFloats(positions);
+                if (hasCollapsedTriangle(m.positions, m.indices)) continue;  // corners merged by float rounding
+                m.exact = std::move(positions);
+                m.state = Measured::Built;
+            }
+            if (m.state == Measured::Unusable || m.indices.size() / 3 > maxTriangles) continue;
+            // Measured again only when an earlier measurement stopped at a distance found
+            // over its budget but not over this one.
+            if (m.state == Measured::Built || (m.state == Measured::GaveUp && !(m.error.proxyToOriginalsLower > budget))) {
+                m.error = measureEnclosure(m.exact, m.positions, m.indices, originals_, tolerance, settings_, budget, cache_);
+                m.state = m.error.proxyToOriginalsLower > budget ? Measured::GaveUp : Measured::Certified;
+            }
+            if (m.state == Measured::Certified && m.error.bound() <= budget) {
+                n.positions = m.positions;
+                n.indices = m.indices;
+                n.error = m.error;
                 return true;
             }
             if (++tried == 2) break;  // the bound by the triangle inequality was loose twice
@@ -241,11 +266,21 @@ public:
     }
 
 private:
+    /// A polytope's mesh and certified error, made once.
+    struct Measured {
+        enum State { Unbuilt, Unusable, Built, Certified, GaveUp } state = Unbuilt;
+        std::vector<double> exact;
+        std::vector<float> positions;
+        std::vector<uint32_t> indices;
+        ProxyError error;  ///< Certified: final; GaveUp: stopped early, proxyToOriginalsLower is a distance found
+    };
     const std::vector<const detail::PreparedOriginal*>& originals_;
     const ProxySettings& settings_;
     std::vector<double> enclosed_;
     std::vector<detail::BoundingPolytope> polytopes_;
-    double hullError_ = INFINITY;
+    std::vector<Measured> measured_;
+    detail::TriangleBoundCache* cache_;
+    double hullReach_ = 0;  ///< a distance from the hull to the originals found at its faces' centroids
 };
 
 /// A proxy as built, in doubles, before vertex-cache ordering: what its coarser versions
@@ -271,7 +306,9 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
     n.positions = toFloats(agg.positions);
     n.indices = agg.indices;
     exactProxy = {agg.positions, agg.indices};
-    n.error = measureEnclosure(agg.positions, n.positions, n.indices, originals, tolerance, settings, INFINITY);
+    detail::TriangleBoundCache cache;  // the aggregate's faces on its originals, and those the versions share
+    for (const detail::PreparedOriginal* o : originals) cache.addOriginal(*o->object);
+    n.error = measureEnclosure(agg.positions, n.positions, n.indices, originals, tolerance, settings, INFINITY, &cache);
     const double room = settings.simplifyFraction * n.delta;
     n.budget = n.error.bound() + room;
     if (!(room > 0)) return;
@@ -284,7 +321,7 @@ void makeAggregateProxy(const Aggregate& agg, const std::vector<const detail::Pr
         const detail::ConservativeSnapshot& s = *clean;
         if (s.indices.size() >= agg.indices.size()) break;  // no coarser than the exact one
         std::vector<float> positions = toFloats(s.positions);
-        const ProxyError e = measureEnclosure(s.positions, positions, s.indices, originals, tolerance, settings, n.budget);
+        const ProxyError e = measureEnclosure(s.positions, positions, s.indices, originals, tolerance, settings, n.budget, &cache);
         if (e.bound() <= n.budget) {
             n.positions = std::move(positions);
             n.indices = s.indices;
@@ -390,11 +427,11 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
     if (targets.empty()) return chain;
     EnclosureSeries series(*basePositions, *baseTriangles, targets);
     const std::vector<const detail::PreparedOriginal*> originals{&original};
+    detail::TriangleBoundCache cache;  // the versions share many triangles, and with the object
+    cache.addOriginal(object);
     std::unique_ptr<PolytopeSource> polytopes;
     if (shellCount(basePositions->size() / 3, *baseTriangles) == 1)
-        polytopes = std::make_unique<PolytopeSource>(*basePositions, originals,
-                                                     settings.toleranceFraction * targets.front(), settings,
-                                                     std::min(ceiling, 2 * top));
+        polytopes = std::make_unique<PolytopeSource>(*basePositions, originals, settings, std::min(ceiling, 2 * top), &cache);
     std::vector<HierarchyNode> candidates;
     const size_t objectTriangles = object.indices.size() / 3;
     size_t lastTriangles = 0;
@@ -414,7 +451,7 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
         n.positions = toFloats(clean->positions);
         n.indices = clean->indices;
         n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals, tolerance, settings,
-                                   std::min(budget, ceiling));
+                                   std::min(budget, ceiling), &cache);
         if (!(n.error.bound() <= budget) || !(n.error.bound() < ceiling)) continue;
         n.budget = budget;
         candidates.push_back(std::move(n));
@@ -462,11 +499,11 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
     if (oneShell && detail::convexHull3(proxy.positions, hull.positions, hull.indices) &&
         hull.indices.size() < proxy.indices.size())
         sources.push_back(std::make_unique<EnclosureSeries>(hull.positions, hull.indices, allowances));
+    detail::TriangleBoundCache cache;  // the versions of one source share many triangles
     std::unique_ptr<PolytopeSource> polytopes;
     if (oneShell)
-        polytopes = std::make_unique<PolytopeSource>(proxy.positions, originals,
-                                                     settings.toleranceFraction * base, settings,
-                                                     std::min(ceiling, own + 2 * top));
+        polytopes = std::make_unique<PolytopeSource>(proxy.positions, originals, settings, std::min(ceiling, own + 2 * top),
+                                                     &cache);
     // Every version that fits its target's budget, from every source; then the lightest chain.
     std::vector<HierarchyNode> candidates;
     std::vector<size_t> lastTriangles(sources.size(), 0);
@@ -489,7 +526,7 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
             n.positions = toFloats(clean->positions);
             n.indices = clean->indices;
             n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals, tolerance, settings,
-                                       std::min(budget, ceiling));
+                                       std::min(budget, ceiling), &cache);
             if (!(n.error.bound() <= budget && n.error.bound() < ceiling)) continue;
             n.budget = budget;
             candidates.push_back(std::move(n));

@@ -41,6 +41,7 @@
 // largest upper bound left: never below the true Hausdorff distance (up to double rounding;
 // the flat-patch allowance is part of the bound, not an assumption).
 #include "proxy_error.h"
+#include "vec3.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 
@@ -532,6 +533,7 @@ struct Region {
     double upper;
     double surfaceUpper;  ///< upper bound of the distance to the target surface (search hint for the parts)
     uint64_t order;  ///< creation order: a full tie-break, so the refinement is deterministic
+    uint32_t root = ~0u;  ///< triangle regions: the seed triangle it lies in
 };
 struct LowerUpperFirst {
     bool operator()(const Region& a, const Region& b) const {
@@ -558,7 +560,7 @@ public:
 
     /// Triangle region: h at its centroid is a lower bound; upper bound in the file comment
     /// (plus edgePairBound where the one-triangle bound does not settle the region).
-    void evaluateTriangle(const std::array<double, 9>& c, double hint = INFINITY) {
+    void evaluateTriangle(const std::array<double, 9>& c, double hint = INFINITY, uint32_t root = ~0u) {
         ++r_.evaluations;
         double centroid[3], rho = 0;
         for (int k = 0; k < 3; ++k) centroid[k] = (c[k] + c[3 + k] + c[6 + k]) / 3;
@@ -581,6 +583,7 @@ public:
             if (upper > r_.lower + tolerance_ && !target_.touches(c.data())) upper = 0;
         }
         r_.lower = std::max(r_.lower, h);
+        if (root < rootLower_.size()) rootLower_[root] = std::max(rootLower_[root], h);
         // Bounds of the distance to the surface, so of the distance to the solid as well.
         if (near.mesh && upper > r_.lower + tolerance_) {
             surfaceUpper = std::min(surfaceUpper, patchBound(*near.mesh, near.triangle, c.data(), 3));
@@ -594,11 +597,28 @@ public:
             surfaceUpper = std::min(surfaceUpper, vertexFanBound(*near.mesh, near.triangle, c.data(), 3));
             upper = std::min(upper, surfaceUpper);
         }
-        Region g;
-        g.corners = c;
-        g.upper = upper;
-        g.surfaceUpper = surfaceUpper;
-        keepOrDismiss(g);
+        keepTriangle(c, upper, surfaceUpper, root);
+    }
+
+    /// Seeds are the triangles 0..count-1 of a mesh: per seed, the largest bound of its parts
+    /// and the largest distance found in it are tracked (rootBounds).
+    void trackSeeds(size_t count) {
+        rootLower_.assign(count, 0.0);
+        rootUpper_.assign(count, 0.0);
+    }
+
+    /// Seed triangle `root` whose bound and a distance found in it are known already (an
+    /// earlier measurement of the same triangle against the same target): not evaluated.
+    void seedKnown(const std::array<double, 9>& c, uint32_t root, double upper, double lower) {
+        r_.lower = std::max(r_.lower, lower);
+        rootLower_[root] = std::max(rootLower_[root], lower);
+        keepTriangle(c, upper, upper, root);
+    }
+
+    /// After run(): per seed, a certified upper bound of h over it and the largest h found in it.
+    void rootBounds(std::vector<double>& upper, std::vector<double>& lower) const {
+        upper = rootUpper_;
+        lower = rootLower_;
     }
 
     /// Box of node `node` of the BVH of (*boxSources)[object]: none of its points is an
@@ -675,14 +695,15 @@ public:
             auto tri = [](const double* p, const double* q, const double* s) {
                 return std::array<double, 9>{p[0], p[1], p[2], q[0], q[1], q[2], s[0], s[1], s[2]};
             };
-            evaluateTriangle(tri(c, m[0], m[2]), hint);
-            evaluateTriangle(tri(m[0], c + 3, m[1]), hint);
-            evaluateTriangle(tri(m[2], m[1], c + 6), hint);
-            evaluateTriangle(tri(m[0], m[1], m[2]), hint);
+            evaluateTriangle(tri(c, m[0], m[2]), hint, g.root);
+            evaluateTriangle(tri(m[0], c + 3, m[1]), hint, g.root);
+            evaluateTriangle(tri(m[2], m[1], c + 6), hint, g.root);
+            evaluateTriangle(tri(m[0], m[1], m[2]), hint, g.root);
         }
         // What is left open keeps its upper bound.
         while (!open_.empty()) {
             r_.upper = std::max(r_.upper, open_.top().upper);
+            noteRootUpper(open_.top());
             open_.pop();
         }
         r_.upper = std::max(r_.upper, r_.lower);
@@ -690,10 +711,25 @@ public:
     }
 
 private:
+    void keepTriangle(const std::array<double, 9>& c, double upper, double surfaceUpper, uint32_t root) {
+        Region g;
+        g.corners = c;
+        g.upper = upper;
+        g.surfaceUpper = surfaceUpper;
+        g.root = root;
+        keepOrDismiss(g);
+    }
     void keepOrDismiss(Region& g) {
         g.order = order_++;
-        if (g.upper > r_.lower + tolerance_) open_.push(g);
-        else r_.upper = std::max(r_.upper, g.upper);
+        if (g.upper > r_.lower + tolerance_) {
+            open_.push(g);
+        } else {
+            r_.upper = std::max(r_.upper, g.upper);
+            noteRootUpper(g);
+        }
+    }
+    void noteRootUpper(const Region& g) {
+        if (g.root != ~0u && g.root < rootUpper_.size()) rootUpper_[g.root] = std::max(rootUpper_[g.root], g.upper);
     }
 
     const Target& target_;
@@ -703,6 +739,7 @@ private:
     DirectionResult r_;
     std::priority_queue<Region, std::vector<Region>, LowerUpperFirst> open_;
     uint64_t order_ = 0;
+    std::vector<double> rootLower_, rootUpper_;  ///< per seed triangle (trackSeeds)
 };
 
 }  // namespace
@@ -920,12 +957,87 @@ PlanarPatches planarPatches(const double* positions, const uint32_t* indices, co
     return out;
 }
 
+namespace {
+
+/// Whether a triangle mesh (positions 3 * n, indices 3 * m, across as trianglesAcrossEdges)
+/// bounds a convex solid: closed, one shell, positive volume, the opposite corner of the
+/// triangle across every edge on or behind the edge's triangle's plane, and at every vertex
+/// face angles summing to at most 2 pi (no saddle), all within `slack` (world units): the
+/// float rounding of flat faces split into many triangles.
+bool boundsConvexSolid(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
+                       const std::vector<uint32_t>& across, double slack) {
+    const size_t triangles = indices.size() / 3, vertices = positions.size() / 3;
+    if (triangles < 4) return false;
+    auto at = [&](uint32_t v) { return Vec3{positions[3 * size_t(v)], positions[3 * size_t(v) + 1], positions[3 * size_t(v) + 2]}; };
+    std::vector<double> angleSum(vertices, 0.0);
+    std::vector<uint32_t> shell(triangles);
+    for (uint32_t t = 0; t < triangles; ++t) shell[t] = t;
+    auto find = [&](uint32_t x) {
+        while (shell[x] != x) x = shell[x] = shell[shell[x]];
+        return x;
+    };
+    double volume = 0;
+    for (size_t t = 0; t < triangles; ++t) {
+        const uint32_t* tri = &indices[3 * t];
+        const Vec3 a = at(tri[0]), b = at(tri[1]), c = at(tri[2]);
+        const Vec3 n = glm::cross(b - a, c - a);
+        const double len = glm::length(n);
+        if (!(len > 0)) return false;
+        const Vec3 unit = n / len;
+        volume += glm::dot(a, glm::cross(b, c));
+        const Vec3 corner[3] = {a, b, c};
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t other = across[3 * t + size_t(k)];
+            if (other == ~0u || other >= triangles) return false;
+            const uint32_t r = find(uint32_t(t)), q = find(other);
+            if (r != q) shell[std::max(r, q)] = std::min(r, q);
+            // The other triangle's corner off this edge lies behind this plane.
+            for (int j = 0; j < 3; ++j) {
+                const Vec3 p = at(indices[3 * size_t(other) + size_t(j)]);
+                if (glm::dot(unit, p - a) > slack) return false;
+            }
+            const Vec3 u = corner[(k + 1) % 3] - corner[k], w = corner[(k + 2) % 3] - corner[k];
+            const double lu = glm::length(u), lw = glm::length(w);
+            if (!(lu > 0 && lw > 0)) return false;
+            angleSum[tri[k]] += std::acos(std::clamp(glm::dot(u, w) / (lu * lw), -1.0, 1.0));
+        }
+    }
+    if (!(volume > 0)) return false;
+    for (uint32_t t = 1; t < triangles; ++t)
+        if (find(t) != 0) return false;
+    for (size_t v = 0; v < vertices; ++v)
+        if (angleSum[v] > 2 * M_PI + 1e-6) return false;
+    return true;
+}
+
+}  // namespace
+
 void prepareOriginal(const InputObject& object, PreparedOriginal& out) {
     out.object = &object;
     const size_t triangles = object.indices.size() / 3;
     out.bvh.build(object.positions.data(), object.positions.size() / 3, object.indices.data(), triangles);
     out.across = trianglesAcrossEdges(object.positions.data(), object.indices.data(), triangles);
     out.patches = planarPatches(object.positions.data(), object.indices.data(), out.across.data(), triangles);
+    double extent = 0;
+    for (double x : object.positions) extent = std::max(extent, std::fabs(x));
+    out.convexSlack = 1e-6 * extent;
+    out.convexSolid = boundsConvexSolid(object.positions, object.indices, out.across, out.convexSlack);
+}
+
+void TriangleBoundCache::addOriginal(const InputObject& object) {
+    const std::vector<double>& p = object.positions;
+    for (size_t t = 0; t + 2 < object.indices.size(); t += 3) {
+        float c[9];
+        bool exact = true;
+        for (int v = 0; v < 3 && exact; ++v)
+            for (int k = 0; k < 3; ++k) {
+                const size_t i = 3 * size_t(object.indices[t + size_t(v)]) + size_t(k);
+                if (i >= p.size()) return;
+                c[3 * v + k] = static_cast<float>(p[i]);
+                exact = exact && double(c[3 * v + k]) == p[i];
+            }
+        if (exact) bounds[key(c, c + 3, c + 6)] = Bound{};
+    }
 }
 
 ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
@@ -960,24 +1072,62 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
             std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
         return e;
     }
+    // An enclosure of one convex solid K: the distance to K is convex, so over each proxy
+    // triangle it is largest at a corner, and it equals the distance to K's surface wherever
+    // the proxy lies outside K (everywhere, up to the enclosure's slack). Exact: the largest
+    // corner distance.
+    if (options.enclosesOriginals && originals.size() == 1 && originals[0]->convexSolid) {
+        double worst = 0;
+        for (size_t v = 0; v + 2 < proxyPositions.size(); v += 3) {
+            const double q[3] = {proxyPositions[v], proxyPositions[v + 1], proxyPositions[v + 2]};
+            worst = std::max(worst, closestPoint(originals[0]->bvh, q).distance);
+        }
+        // A solid convex within convexSlack lies within it of a convex one: twice that margin.
+        e.proxyToOriginals = std::max(worst + 2 * originals[0]->convexSlack, options.enclosureSlack) * (1 + 1e-12);
+        e.proxyToOriginalsLower = worst;
+        e.originalsToProxy = options.enclosureSlack;
+        e.evaluationCount = proxyPositions.size() / 3;
+        return e;
+    }
     Mesh proxy;
     proxy.positions.assign(proxyPositions.begin(), proxyPositions.end());
     proxy.indices = proxyIndices;
-    TriangleBvh proxyBvh;
-    proxyBvh.build(proxy.positions.data(), proxy.positions.size() / 3, proxy.indices.data(), proxy.triangleCount());
-    const std::vector<uint32_t> proxyAcross =
-        trianglesAcrossEdges(proxy.positions.data(), proxy.indices.data(), proxy.triangleCount());
 
-    // proxy -> original surfaces: every proxy triangle is a seed.
+    // proxy -> original surfaces: every proxy triangle is a seed; one whose bound an earlier
+    // measurement against the same originals certified is taken from the cache.
     const OriginalsTarget originalsTarget(originals);
     BranchAndBound<OriginalsTarget> forward(originalsTarget, false, tolerance, nullptr);
+    TriangleBoundCache* cache = options.cache;
+    std::vector<TriangleBoundCache::Key> keys;
+    if (cache) {
+        forward.trackSeeds(proxy.triangleCount());
+        keys.resize(proxy.triangleCount());
+    }
     for (size_t t = 0; t < proxy.triangleCount(); ++t) {
         std::array<double, 9> c;
         for (int v = 0; v < 3; ++v)
             for (int k = 0; k < 3; ++k) c[size_t(3 * v + k)] = proxy.corner(t, v)[k];
-        forward.evaluateTriangle(c);
+        if (!cache) {
+            forward.evaluateTriangle(c);
+            continue;
+        }
+        keys[t] = TriangleBoundCache::key(&proxyPositions[3 * size_t(proxyIndices[3 * t])],
+                                          &proxyPositions[3 * size_t(proxyIndices[3 * t + 1])],
+                                          &proxyPositions[3 * size_t(proxyIndices[3 * t + 2])]);
+        const auto known = cache->bounds.find(keys[t]);
+        if (known != cache->bounds.end()) forward.seedKnown(c, uint32_t(t), known->second.upper, known->second.lower);
+        else forward.evaluateTriangle(c, INFINITY, uint32_t(t));
     }
     const DirectionResult f = forward.run(proxy.triangleCount() + maxRefinementsPerDirection, options.giveUpAbove);
+    if (cache) {
+        std::vector<double> upper, lower;
+        forward.rootBounds(upper, lower);
+        for (size_t t = 0; t < keys.size(); ++t) {
+            TriangleBoundCache::Bound& b = cache->bounds[keys[t]];
+            b.upper = upper[t];
+            b.lower = lower[t];
+        }
+    }
     e.proxyToOriginals = f.upper;
     e.proxyToOriginalsLower = f.lower;
     if (options.enclosesOriginals || f.lower > options.giveUpAbove) {
@@ -985,6 +1135,10 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
         e.evaluationCount = f.evaluations;
         return e;
     }
+    TriangleBvh proxyBvh;
+    proxyBvh.build(proxy.positions.data(), proxy.positions.size() / 3, proxy.indices.data(), proxy.triangleCount());
+    const std::vector<uint32_t> proxyAcross =
+        trianglesAcrossEdges(proxy.positions.data(), proxy.indices.data(), proxy.triangleCount());
 
     // originals -> proxy solid: the root box of every object's BVH is a seed, so originals
     // deep inside the proxy or well within the tolerance are dismissed a box at a time.

@@ -10,6 +10,7 @@
 #include <aggrelod/samples.h>
 
 #include "mesh_distance.h"
+#include "proxy_error.h"
 
 #include <gtest/gtest.h>
 
@@ -154,4 +155,93 @@ TEST(ProxyErrorBounds, OriginalsInsideABoxProxyAreDismissedByBoxes) {
     const size_t originalTriangles = (a.indices.size() + b.indices.size() + c.indices.size()) / 3;
     const ProxyError shrunk = measureProxyError(proxy, box.indices, {&a, &c}, tolerance, 200000);
     EXPECT_LT(shrunk.evaluationCount, originalTriangles);
+}
+
+TEST(ProxyErrorBounds, EnclosureOfAConvexSolidIsMeasuredAtItsCorners) {
+    // A UV sphere (flat only up to rounding after the rotation) is a convex solid: the distance
+    // to it is convex, so over an enclosing proxy it is largest at a corner. The corner bound
+    // must cover the dense grid and agree with the branch and bound run on the same proxy.
+    InputObject sphere = samples::makeUvSphere("sphere", {0, 0, 0}, 1.0, 24, 13);
+    rotate(sphere.positions);
+    detail::PreparedOriginal prepared;
+    detail::prepareOriginal(sphere, prepared);
+    ASSERT_TRUE(prepared.convexSolid);
+    // Enclosure: an octahedron around the sphere (vertices at sqrt(3) radii, faces tangent).
+    std::vector<double> octa;
+    const double r = std::sqrt(3.0) * 1.001, c[3] = {3, -2, 1};  // centre of the rotated sphere
+    for (int axis = 0; axis < 3; ++axis)
+        for (double s : {1.0, -1.0}) {
+            double v[3] = {c[0], c[1], c[2]};
+            v[axis] += s * r;
+            octa.insert(octa.end(), v, v + 3);
+        }
+    const std::vector<uint32_t> octaIndices = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+    const std::vector<float> proxy = toFloat(octa);
+    detail::ProxyMeasureOptions enclosure;
+    enclosure.enclosesOriginals = true;
+    const double tolerance = 1e-3;
+    const ProxyError corners = detail::measureProxyErrorPrepared(proxy, octaIndices, {&prepared}, tolerance, 200000, enclosure);
+    EXPECT_LT(corners.evaluationCount, 10u);  // one closest point per corner
+    const GridMeasured m = gridMeasure(proxy, octaIndices, {&sphere}, 24);
+    EXPECT_GE(corners.proxyToOriginals + 1e-9, m.proxyToOriginals);
+    prepared.convexSolid = false;  // the same proxy through the branch and bound
+    const ProxyError refined = detail::measureProxyErrorPrepared(proxy, octaIndices, {&prepared}, tolerance, 200000, enclosure);
+    EXPECT_NEAR(corners.proxyToOriginals, refined.proxyToOriginals, tolerance);
+    EXPECT_GT(corners.proxyToOriginals, 0.5);  // the octahedron's corners: about 0.73 radii out
+}
+
+TEST(ProxyErrorBounds, ConvexSolidsAreToldFromOthers) {
+    auto convex = [](const InputObject& o) {
+        detail::PreparedOriginal p;
+        detail::prepareOriginal(o, p);
+        return p.convexSolid;
+    };
+    EXPECT_TRUE(convex(samples::makeBox("box", {0, 0, 0}, {1, 2, 3}, 0.25)));
+    EXPECT_TRUE(convex(samples::makeCylinder("cylinder", {0, 0, 0}, 0.5, 2, 16, 3)));
+    // A vase with a waist is not convex; nor are two boxes in one object, nor an open box.
+    EXPECT_FALSE(convex(samples::makeLathe("vase", {0, 0, 0}, {{0.5, 0}, {0.2, 0.5}, {0.5, 1}}, 16)));
+    InputObject two = samples::makeBox("a", {0, 0, 0}, {1, 1, 1});
+    const InputObject second = samples::makeBox("b", {2, 0, 0}, {3, 1, 1});
+    const uint32_t base = uint32_t(two.positions.size() / 3);
+    two.positions.insert(two.positions.end(), second.positions.begin(), second.positions.end());
+    for (uint32_t i : second.indices) two.indices.push_back(base + i);
+    EXPECT_FALSE(convex(two));
+    InputObject open = samples::makeBox("open", {0, 0, 0}, {1, 1, 1});
+    open.indices.resize(open.indices.size() - 3);
+    EXPECT_FALSE(convex(open));
+}
+
+TEST(ProxyErrorBounds, TriangleBoundsReusedAcrossProxiesStayCertified) {
+    // Two proxies of one original sharing most of their triangles: the second measurement
+    // takes the shared triangles' bounds from the cache, evaluates fewer regions and is
+    // still certified against the dense grid.
+    const InputObject sphere = samples::makeUvSphere("sphere", {0.2, -0.1, 0.3}, 1.0, 16, 9);
+    detail::PreparedOriginal prepared;
+    detail::prepareOriginal(sphere, prepared);
+    prepared.convexSolid = false;  // measure by branch and bound
+    auto scaled = [&](double s, size_t upTo) {
+        std::vector<double> p = sphere.positions;
+        for (size_t i = 0; i + 2 < p.size() && i < 3 * upTo; i += 3) {
+            const double centre[3] = {0.2, -0.1, 0.3};
+            for (int k = 0; k < 3; ++k) p[i + k] = centre[k] + s * (p[i + k] - centre[k]);
+        }
+        return toFloat(p);
+    };
+    const std::vector<float> first = scaled(1.05, SIZE_MAX);
+    std::vector<float> second = first;  // the same, with its top vertices pushed out further
+    const std::vector<float> further = scaled(1.08, SIZE_MAX);
+    std::copy(further.begin(), further.begin() + 3 * 20, second.begin());
+    const double tolerance = 2e-3;
+    detail::TriangleBoundCache cache;
+    detail::ProxyMeasureOptions options;
+    options.cache = &cache;
+    detail::measureProxyErrorPrepared(first, sphere.indices, {&prepared}, tolerance, 200000, options);
+    const size_t cached = cache.bounds.size();
+    EXPECT_EQ(cached, sphere.indices.size() / 3);
+    const ProxyError withCache = detail::measureProxyErrorPrepared(second, sphere.indices, {&prepared}, tolerance, 200000, options);
+    const ProxyError without = detail::measureProxyErrorPrepared(second, sphere.indices, {&prepared}, tolerance, 200000);
+    EXPECT_LT(withCache.evaluationCount, without.evaluationCount);
+    const GridMeasured m = gridMeasure(second, sphere.indices, {&sphere}, 12);
+    EXPECT_GE(withCache.proxyToOriginals + 1e-9, m.proxyToOriginals);
+    EXPECT_NEAR(withCache.proxyToOriginals, without.proxyToOriginals, tolerance);
 }
