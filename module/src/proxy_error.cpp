@@ -960,12 +960,14 @@ PlanarPatches planarPatches(const double* positions, const uint32_t* indices, co
 namespace {
 
 /// Whether a triangle mesh (positions 3 * n, indices 3 * m, across as trianglesAcrossEdges)
-/// bounds a convex solid: closed, one shell, positive volume, the opposite corner of the
-/// triangle across every edge on or behind the edge's triangle's plane, and at every vertex
-/// face angles summing to at most 2 pi (no saddle), all within `slack` (world units): the
-/// float rounding of flat faces split into many triangles.
+/// bounds a convex solid: closed, one shell, positive volume, the corners of the triangle
+/// across every edge on or behind the edge's triangle's plane, and at every vertex face
+/// angles summing to at most 2 pi (no saddle), all within `slack` (world units: the float
+/// rounding of flat faces split into many triangles). `violation` gets the largest distance
+/// of a corner in front of such a plane (0 for an exactly convex mesh).
 bool boundsConvexSolid(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
-                       const std::vector<uint32_t>& across, double slack) {
+                       const std::vector<uint32_t>& across, double slack, double& violation) {
+    violation = 0;
     const size_t triangles = indices.size() / 3, vertices = positions.size() / 3;
     if (triangles < 4) return false;
     auto at = [&](uint32_t v) { return Vec3{positions[3 * size_t(v)], positions[3 * size_t(v) + 1], positions[3 * size_t(v) + 2]}; };
@@ -994,7 +996,9 @@ bool boundsConvexSolid(const std::vector<double>& positions, const std::vector<u
             // The other triangle's corner off this edge lies behind this plane.
             for (int j = 0; j < 3; ++j) {
                 const Vec3 p = at(indices[3 * size_t(other) + size_t(j)]);
-                if (glm::dot(unit, p - a) > slack) return false;
+                const double ahead = glm::dot(unit, p - a);
+                if (ahead > slack) return false;
+                violation = std::max(violation, ahead);
             }
             const Vec3 u = corner[(k + 1) % 3] - corner[k], w = corner[(k + 2) % 3] - corner[k];
             const double lu = glm::length(u), lw = glm::length(w);
@@ -1020,8 +1024,7 @@ void prepareOriginal(const InputObject& object, PreparedOriginal& out) {
     out.patches = planarPatches(object.positions.data(), object.indices.data(), out.across.data(), triangles);
     double extent = 0;
     for (double x : object.positions) extent = std::max(extent, std::fabs(x));
-    out.convexSlack = 1e-6 * extent;
-    out.convexSolid = boundsConvexSolid(object.positions, object.indices, out.across, out.convexSlack);
+    out.convexSolid = boundsConvexSolid(object.positions, object.indices, out.across, 1e-6 * extent, out.convexSlack);
 }
 
 void TriangleBoundCache::addOriginal(const InputObject& object) {
@@ -1082,7 +1085,7 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
             const double q[3] = {proxyPositions[v], proxyPositions[v + 1], proxyPositions[v + 2]};
             worst = std::max(worst, closestPoint(originals[0]->bvh, q).distance);
         }
-        // A solid convex within convexSlack lies within it of a convex one: twice that margin.
+        // A solid convex up to convexSlack lies within about that of a convex one: twice that margin.
         e.proxyToOriginals = std::max(worst + 2 * originals[0]->convexSlack, options.enclosureSlack) * (1 + 1e-12);
         e.proxyToOriginalsLower = worst;
         e.originalsToProxy = options.enclosureSlack;

@@ -53,9 +53,10 @@ struct PreparedOriginal {
     /// of a convex solid K, by Tietze's theorem on locally convex sets): the distance to K is
     /// a convex function, so over a proxy triangle outside K it is largest at a corner.
     bool convexSolid = false;
-    /// How far (world units) a vertex may lie in front of a neighbouring face's plane and
-    /// the object still count as convex: float rounding of flat faces split into many
-    /// triangles (1e-6 of the largest coordinate). Added twice to bounds that use convexity.
+    /// How far (world units) a vertex lies in front of a neighbouring face's plane, at most,
+    /// in an object that counts as convex (float rounding of flat faces split into many
+    /// triangles; at most 1e-6 of the largest coordinate). Added twice to bounds that use
+    /// convexity.
     double convexSlack = 0;
 };
 
