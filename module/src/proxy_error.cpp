@@ -404,6 +404,7 @@ struct ProxyTarget {
         return r;
     }
     bool inside(const double p[3]) const { return insideSolid(bvh, p); }
+    double convexCornerBound(const TargetMesh*, const double*, int) const { return INFINITY; }
     /// A region triangle that does not meet the surface lies on one side of it.
     bool touches(const double* tri) const { return touchesMesh(bvh, tri, 1e-9 * bvh.maxAbsCoordinate()); }
 };
@@ -522,6 +523,17 @@ struct OriginalsTarget {
     }
     bool inside(const double*) const { return false; }  // never asked: the originals are surfaces
     bool touches(const double*) const { return true; }
+    /// For a region outside every original (an enclosure), when `mesh` is the surface of a
+    /// convex solid K (PreparedOriginal::convexSolid): the largest distance from its n corners
+    /// to K bounds the distance to K over the whole region (convex function), so to the
+    /// originals. INFINITY for other objects.
+    double convexCornerBound(const TargetMesh* mesh, const double* corners, int n) const {
+        const size_t i = size_t(mesh - meshes.data());
+        if (i >= objects.size() || !objects[i]->convexSolid) return INFINITY;
+        double worst = 0;
+        for (int v = 0; v < n; ++v) worst = std::max(worst, detail::closestPoint(objects[i]->bvh, corners + 3 * v).distance);
+        return worst + 2 * objects[i]->convexSlack;
+    }
 };
 
 /// One region of the branch and bound: a triangle (corners), or the box of a node of an
@@ -554,9 +566,12 @@ struct DirectionResult {
 template <class Target>
 class BranchAndBound {
 public:
+    /// outsideSlack >= 0: every region point lies outside the target's solids or within this
+    /// distance of outside (an enclosure measured against its originals), which allows the
+    /// convex-solid corner bound; < 0: unknown.
     BranchAndBound(const Target& target, bool toSolid, double tolerance,
-                   const std::vector<const detail::PreparedOriginal*>* boxSources)
-        : target_(target), toSolid_(toSolid), tolerance_(tolerance), boxSources_(boxSources) {}
+                   const std::vector<const detail::PreparedOriginal*>* boxSources, double outsideSlack = -1)
+        : target_(target), toSolid_(toSolid), tolerance_(tolerance), boxSources_(boxSources), outsideSlack_(outsideSlack) {}
 
     /// Triangle region: h at its centroid is a lower bound; upper bound in the file comment
     /// (plus edgePairBound where the one-triangle bound does not settle the region).
@@ -595,6 +610,12 @@ public:
         }
         if (near.mesh && upper > r_.lower + tolerance_) {
             surfaceUpper = std::min(surfaceUpper, vertexFanBound(*near.mesh, near.triangle, c.data(), 3));
+            upper = std::min(upper, surfaceUpper);
+        }
+        if (near.mesh && outsideSlack_ >= 0 && upper > r_.lower + tolerance_) {
+            // Points within the slack inside a solid are within it of its surface.
+            const double convex = std::max(target_.convexCornerBound(near.mesh, c.data(), 3), outsideSlack_);
+            surfaceUpper = std::min(surfaceUpper, convex);
             upper = std::min(upper, surfaceUpper);
         }
         keepTriangle(c, upper, surfaceUpper, root);
@@ -736,6 +757,7 @@ private:
     bool toSolid_;
     double tolerance_;
     const std::vector<const detail::PreparedOriginal*>* boxSources_;
+    double outsideSlack_;
     DirectionResult r_;
     std::priority_queue<Region, std::vector<Region>, LowerUpperFirst> open_;
     uint64_t order_ = 0;
@@ -1099,7 +1121,8 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
     // proxy -> original surfaces: every proxy triangle is a seed; one whose bound an earlier
     // measurement against the same originals certified is taken from the cache.
     const OriginalsTarget originalsTarget(originals);
-    BranchAndBound<OriginalsTarget> forward(originalsTarget, false, tolerance, nullptr);
+    BranchAndBound<OriginalsTarget> forward(originalsTarget, false, tolerance, nullptr,
+                                            options.enclosesOriginals ? options.enclosureSlack : -1.0);
     TriangleBoundCache* cache = options.cache;
     std::vector<TriangleBoundCache::Key> keys;
     if (cache) {
