@@ -14,6 +14,7 @@
 #include "mesh_preparation.h"
 #include "parallel_for.h"
 #include "proxy_error.h"
+#include "solidify.h"
 #include "surface_colors.h"
 
 #include <aggrelod/disjoint_sets.h>
@@ -231,7 +232,8 @@ public:
     /// maxTriangles triangles; false when none does. n gets positions, indices and error.
     /// Callers ask for ascending budgets: each polytope's mesh is built and its error
     /// measured once (again only when an earlier measurement gave up below the new budget).
-    bool coarsestWithin(double budget, size_t maxTriangles, double tolerance, HierarchyNode& n) {
+    bool coarsestWithin(double budget, size_t maxTriangles, double tolerance, HierarchyNode& n,
+                        std::vector<double>* exact = nullptr) {
         int tried = 0;
         for (size_t i = 0; i < polytopes_.size(); ++i) {
             const detail::BoundingPolytope& p = polytopes_[i];
@@ -258,6 +260,7 @@ public:
                 n.positions = m.positions;
                 n.indices = m.indices;
                 n.error = m.error;
+                if (exact) *exact = m.exact;
                 return true;
             }
             if (++tried == 2) break;  // the bound by the triangle inequality was loose twice
@@ -388,82 +391,119 @@ std::vector<HierarchyNode> lightestChain(std::vector<HierarchyNode> candidates, 
 constexpr double kChainFinestFraction = 1.0 / 1024;
 constexpr double kChainRatio = 1.4142135623730951;
 
-/// Per-object LOD (docs/design.md §2.6): conservative simplifications of one object at error
-/// targets sqrt(2) apart, from a thousandth of its diagonal up to below `ceiling` (the error
-/// of the first aggregate above it holding other objects; infinity for none, then up to its
-/// diagonal), and for an object of one shell the coarsest enclosing polytope of its convex
-/// hull that fits each target. A candidate counts when it does not intersect itself and its
-/// certified error fits its budget (twice its target) and stays below the ceiling; the chain
-/// is the lightest one through them (lightestChain). Returned finest first. An object that is
-/// not a closed solid is simplified from `standIn`, the watertight solid that contains it
-/// alone (its alpha wrap), when there is one: whatever encloses that solid encloses the
-/// object, and errors are still certified against the object itself. Empty for such an object
-/// without a solid of its own.
-std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t objectIndex,
-                                          const detail::PreparedOriginal& original, const SolidReport* standIn,
-                                          double ceiling, const ProxySettings& settings) {
-    std::vector<HierarchyNode> chain;
-    if (settings.objectLodCount <= 0) return chain;
+/// One certified enclosing version of an object: the node as stored (float positions,
+/// indices, error, budget) and its vertices in doubles (what unions are made from).
+struct Version {
+    HierarchyNode node;
+    std::vector<double> exact;
+};
+
+/// Every certified enclosing version of one object, ascending by error (ties: fewer
+/// triangles first): its per-object LOD chain is chosen from them (chainFromLadder), and the
+/// coarser versions of the groups holding it are united from them (coarserChain).
+struct VersionLadder {
+    std::vector<Version> versions;
+    size_t objectTriangles = 0;
+    /// The version with the fewest triangles whose error is at most `error`; null for none.
+    const Version* lightestWithin(double error) const {
+        const Version* best = nullptr;
+        for (const Version& v : versions)
+            if (v.node.error.bound() <= error && (!best || v.node.indices.size() < best->node.indices.size())) best = &v;
+        return best;
+    }
+};
+
+/// Per-object versions (docs/design.md §2.6): conservative simplifications of one object at
+/// error targets sqrt(2) apart, from a thousandth of its diagonal up to its diagonal, and for
+/// an object of one shell the coarsest enclosing polytope of its convex hull that fits each
+/// target. A candidate counts when it does not intersect itself and its certified error fits
+/// its budget (twice its target). An object that is not a closed solid is simplified from
+/// `standIn`, the watertight solid that contains it alone (its alpha wrap), when there is one:
+/// whatever encloses that solid encloses the object, and errors are still certified against
+/// the object itself. Empty for such an object without a solid of its own.
+VersionLadder objectLadder(const InputObject& object, const detail::PreparedOriginal& original,
+                           const SolidReport* standIn, const ProxySettings& settings) {
+    VersionLadder ladder;
+    ladder.objectTriangles = object.indices.size() / 3;
+    if (settings.objectLodCount <= 0) return ladder;
     detail::PreparedObject prepared;
     std::vector<Diagnostic> ignored;  // the bake reported the object's problems already
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i + 2 < object.positions.size(); i += 3) growBox(lo, hi, &object.positions[i]);
     const double diagonal = distance(lo, hi);
-    if (!(diagonal > 0)) return chain;
+    if (!(diagonal > 0)) return ladder;
     detail::prepareObject(object, 1e-14 * diagonal * diagonal, prepared, ignored);
     const std::vector<double>* basePositions = &prepared.positions;
     const std::vector<uint32_t>* baseTriangles = &prepared.triangles;
     double finest = kChainFinestFraction * diagonal;
     if (!prepared.validSolid()) {
-        if (!standIn || !standIn->closedManifold || standIn->triangles.empty()) return chain;
+        if (!standIn || !standIn->closedManifold || standIn->triangles.empty()) return ladder;
         basePositions = &standIn->positions;
         baseTriangles = &standIn->triangles;
         // No version can be closer to the object than its solid is.
         finest = std::max(finest, 0.5 * std::max(standIn->distanceSolidToOriginal, standIn->distanceOriginalToSolid));
     }
-    const double top = std::min(ceiling, diagonal);
     std::vector<double> targets;  // ascending
-    for (double t = finest; t < top; t *= kChainRatio) targets.push_back(t);
-    if (targets.empty()) return chain;
+    for (double t = finest; t < diagonal; t *= kChainRatio) targets.push_back(t);
+    if (targets.empty()) return ladder;
     EnclosureSeries series(*basePositions, *baseTriangles, targets);
     const std::vector<const detail::PreparedOriginal*> originals{&original};
     detail::TriangleBoundCache cache;  // the versions share many triangles, and with the object
     cache.addOriginal(object);
     std::unique_ptr<PolytopeSource> polytopes;
     if (shellCount(basePositions->size() / 3, *baseTriangles) == 1)
-        polytopes = std::make_unique<PolytopeSource>(*basePositions, originals, settings, std::min(ceiling, 2 * top), &cache);
-    std::vector<HierarchyNode> candidates;
-    const size_t objectTriangles = object.indices.size() / 3;
+        polytopes = std::make_unique<PolytopeSource>(*basePositions, originals, settings, 2 * diagonal, &cache);
+    const size_t objectTriangles = ladder.objectTriangles;
     size_t lastTriangles = 0;
     for (size_t i = 0; i < series.size(); ++i) {
         const double budget = 2 * targets[i], tolerance = settings.toleranceFraction * targets[i];
-        HierarchyNode p;
-        if (polytopes && polytopes->coarsestWithin(std::min(budget, std::nextafter(ceiling, 0.0)),
-                                                   kWorthNumerator * objectTriangles / kWorthDenominator, tolerance, p)) {
-            p.budget = budget;
-            candidates.push_back(std::move(p));
+        Version p;
+        if (polytopes && polytopes->coarsestWithin(budget, kWorthNumerator * objectTriangles / kWorthDenominator, tolerance,
+                                                   p.node, &p.exact)) {
+            p.node.budget = budget;
+            ladder.versions.push_back(std::move(p));
         }
         if (series.triangleCount(i) == lastTriangles) continue;  // stopped simplifying: the same mesh again
         const detail::ConservativeSnapshot* clean = lighterCleanSnapshot(series, i, objectTriangles);
         if (!clean) continue;
         lastTriangles = series.triangleCount(i);
-        HierarchyNode n;
-        n.positions = toFloats(clean->positions);
-        n.indices = clean->indices;
-        n.error = measureEnclosure(clean->positions, n.positions, n.indices, originals, tolerance, settings,
-                                   std::min(budget, ceiling), &cache);
-        if (!(n.error.bound() <= budget) || !(n.error.bound() < ceiling)) continue;
-        n.budget = budget;
-        candidates.push_back(std::move(n));
+        Version v;
+        v.node.positions = toFloats(clean->positions);
+        v.node.indices = clean->indices;
+        v.node.error = measureEnclosure(clean->positions, v.node.positions, v.node.indices, originals, tolerance, settings,
+                                        budget, &cache);
+        if (!(v.node.error.bound() <= budget)) continue;
+        v.node.budget = budget;
+        v.exact = clean->positions;
+        ladder.versions.push_back(std::move(v));
     }
-    chain = lightestChain(std::move(candidates), objectTriangles, settings.objectLodCount);
+    std::stable_sort(ladder.versions.begin(), ladder.versions.end(), [](const Version& a, const Version& b) {
+        const double ea = a.node.error.bound(), eb = b.node.error.bound();
+        return ea < eb || (ea == eb && a.node.indices.size() < b.node.indices.size());
+    });
+    return ladder;
+}
+
+/// Per-object LOD (docs/design.md §2.6): the lightest chain (lightestChain) through the
+/// object's versions whose error stays below `ceiling` (the error of the first aggregate above
+/// it holding other objects; infinity for none). Returned finest first.
+std::vector<HierarchyNode> chainFromLadder(const VersionLadder& ladder, uint32_t objectIndex, double ceiling,
+                                           const ProxySettings& settings) {
+    std::vector<HierarchyNode> candidates;
+    for (const Version& v : ladder.versions)
+        if (v.node.error.bound() < ceiling) candidates.push_back(v.node);
+    std::vector<HierarchyNode> chain = lightestChain(std::move(candidates), ladder.objectTriangles, settings.objectLodCount);
     for (size_t j = 0; j < chain.size(); ++j) {
         chain[j].objectLod = static_cast<int>(j) + 1;
         chain[j].sources = {objectIndex};
-        chain[j].exactTriangleCount = objectTriangles;
+        chain[j].exactTriangleCount = ladder.objectTriangles;
     }
     return chain;
 }
+
+/// Most objects a group may hold for its coarser versions to be tried as unions of its
+/// objects' versions (each union is a chain of exact boolean operations).
+constexpr size_t kUnionMaxObjects = 48;
 
 /// Coarser versions of an aggregate node (docs/design.md §2.6): enclosing simplifications of
 /// its proxy at error targets sqrt(2) apart above the node's budget, up to below `ceiling`
@@ -476,9 +516,17 @@ std::vector<HierarchyNode> objectLodChain(const InputObject& object, uint32_t ob
 /// when it does not intersect itself, its certified error fits its budget (the node's error
 /// plus twice its push-out allowance) and stays below the ceiling; the chain is the lightest
 /// one through them (lightestChain). Finest first.
-std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactProxy& proxy, bool oneShell,
-                                        const std::vector<const detail::PreparedOriginal*>& originals, double ceiling,
+/// A group of at most kUnionMaxObjects objects whose every object has versions (`ladders`,
+/// one per source object, null for none) is also tried as the exact union of its objects'
+/// lightest versions within each budget: where the group's proxy keeps the detail of its fill,
+/// its objects' coarse versions often overlap into a lighter solid of the same shells. Every
+/// point of the union's surface lies on an object's version, so it is within that version's
+/// error of the originals (certified again all the same).
+std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactProxy& proxy, size_t shells,
+                                        const std::vector<const detail::PreparedOriginal*>& originals,
+                                        const std::vector<const VersionLadder*>& ladders, double ceiling,
                                         const ProxySettings& settings) {
+    const bool oneShell = shells == 1;
     std::vector<HierarchyNode> chain;
     if (settings.coarserCount <= 0 || proxy.indices.empty()) return chain;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -504,6 +552,41 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
     if (oneShell)
         polytopes = std::make_unique<PolytopeSource>(proxy.positions, originals, settings, std::min(ceiling, own + 2 * top),
                                                      &cache);
+    // Unions of the objects' versions: one per distinct choice of versions.
+    const bool unite = ladders.size() >= 2 && ladders.size() <= kUnionMaxObjects &&
+                       std::all_of(ladders.begin(), ladders.end(), [](const VersionLadder* l) { return l != nullptr; });
+    std::vector<const Version*> lastChoice;
+    const auto unionWithin = [&](double budget, double tolerance, HierarchyNode& u) {
+        std::vector<const Version*> choice;
+        for (const VersionLadder* l : ladders) {
+            const Version* v = l->lightestWithin(budget);
+            if (!v) return false;
+            choice.push_back(v);
+        }
+        if (choice == lastChoice) return false;  // the same union as for the previous budget
+        lastChoice = choice;
+        std::vector<const std::vector<double>*> parts;
+        std::vector<const std::vector<uint32_t>*> partIndices;
+        size_t partTriangles = 0;
+        for (const Version* v : choice) {
+            parts.push_back(&v->exact);
+            partIndices.push_back(&v->node.indices);
+            partTriangles += v->node.indices.size() / 3;
+        }
+        if (!lighterEnough(partTriangles, proxy.indices.size() / 3)) return false;  // seams only add
+        std::vector<double> positions;
+        std::vector<uint32_t> indices;
+        std::string ignored;
+        if (!detail::exactUnion(parts, partIndices, positions, indices, ignored)) return false;
+        if (!lighterEnough(indices.size() / 3, proxy.indices.size() / 3) ||
+            shellCount(positions.size() / 3, indices) != shells || detail::meshSelfIntersects(positions, indices))
+            return false;
+        u.positions = toFloats(positions);
+        u.indices = std::move(indices);
+        if (hasCollapsedTriangle(u.positions, u.indices)) return false;
+        u.error = measureEnclosure(positions, u.positions, u.indices, originals, tolerance, settings, budget, &cache);
+        return u.error.bound() <= budget;
+    };
     // Every version that fits its target's budget, from every source; then the lightest chain.
     std::vector<HierarchyNode> candidates;
     std::vector<size_t> lastTriangles(sources.size(), 0);
@@ -530,6 +613,13 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
             if (!(n.error.bound() <= budget && n.error.bound() < ceiling)) continue;
             n.budget = budget;
             candidates.push_back(std::move(n));
+        }
+        if (unite) {
+            HierarchyNode u;
+            if (unionWithin(std::min(budget, std::nextafter(ceiling, 0.0)), tolerance, u)) {
+                u.budget = budget;
+                candidates.push_back(std::move(u));
+            }
         }
     }
     chain = lightestChain(std::move(candidates), proxy.indices.size() / 3, settings.coarserCount);
@@ -722,10 +812,14 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
     std::vector<const SolidReport*> standInOf(objectCount, nullptr);
     for (const SolidReport& r : hierarchy.solids)
         if (r.objects.size() == 1 && r.objects.front() < objectCount) standInOf[r.objects.front()] = &r;
+    // Every object's versions, up to its diagonal: its chain is cut at its first group's
+    // error, and the groups holding it unite them into coarser versions.
+    std::vector<VersionLadder> ladders(objectCount);
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (nodes[o].parent == kNoNode || nodes[o].positions.empty()) return;
+        ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
         const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
-        chains[o] = objectLodChain(objects[o], static_cast<uint32_t>(o), prepared[o], standInOf[o], ceiling, settings);
+        chains[o] = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceiling, settings);
         std::vector<const InputObject*> source{&objects[o]};
         for (HierarchyNode& c : chains[o]) {
             detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);
@@ -759,8 +853,10 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
             originals.push_back(&prepared[o]);
             sourceObjects.push_back(&objects[o]);
         }
-        const bool oneShell = n.firstLevel >= 0 && aggregateOf(n).componentCount == 1;
-        coarser[i] = coarserChain(n, exactProxies[i], oneShell, originals, ceiling, settings);
+        std::vector<const VersionLadder*> sourceLadders;
+        for (uint32_t o : n.sources) sourceLadders.push_back(ladders[o].versions.empty() ? nullptr : &ladders[o]);
+        coarser[i] = coarserChain(n, exactProxies[i], aggregateOf(n).componentCount, originals, sourceLadders, ceiling,
+                                  settings);
         exactProxies[i] = ExactProxy{};
         for (HierarchyNode& c : coarser[i]) {
             detail::nearestSurfaceColors(c.positions, c.indices, sourceObjects, c.faceColors);
