@@ -25,6 +25,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 
 namespace aggrelod {
 
@@ -940,6 +941,20 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         computeBounds(n, exact, nodes);
     }
     return true;
+}
+
+std::vector<HierarchyNode> enclosingVersions(const InputObject& object, const SolidReport* standIn,
+                                             const ProxySettings& settings) {
+    detail::PreparedOriginal original;
+    try {
+        detail::prepareOriginal(object, original);
+    } catch (const std::invalid_argument&) {  // a non-finite coordinate or an index out of range
+        return {};
+    }
+    VersionLadder ladder = objectLadder(object, original, standIn, settings);
+    std::vector<HierarchyNode> out;
+    for (Version& v : ladder.versions) out.push_back(std::move(v.node));
+    return out;
 }
 
 uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node) {

@@ -9,6 +9,9 @@
 //      errors sqrt(2) apart), each level's error measured as ours (measureProxyError, the
 //      certified two-sided Hausdorff distance), the level with the fewest triangles whose
 //      error projects to <= tau at the object's bounding sphere; one draw call per object;
+//  (b') conservative per-object LOD: the same choice among each object's enclosing versions
+//      (enclosingVersions: what the bake's per-object chains are cut from, not cut), each of
+//      which contains its object as the cut's proxies do; one draw call per object;
 //  (c) aggrelod's cut: Selector::selectFull at tau, no hysteresis, with the originals'
 //      triangle counts given (Selector::setDrawCosts, default cost per draw call); proxy
 //      triangles plus the originals drawn as leaves, one draw call per proxy node and per leaf.
@@ -168,7 +171,7 @@ struct Cost {
 
 struct Row {
     int distance = 0;
-    Cost originals, perObject, cut;
+    Cost originals, perObject, enclosingPerObject, cut;
     double cutProxies = 0, cutLeaves = 0;
     // --breakdown: the cut's triangles by node kind, beside (b)'s triangles for the same objects.
     // [0] leaves, [1] per-object LOD, [2] one-object aggregates, [3] aggregates of several
@@ -285,6 +288,22 @@ bool runScene(const Options& o, const std::string& name) {
     std::printf("per-object LOD: %zu simplified levels (%.1f per object), %zu of them not closed (no inside credit); "
                 "targets down to %.3g; chains built and measured in %.2f s\n",
                 chainLevels, double(chainLevels) / double(objects.size()), openLevels, finest, chainSeconds);
+    // (b'): every object's enclosing versions, as the bake makes them (an open object's from
+    // the solid standing in for it alone); support surfaces and objects left out are drawn
+    // as they are, as in the cut.
+    std::vector<const SolidReport*> standIn(objects.size(), nullptr);
+    for (const SolidReport& r : b.hierarchy.solids)
+        if (r.objects.size() == 1 && r.objects.front() < objects.size()) standIn[r.objects.front()] = &r;
+    std::vector<char> asGiven(objects.size(), 0);
+    for (uint32_t i : b.hierarchy.supportObjects) asGiven[i] = 1;
+    for (uint32_t i : b.hierarchy.leftOutObjects) asGiven[i] = 1;
+    std::vector<std::vector<ChainLevel>> enclosing(objects.size());
+    ProxySettings versionSettings;
+    detail::parallelFor(objects.size(), o.threads, [&](size_t i) {
+        if (asGiven[i]) return;
+        for (const HierarchyNode& v : enclosingVersions(objects[i], standIn[i], versionSettings))
+            enclosing[i].push_back({v.indices.size() / 3, v.error.bound(), true});
+    });
 
     // Cameras.
     int a1 = 0, a2 = 1;  // horizontal axes
@@ -325,6 +344,11 @@ bool runScene(const Options& o, const std::string& name) {
                 row.perObject.triangles += double(best);
                 row.perObject.drawCalls += t ? 1 : 0;
                 perObjectChoice[i] = double(best);
+                size_t enclosed = t;
+                for (const ChainLevel& level : enclosing[i])
+                    if (level.error * k / d <= kTau) enclosed = std::min(enclosed, level.triangles);
+                row.enclosingPerObject.triangles += double(enclosed);
+                row.enclosingPerObject.drawCalls += t ? 1 : 0;
             }
             selector.reset();
             selector.selectFull(camera, settings);
@@ -352,7 +376,7 @@ bool runScene(const Options& o, const std::string& name) {
                 row.excess[~obj] += double(objects[obj].indices.size() / 3) - perObjectChoice[obj];
             }
         }
-        for (Cost* c : {&row.originals, &row.perObject, &row.cut}) {
+        for (Cost* c : {&row.originals, &row.perObject, &row.enclosingPerObject, &row.cut}) {
             c->triangles /= kAzimuths;
             c->drawCalls /= kAzimuths;
         }
@@ -368,13 +392,14 @@ bool runScene(const Options& o, const std::string& name) {
     }
     std::printf("\nmeans per camera over %d azimuths, elevation %.0f deg, %d x %d px, fov 60 deg, tau %.0f px:\n",
                 kAzimuths, o.elevationDegrees, 1920, int(kViewportHeight), double(kTau));
-    std::printf("| distance (diameters) | (a) triangles | (a) draws | (b) triangles | (b) draws | (c) triangles | "
-                "(c) draws (proxies + leaves) | (c)/(b) triangles | (c)/(a) draws |\n");
-    std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("| distance (diameters) | (a) triangles | (a) draws | (b) triangles | (b) draws | (b') triangles | "
+                "(c) triangles | (c) draws (proxies + leaves) | (c)/(b) triangles | (c)/(b') triangles | (c)/(a) draws |\n");
+    std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const Row& r : rows)
-        std::printf("| %d | %.0f | %.0f | %.1f | %.0f | %.1f | %.1f (%.1f + %.1f) | %.2f | %.3f |\n", r.distance,
+        std::printf("| %d | %.0f | %.0f | %.1f | %.0f | %.1f | %.1f | %.1f (%.1f + %.1f) | %.2f | %.2f | %.3f |\n", r.distance,
                     r.originals.triangles, r.originals.drawCalls, r.perObject.triangles, r.perObject.drawCalls,
-                    r.cut.triangles, r.cut.drawCalls, r.cutProxies, r.cutLeaves, r.cut.triangles / r.perObject.triangles,
+                    r.enclosingPerObject.triangles, r.cut.triangles, r.cut.drawCalls, r.cutProxies, r.cutLeaves,
+                    r.cut.triangles / r.perObject.triangles, r.cut.triangles / r.enclosingPerObject.triangles,
                     r.cut.drawCalls / r.originals.drawCalls);
     if (o.breakdown) {
         std::printf("\nthe cut by node kind: nodes, (c) triangles / (b) triangles of the same objects:\n");

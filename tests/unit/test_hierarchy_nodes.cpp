@@ -312,3 +312,32 @@ TEST(HierarchyNodes, ProxyErrorOfKnownShapes) {
     const ProxyError none = measureProxyError({}, {}, {&cube}, 1e-3, 100);
     EXPECT_NEAR(none.bound(), std::sqrt(3.0), 1e-12);
 }
+
+TEST(HierarchyNodes, EnclosingVersionsOfAnObjectContainItWithinTheirCertifiedError) {
+    // The versions a conservative per-object LOD is chosen from: ascending error, each closed,
+    // containing every vertex of the object, its certified error covering a dense grid
+    // measurement and within its budget; the coarsest is far lighter than the object.
+    const InputObject vase = samples::makeLathe("vase", {0, 0, 0}, {{0.5, 0}, {0.3, 0.4}, {0.45, 0.8}, {0.2, 1.2}}, 24);
+    const std::vector<HierarchyNode> versions = enclosingVersions(vase, nullptr, ProxySettings{});
+    ASSERT_GE(versions.size(), 3u);
+    for (size_t i = 0; i < versions.size(); ++i) {
+        const HierarchyNode& v = versions[i];
+        if (i > 0) EXPECT_GE(v.error.bound(), versions[i - 1].error.bound());
+        EXPECT_LE(v.error.bound(), v.budget);
+        const std::vector<double> p(v.positions.begin(), v.positions.end());
+        detail::TriangleBvh surface;
+        surface.build(p.data(), p.size() / 3, v.indices.data(), v.indices.size() / 3);
+        for (size_t k = 0; k + 2 < vase.positions.size(); k += 3) {
+            const bool on = detail::closestPoint(surface, &vase.positions[k]).distance <= 1e-6;
+            EXPECT_TRUE(on || aggrelod::testing::windingNumber(p, v.indices, &vase.positions[k]) > 0.5)
+                << "version " << i << ", vertex " << k / 3;
+        }
+        const aggrelod::testing::GridMeasured m = aggrelod::testing::gridMeasure(v.positions, v.indices, {&vase}, 6);
+        EXPECT_GE(v.error.bound() + 1e-9, m.proxyToOriginals) << "version " << i;
+    }
+    EXPECT_LT(versions.back().indices.size() * 4, vase.indices.size());
+    // An open object without a solid standing in for it has none.
+    InputObject open = vase;
+    open.indices.resize(open.indices.size() - 3);
+    EXPECT_TRUE(enclosingVersions(open, nullptr, ProxySettings{}).empty());
+}
