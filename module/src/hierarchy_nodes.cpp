@@ -821,9 +821,9 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
         const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
         chains[o] = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceiling, settings);
-        std::vector<const InputObject*> source{&objects[o]};
+        const detail::SurfaceColorSource colors({&objects[o]});
         for (HierarchyNode& c : chains[o]) {
-            detail::nearestSurfaceColors(c.positions, c.indices, source, c.faceColors);
+            colors.colorsOf(c.positions, c.indices, c.faceColors);
             detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
         }
     }, [&](size_t done) {
@@ -859,8 +859,9 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         coarser[i] = coarserChain(n, exactProxies[i], aggregateOf(n).componentCount, originals, sourceLadders, ceiling,
                                   settings);
         exactProxies[i] = ExactProxy{};
+        const detail::SurfaceColorSource colors(sourceObjects);
         for (HierarchyNode& c : coarser[i]) {
-            detail::nearestSurfaceColors(c.positions, c.indices, sourceObjects, c.faceColors);
+            colors.colorsOf(c.positions, c.indices, c.faceColors);
             detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
         }
     }, [&](size_t done) {

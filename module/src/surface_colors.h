@@ -12,6 +12,8 @@
 
 #include <aggrelod/aggregate3d.h>
 
+#include "mesh_distance.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -30,5 +32,22 @@ void nearestSurfaceColors(const std::vector<double>& positions, const std::vecto
                           const std::vector<const InputObject*>& originals, std::vector<float>& faceColors);
 void nearestSurfaceColors(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
                           const std::vector<const InputObject*>& originals, std::vector<float>& faceColors);
+
+/// The same, for several meshes standing for the same originals: the originals' surface and
+/// colours are gathered once (a surface of one colour needs no search at all).
+class SurfaceColorSource {
+public:
+    explicit SurfaceColorSource(const std::vector<const InputObject*>& originals);
+    /// As nearestSurfaceColors with this source's originals. Real: float or double.
+    template <typename Real>
+    void colorsOf(const std::vector<Real>& positions, const std::vector<uint32_t>& indices,
+                  std::vector<float>& faceColors) const;
+
+private:
+    bool coloured_ = false;  ///< some original has triangle colours
+    bool uniform_ = false;   ///< every usable original triangle has the same colour
+    std::vector<float> colors_;  ///< per soup triangle, RGBA
+    TriangleBvh bvh_;            ///< of the soup (built only when the colours differ)
+};
 
 }  // namespace aggrelod::detail
