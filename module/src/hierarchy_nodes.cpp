@@ -482,6 +482,12 @@ VersionLadder objectLadder(const InputObject& object, const detail::PreparedOrig
         const double ea = a.node.error.bound(), eb = b.node.error.bound();
         return ea < eb || (ea == eb && a.node.indices.size() < b.node.indices.size());
     });
+    // A version with no fewer triangles than one of smaller error is never chosen (neither by
+    // the lightest chain nor by lightestWithin): keep the others only.
+    std::vector<Version> kept;
+    for (Version& v : ladder.versions)
+        if (kept.empty() || v.node.indices.size() < kept.back().node.indices.size()) kept.push_back(std::move(v));
+    ladder.versions = std::move(kept);
     return ladder;
 }
 
