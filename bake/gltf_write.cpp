@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // aggrelod bake: writing glTF: the sample scenes (writeObjectsGlb), levels.glb, proxies.glb,
-// collision.glb and the 3D Tiles contents, all through one GLB builder (tinygltf, whose
-// implementation Debian ships compiled in libtinygltf.so).
+// collision.glb and the 3D Tiles contents, all through one GLB builder (tinygltf's model types;
+// the JSON and the binary chunk written here).
 #include "runtime_export.h"
 #include "scene_io.h"
 
@@ -17,7 +17,10 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
+#include <charconv>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 
@@ -29,13 +32,348 @@ using Severity = Diagnostic::Severity;
 // ---------------------------------------------------------------------------
 // Writing.
 
+/// A mesh of one triangle primitive as GlbBuilder writes it (accessor indices, -1 for none).
+struct MeshRecord {
+    std::string name;
+    int material = -1;
+    int position = -1, normal = -1, color = -1, indices = -1;
+};
+
+struct AccessorRecord {
+    int bufferView = -1;
+    int componentType = 0;
+    int type = 0;
+    uint64_t count = 0;
+    bool bounded = false;  ///< min and max written (VEC3)
+    double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};
+};
+
+struct ViewRecord {
+    uint64_t byteOffset = 0;
+    uint64_t byteLength = 0;
+    int target = 0;
+};
+
+/// JSON text of the glTF properties aggrelod's writers set (see GlbBuilder), in a fixed key
+/// order: the same model gives the same bytes.
+class JsonWriter {
+public:
+    std::string text;
+
+    void string(const std::string& s) {
+        text += '"';
+        for (size_t i = 0; i < s.size();) {
+            const unsigned char c = static_cast<unsigned char>(s[i]);
+            const size_t length = utf8Length(s, i);
+            if (length == 0) {  // not UTF-8: U+FFFD
+                text += "\xEF\xBF\xBD";
+                ++i;
+                continue;
+            }
+            if (c == '"' || c == '\\') {
+                text += '\\';
+                text += char(c);
+            } else if (c == '\n') {
+                text += "\\n";
+            } else if (c == '\t') {
+                text += "\\t";
+            } else if (c == '\r') {
+                text += "\\r";
+            } else if (c < 0x20) {
+                char escaped[8];
+                std::snprintf(escaped, sizeof escaped, "\\u%04x", unsigned(c));
+                text += escaped;
+            } else {
+                text.append(s, i, length);
+            }
+            i += length;
+        }
+        text += '"';
+    }
+    void number(double x) {
+        if (!std::isfinite(x)) {
+            text += "null";
+            return;
+        }
+        char buffer[32];
+        const auto end = std::to_chars(buffer, buffer + sizeof buffer, x).ptr;  // shortest round trip
+        text.append(buffer, end);
+        // A whole number keeps a fraction, so that readers see a real, as written.
+        if (std::find_if(buffer, end, [](char c) { return c == '.' || c == 'e'; }) == end) text += ".0";
+    }
+    void integer(int64_t x) { text += std::to_string(x); }
+    /// An object member's key; its value follows.
+    void key(const std::string& name) {
+        comma();
+        string(name);
+        text += ':';
+        fresh_ = true;
+    }
+    void open(char c) {
+        comma();
+        text += c;
+        fresh_ = true;
+    }
+    void close(char c) {
+        text += c;
+        fresh_ = false;
+    }
+    void value(const tinygltf::Value& v) {
+        switch (v.Type()) {
+        case tinygltf::BOOL_TYPE: literal(v.Get<bool>() ? "true" : "false"); break;
+        case tinygltf::INT_TYPE: field(int64_t(v.Get<int>())); break;
+        case tinygltf::REAL_TYPE: field(v.Get<double>()); break;
+        case tinygltf::STRING_TYPE: field(v.Get<std::string>()); break;
+        case tinygltf::ARRAY_TYPE:
+            open('[');
+            for (const tinygltf::Value& e : v.Get<tinygltf::Value::Array>()) value(e);
+            close(']');
+            break;
+        case tinygltf::OBJECT_TYPE:
+            open('{');
+            for (const auto& [k, e] : v.Get<tinygltf::Value::Object>()) {
+                key(k);
+                value(e);
+            }
+            close('}');
+            break;
+        default: literal("null"); break;  // null; binary values are never set
+        }
+    }
+    void literal(const char* s) {
+        comma();
+        text += s;
+    }
+    void field(int64_t x) {
+        comma();
+        integer(x);
+    }
+    void field(double x) {
+        comma();
+        number(x);
+    }
+    void field(const std::string& s) {
+        comma();
+        string(s);
+    }
+    template <typename T>
+    void member(const char* name, const T& x) {
+        key(name);
+        field(x);
+    }
+    template <typename T>
+    void numbers(const char* name, const std::vector<T>& xs) {
+        key(name);
+        open('[');
+        for (T x : xs) {
+            if constexpr (std::is_integral_v<T>) field(int64_t(x));
+            else field(double(x));
+        }
+        close(']');
+    }
+    void strings(const char* name, const std::vector<std::string>& xs) {
+        key(name);
+        open('[');
+        for (const std::string& x : xs) field(x);
+        close(']');
+    }
+    void extensions(const tinygltf::ExtensionMap& map) {
+        if (map.empty()) return;
+        key("extensions");
+        open('{');
+        for (const auto& [k, v] : map) {
+            key(k);
+            value(v);
+        }
+        close('}');
+    }
+    void extras(const tinygltf::Value& v) {
+        if (v.Type() == tinygltf::NULL_TYPE) return;
+        key("extras");
+        value(v);
+    }
+
+private:
+    bool fresh_ = true;  ///< just after '[', '{' or a key: the next item takes no comma
+    void comma() {
+        if (!fresh_) text += ',';
+        fresh_ = false;
+    }
+    /// Bytes of the UTF-8 sequence starting at s[i], 0 when it is not one.
+    static size_t utf8Length(const std::string& s, size_t i) {
+        const unsigned char c = static_cast<unsigned char>(s[i]);
+        const size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+        if (n == 0 || i + n > s.size()) return 0;
+        for (size_t k = 1; k < n; ++k)
+            if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return 0;
+        return n;
+    }
+};
+
+const char* accessorTypeName(int type) {
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+    case TINYGLTF_TYPE_VEC2: return "VEC2";
+    case TINYGLTF_TYPE_VEC3: return "VEC3";
+    case TINYGLTF_TYPE_VEC4: return "VEC4";
+    case TINYGLTF_TYPE_MAT2: return "MAT2";
+    case TINYGLTF_TYPE_MAT3: return "MAT3";
+    case TINYGLTF_TYPE_MAT4: return "MAT4";
+    default: throw std::runtime_error("accessor of unknown type " + std::to_string(type));
+    }
+}
+
+/// The glTF JSON of `model` with one buffer of `binaryBytes` (none when 0).
+std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord>& meshes,
+                      const std::vector<AccessorRecord>& accessors, const std::vector<ViewRecord>& views,
+                      uint64_t binaryBytes) {
+    JsonWriter w;
+    w.open('{');
+    w.key("asset");
+    w.open('{');
+    if (!model.asset.generator.empty()) w.member("generator", model.asset.generator);
+    w.member("version", model.asset.version);
+    w.close('}');
+    if (!model.extensionsUsed.empty()) w.strings("extensionsUsed", model.extensionsUsed);
+    if (!model.extensionsRequired.empty()) w.strings("extensionsRequired", model.extensionsRequired);
+    w.extensions(model.extensions);
+    w.extras(model.extras);
+    if (model.defaultScene >= 0) w.member("scene", int64_t(model.defaultScene));
+    w.key("scenes");
+    w.open('[');
+    for (const tinygltf::Scene& scene : model.scenes) {
+        w.open('{');
+        if (!scene.name.empty()) w.member("name", scene.name);
+        if (!scene.nodes.empty()) w.numbers("nodes", scene.nodes);
+        w.close('}');
+    }
+    w.close(']');
+    if (!model.nodes.empty()) {
+        w.key("nodes");
+        w.open('[');
+        for (const tinygltf::Node& node : model.nodes) {
+            w.open('{');
+            if (!node.name.empty()) w.member("name", node.name);
+            if (node.mesh >= 0) w.member("mesh", int64_t(node.mesh));
+            if (!node.children.empty()) w.numbers("children", node.children);
+            if (!node.matrix.empty()) w.numbers("matrix", node.matrix);
+            if (!node.translation.empty()) w.numbers("translation", node.translation);
+            if (!node.rotation.empty()) w.numbers("rotation", node.rotation);
+            if (!node.scale.empty()) w.numbers("scale", node.scale);
+            w.extensions(node.extensions);
+            w.extras(node.extras);
+            w.close('}');
+        }
+        w.close(']');
+    }
+    if (!meshes.empty()) {
+        w.key("meshes");
+        w.open('[');
+        for (const MeshRecord& mesh : meshes) {
+            w.open('{');
+            if (!mesh.name.empty()) w.member("name", mesh.name);
+            w.key("primitives");
+            w.open('[');
+            w.open('{');
+            w.key("attributes");
+            w.open('{');
+            if (mesh.color >= 0) w.member("COLOR_0", int64_t(mesh.color));
+            if (mesh.normal >= 0) w.member("NORMAL", int64_t(mesh.normal));
+            if (mesh.position >= 0) w.member("POSITION", int64_t(mesh.position));
+            w.close('}');
+            if (mesh.indices >= 0) w.member("indices", int64_t(mesh.indices));
+            if (mesh.material >= 0) w.member("material", int64_t(mesh.material));
+            w.member("mode", int64_t(TINYGLTF_MODE_TRIANGLES));
+            w.close('}');
+            w.close(']');
+            w.close('}');
+        }
+        w.close(']');
+    }
+    if (!model.materials.empty()) {
+        w.key("materials");
+        w.open('[');
+        for (const tinygltf::Material& m : model.materials) {
+            w.open('{');
+            if (!m.name.empty()) w.member("name", m.name);
+            w.key("pbrMetallicRoughness");
+            w.open('{');
+            // glTF's defaults are left out.
+            const auto& pbr = m.pbrMetallicRoughness;
+            if (pbr.baseColorFactor != std::vector<double>{1.0, 1.0, 1.0, 1.0})
+                w.numbers("baseColorFactor", pbr.baseColorFactor);
+            if (pbr.metallicFactor != 1.0) w.member("metallicFactor", pbr.metallicFactor);
+            if (pbr.roughnessFactor != 1.0) w.member("roughnessFactor", pbr.roughnessFactor);
+            w.close('}');
+            if (m.doubleSided) {
+                w.key("doubleSided");
+                w.literal("true");
+            }
+            if (!m.alphaMode.empty() && m.alphaMode != "OPAQUE") w.member("alphaMode", m.alphaMode);
+            w.extensions(m.extensions);
+            w.extras(m.extras);
+            w.close('}');
+        }
+        w.close(']');
+    }
+    if (!accessors.empty()) {
+        w.key("accessors");
+        w.open('[');
+        for (const AccessorRecord& a : accessors) {
+            w.open('{');
+            w.member("bufferView", int64_t(a.bufferView));
+            w.member("componentType", int64_t(a.componentType));
+            w.member("count", int64_t(a.count));
+            w.member("type", std::string(accessorTypeName(a.type)));
+            if (a.bounded) {
+                w.numbers("min", std::vector<double>(a.min, a.min + 3));
+                w.numbers("max", std::vector<double>(a.max, a.max + 3));
+            }
+            w.close('}');
+        }
+        w.close(']');
+    }
+    if (!views.empty()) {
+        w.key("bufferViews");
+        w.open('[');
+        for (const ViewRecord& v : views) {
+            w.open('{');
+            w.member("buffer", int64_t(0));
+            if (v.byteOffset > 0) w.member("byteOffset", int64_t(v.byteOffset));
+            w.member("byteLength", int64_t(v.byteLength));
+            if (v.target > 0) w.member("target", int64_t(v.target));
+            w.close('}');
+        }
+        w.close(']');
+    }
+    if (binaryBytes > 0) {
+        w.key("buffers");
+        w.open('[');
+        w.open('{');
+        w.member("byteLength", int64_t(binaryBytes));
+        w.close('}');
+        w.close(']');
+    }
+    w.close('}');
+    return std::move(w.text);
+}
+
 /// Builds one GLB model; meshes share one buffer, one buffer view per accessor.
 class GlbBuilder {
 public:
-    GlbBuilder() {
+    /// `path`: the file write() will make; the binary chunk is gathered beside it meanwhile.
+    explicit GlbBuilder(const std::string& path) : spillPath_(path + ".binary-part") {
         model_.asset.version = "2.0";
         model_.asset.generator = "aggrelod";
     }
+    ~GlbBuilder() {
+        if (spill_) {
+            spill_.reset();
+            std::remove(spillPath_.c_str());
+        }
+    }
+    GlbBuilder(const GlbBuilder&) = delete;
+    GlbBuilder& operator=(const GlbBuilder&) = delete;
 
     /// Adds a mesh with one triangle primitive; returns its index, or -1 when there is
     /// nothing to draw. Positions are converted to float32. The primitive always has NORMAL
@@ -104,55 +442,24 @@ public:
             }
         }
 
-        tinygltf::Primitive prim;
-        {
-            tinygltf::Accessor pos;
-            pos.bufferView = addView(render.positions.data(), render.positions.size() * sizeof(float),
-                                     TINYGLTF_TARGET_ARRAY_BUFFER);
-            pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-            pos.type = TINYGLTF_TYPE_VEC3;
-            pos.count = vertexCount;
-            pos.minValues.assign(lo, lo + 3);
-            pos.maxValues.assign(hi, hi + 3);
-            model_.accessors.push_back(std::move(pos));
-            prim.attributes["POSITION"] = int(model_.accessors.size()) - 1;
-        }
-        if (renderAttributes) {
-            tinygltf::Accessor normal;
-            normal.bufferView = addView(render.normals.data(), render.normals.size() * sizeof(float),
-                                        TINYGLTF_TARGET_ARRAY_BUFFER);
-            normal.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-            normal.type = TINYGLTF_TYPE_VEC3;
-            normal.count = vertexCount;
-            model_.accessors.push_back(std::move(normal));
-            prim.attributes["NORMAL"] = int(model_.accessors.size()) - 1;
-        }
-        if (renderAttributes || coloured) {
-            tinygltf::Accessor col;
-            col.bufferView = addView(colours.data(), colours.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
-            col.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-            col.type = TINYGLTF_TYPE_VEC4;
-            col.count = vertexCount;
-            model_.accessors.push_back(std::move(col));
-            prim.attributes["COLOR_0"] = int(model_.accessors.size()) - 1;
-        }
-        {
-            tinygltf::Accessor idx;
-            idx.bufferView = addView(render.indices.data(), render.indices.size() * sizeof(uint32_t),
-                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-            idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-            idx.type = TINYGLTF_TYPE_SCALAR;
-            idx.count = render.indices.size();
-            model_.accessors.push_back(std::move(idx));
-            prim.indices = int(model_.accessors.size()) - 1;
-        }
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
-        prim.material = material;
-        tinygltf::Mesh mesh;
+        MeshRecord mesh;
         mesh.name = name;
-        mesh.primitives.push_back(std::move(prim));
-        model_.meshes.push_back(std::move(mesh));
-        return int(model_.meshes.size()) - 1;
+        mesh.material = material;
+        mesh.position = addAccessor(render.positions.data(), render.positions.size() * sizeof(float),
+                                    TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                    vertexCount, lo, hi);
+        if (renderAttributes)
+            mesh.normal = addAccessor(render.normals.data(), render.normals.size() * sizeof(float),
+                                      TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                      vertexCount);
+        if (renderAttributes || coloured)
+            mesh.color = addAccessor(colours.data(), colours.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER,
+                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, vertexCount);
+        mesh.indices = addAccessor(render.indices.data(), render.indices.size() * sizeof(uint32_t),
+                                   TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                   TINYGLTF_TYPE_SCALAR, render.indices.size());
+        meshes_.push_back(std::move(mesh));
+        return int(meshes_.size()) - 1;
     }
 
     /// Adds a mesh of float positions without normals or colours (collision geometry): POSITION
@@ -169,30 +476,17 @@ public:
                 if (v == 0 || x < lo[c]) lo[c] = x;
                 if (v == 0 || x > hi[c]) hi[c] = x;
             }
-        tinygltf::Primitive prim;
-        tinygltf::Accessor pos;
-        pos.bufferView = addView(positions.data(), positions.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
-        pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-        pos.type = TINYGLTF_TYPE_VEC3;
-        pos.count = vertexCount;
-        pos.minValues.assign(lo, lo + 3);
-        pos.maxValues.assign(hi, hi + 3);
-        model_.accessors.push_back(std::move(pos));
-        prim.attributes["POSITION"] = int(model_.accessors.size()) - 1;
-        tinygltf::Accessor idx;
-        idx.bufferView = addView(indices.data(), indices.size() * sizeof(uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-        idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-        idx.type = TINYGLTF_TYPE_SCALAR;
-        idx.count = indices.size();
-        model_.accessors.push_back(std::move(idx));
-        prim.indices = int(model_.accessors.size()) - 1;
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
-        tinygltf::Mesh mesh;
+        MeshRecord mesh;
         mesh.name = name;
-        mesh.primitives.push_back(std::move(prim));
-        model_.meshes.push_back(std::move(mesh));
-        return int(model_.meshes.size()) - 1;
+        mesh.position = addAccessor(positions.data(), positions.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER,
+                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, vertexCount, lo, hi);
+        mesh.indices = addAccessor(indices.data(), indices.size() * sizeof(uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
+        meshes_.push_back(std::move(mesh));
+        return int(meshes_.size()) - 1;
     }
+
+    size_t meshCount() const { return meshes_.size(); }
 
     int addNode(tinygltf::Node node) {
         model_.nodes.push_back(std::move(node));
@@ -215,26 +509,62 @@ public:
             model_.scenes.push_back(std::move(scene));
         }
         model_.defaultScene = 0;
-        if (!bin_.empty()) {
-            tinygltf::Buffer buffer;
-            buffer.data = std::move(bin_);
-            model_.buffers.push_back(std::move(buffer));
+        // The JSON written here from the model, the binary chunk straight from the views:
+        // tinygltf would build a JSON document of the whole model and copy the buffer once
+        // more, several times the file in memory for a large hierarchy.
+        std::string json;
+        try {
+            json = modelJson(model_, meshes_, accessors_, views_, binSize_);
+        } catch (const std::exception& e) {
+            error = path + ": cannot write glTF: " + e.what();
+            return false;
+        }
+        const auto padded = [](uint64_t n) { return (n + 3) / 4 * 4; };
+        const uint64_t total = 12 + 8 + padded(json.size()) + (binSize_ ? 8 + padded(binSize_) : 0);
+        if (total > std::numeric_limits<uint32_t>::max()) {
+            error = path + ": " + std::to_string(total) + " bytes: beyond the 4 GiB a GLB file can hold";
+            return false;
+        }
+        if (binSize_ > 0 && spill_ &&
+            (spillFailed_ || std::fflush(spill_.get()) != 0 || std::fseek(spill_.get(), 0, SEEK_SET) != 0)) {
+            error = path + ": cannot write glTF: temporary file: " + std::strerror(errno);
+            return false;
         }
         std::ofstream out(path, std::ios::binary | std::ios::trunc);
         if (!out) {
             error = path + ": cannot create: " + std::strerror(errno);
             return false;
         }
-        tinygltf::TinyGLTF writer;
-        bool ok = false;
-        try {
-            ok = writer.WriteGltfSceneToStream(&model_, out, false, true);
-        } catch (const std::exception& e) {
-            error = path + ": cannot write glTF: " + e.what();
-            return false;
+        const auto word = [&](uint32_t v) {  // little endian, as GLB wants
+            const unsigned char b[4] = {uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16), uint8_t(v >> 24)};
+            out.write(reinterpret_cast<const char*>(b), 4);
+        };
+        out.write("glTF", 4);
+        word(2);
+        word(uint32_t(total));
+        word(uint32_t(padded(json.size())));
+        word(0x4E4F534Au);  // "JSON"
+        json.resize(padded(json.size()), ' ');
+        out.write(json.data(), std::streamsize(json.size()));
+        if (binSize_) {
+            word(uint32_t(padded(binSize_)));
+            word(0x004E4942u);  // "BIN\0"
+            if (!spill_) out.write(reinterpret_cast<const char*>(inMemory_.data()), std::streamsize(inMemory_.size()));
+            std::vector<char> block(spill_ ? 1 << 20 : 0);
+            for (uint64_t left = spill_ ? binSize_ : 0; left > 0;) {
+                const size_t n = std::fread(block.data(), 1, size_t(std::min<uint64_t>(left, block.size())), spill_.get());
+                if (n == 0) {
+                    error = path + ": cannot write glTF: temporary file ended early";
+                    return false;
+                }
+                out.write(block.data(), std::streamsize(n));
+                left -= n;
+            }
+            const char zeros[4] = {0, 0, 0, 0};
+            out.write(zeros, std::streamsize(padded(binSize_) - binSize_));
         }
         out.close();
-        if (!ok || !out) {
+        if (!out) {
             error = path + ": write error (disk full?)";
             return false;
         }
@@ -243,20 +573,62 @@ public:
 
 private:
     int addView(const void* data, size_t bytes, int target) {
-        while (bin_.size() % 4) bin_.push_back(0);
-        tinygltf::BufferView view;
-        view.buffer = 0;
-        view.byteOffset = bin_.size();
+        ViewRecord view;
+        view.byteOffset = (binSize_ + 3) / 4 * 4;
         view.byteLength = bytes;
         view.target = target;
+        // The binary chunk goes to a file beside the output as it grows (written out after the
+        // JSON, which has to come first): the builder holds the model's description only.
+        // Where that file cannot be made, the chunk stays in memory.
+        if (!spill_ && inMemory_.empty() && binSize_ == 0) spill_.reset(std::fopen(spillPath_.c_str(), "w+b"));
         const auto* b = static_cast<const unsigned char*>(data);
-        bin_.insert(bin_.end(), b, b + bytes);
-        model_.bufferViews.push_back(std::move(view));
-        return int(model_.bufferViews.size()) - 1;
+        if (!spill_) {
+            inMemory_.resize(size_t(view.byteOffset), 0);
+            inMemory_.insert(inMemory_.end(), b, b + bytes);
+        } else {
+            const char zeros[4] = {0, 0, 0, 0};
+            if (std::fwrite(zeros, 1, size_t(view.byteOffset - binSize_), spill_.get()) != view.byteOffset - binSize_ ||
+                std::fwrite(b, 1, bytes, spill_.get()) != bytes)
+                spillFailed_ = true;
+        }
+        binSize_ = view.byteOffset + bytes;
+        views_.push_back(view);
+        return int(views_.size()) - 1;
     }
 
-    tinygltf::Model model_;
-    std::vector<unsigned char> bin_;
+    /// A buffer view of `bytes` and its accessor; lo/hi: min/max of a VEC3, or null.
+    int addAccessor(const void* data, size_t bytes, int target, int componentType, int type, uint64_t count,
+                    const double* lo = nullptr, const double* hi = nullptr) {
+        AccessorRecord a;
+        a.bufferView = addView(data, bytes, target);
+        a.componentType = componentType;
+        a.type = type;
+        a.count = count;
+        a.bounded = lo && hi;
+        if (a.bounded)
+            for (int c = 0; c < 3; ++c) {
+                a.min[c] = lo[c];
+                a.max[c] = hi[c];
+            }
+        accessors_.push_back(a);
+        return int(accessors_.size()) - 1;
+    }
+
+    struct CloseFile {
+        void operator()(std::FILE* f) const { std::fclose(f); }
+    };
+
+    // Meshes, accessors and buffer views are only ever made here: kept in records of their own,
+    // a fraction of tinygltf's (a large hierarchy has hundreds of thousands of them).
+    tinygltf::Model model_;  ///< everything else: nodes, materials, extensions
+    std::vector<MeshRecord> meshes_;
+    std::vector<AccessorRecord> accessors_;
+    std::vector<ViewRecord> views_;
+    std::string spillPath_;
+    std::unique_ptr<std::FILE, CloseFile> spill_;  ///< the binary chunk so far, at spillPath_
+    std::vector<unsigned char> inMemory_;         ///< the same without a temporary file
+    bool spillFailed_ = false;
+    uint64_t binSize_ = 0;      ///< bytes of the binary chunk before its final padding
 };
 
 tinygltf::Value intValue(uint64_t v) {
@@ -353,7 +725,7 @@ void setMsftLod(tinygltf::Model& model, tinygltf::Node& node, const std::vector<
 bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string& path,
                      std::string& error) {
     try {
-        GlbBuilder glb;
+        GlbBuilder glb(path);
         std::vector<int> roots;
         std::map<std::vector<double>, int> materialOfColour;
         for (const InputObject& o : objects) {
@@ -405,7 +777,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
         return false;
     }
     try {
-        GlbBuilder glb;
+        GlbBuilder glb(path);
         tinygltf::Model& model = glb.model();
         std::vector<int> roots;
         const size_t levelCount = hierarchy.levels.size();
@@ -577,7 +949,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
         return false;
     }
     try {
-        GlbBuilder glb;
+        GlbBuilder glb(path);
         tinygltf::Model& model = glb.model();
         int levelCount = 0;
         bool anyColours = false;
@@ -739,7 +1111,7 @@ bool writeCollisionGlb(const HierarchyNodes& nodes, const std::vector<InputObjec
         return false;
     }
     try {
-        GlbBuilder glb;
+        GlbBuilder glb(path);
         tinygltf::Model& model = glb.model();
         tinygltf::Value::Array omiShapes;
         // Static colliders: no motion. Each collider node carries its own mesh and names it as
@@ -863,7 +1235,7 @@ bool writeTileGlb(const TileMesh& tile, const std::string& path, std::string& er
         }
     }
     try {
-        GlbBuilder glb;
+        GlbBuilder glb(path);
         tinygltf::Model& model = glb.model();
         tinygltf::Material material;
         material.name = tile.name;
@@ -884,7 +1256,7 @@ bool writeTileGlb(const TileMesh& tile, const std::string& path, std::string& er
         extras["source_ids"] = tinygltf::Value(std::move(sourceIds));
         node.extras = tinygltf::Value(std::move(extras));
         const int root = glb.addNode(std::move(node));
-        if (model.meshes.empty()) model.materials.clear();  // nothing drawn: no unused material
+        if (glb.meshCount() == 0) model.materials.clear();  // nothing drawn: no unused material
         return glb.write(path, std::vector<int>{root}, error);
     } catch (const std::exception& e) {
         error = path + ": " + e.what();

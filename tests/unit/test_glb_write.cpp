@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The GLB writer of the bake (bake/gltf_write.cpp): its JSON text is written by aggrelod
+// itself, so names with quotes, control characters, non-ASCII letters and bytes that are not
+// UTF-8 must come out as valid glTF and read back; numbers must keep their type.
+#include "scene_io.h"
+#include "test_support.h"
+
+#include <aggrelod/samples.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+namespace aggrelod {
+namespace {
+
+using namespace aggrelod::testing;
+
+std::string glbJson(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_GE(bytes.size(), 20u);
+    if (bytes.size() < 20) return {};
+    uint32_t total = 0, jsonLength = 0;
+    std::memcpy(&total, bytes.data() + 8, 4);
+    std::memcpy(&jsonLength, bytes.data() + 12, 4);
+    EXPECT_EQ(total, bytes.size());
+    EXPECT_EQ(bytes.compare(16, 4, "JSON"), 0);
+    EXPECT_EQ(jsonLength % 4, 0u);
+    return bytes.substr(20, jsonLength);
+}
+
+TEST(GlbWrite, AwkwardNamesAreEscapedAndReadBack) {
+    const fs::path dir = freshTestDir(currentTestName());
+    std::vector<InputObject> objects = samples::makeTwoCubes(0.5);
+    ASSERT_EQ(objects.size(), 2u);
+    objects.push_back(objects[1]);
+    objects.push_back(objects[1]);
+    for (size_t i = 2; i < objects.size(); ++i)
+        for (size_t v = 0; v < objects[i].positions.size(); v += 3) objects[i].positions[v] += 3.0 * double(i);
+    objects[0].name = "quote\" back\\slash /";
+    objects[1].name = std::string("line\nbreak\ttab\x01");
+    objects[2].name = "na\xC3\xAFve \xE2\x9C\x93";  // naïve ✓
+    objects[3].name = "bad\xFF\xFE" "end";               // not UTF-8
+    std::string error;
+    ASSERT_TRUE(io::writeObjectsGlb(objects, (dir / "names.glb").string(), error)) << error;
+    validateGltf({dir / "names.glb"}, dir);
+    const std::string json = glbJson(dir / "names.glb");
+    EXPECT_NE(json.find("quote\\\" back\\\\slash /"), std::string::npos) << json.substr(0, 400);
+    EXPECT_NE(json.find("line\\nbreak\\ttab\\u0001"), std::string::npos) << json.substr(0, 400);
+    io::SceneReadResult back;
+    ASSERT_TRUE(io::readGltfScene((dir / "names.glb").string(), {}, back, error)) << error;
+    ASSERT_EQ(back.objects.size(), 4u);
+    EXPECT_EQ(back.objects[0].name, objects[0].name);
+    EXPECT_EQ(back.objects[1].name, objects[1].name);
+    EXPECT_EQ(back.objects[2].name, objects[2].name);
+    EXPECT_EQ(back.objects[3].name, "bad\xEF\xBF\xBD\xEF\xBF\xBD" "end");  // U+FFFD per stray byte
+    for (size_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(back.objects[i].indices, objects[i].indices) << i;
+        ASSERT_EQ(back.objects[i].positions.size(), objects[i].positions.size()) << i;
+        for (size_t k = 0; k < objects[i].positions.size(); ++k)
+            EXPECT_EQ(back.objects[i].positions[k], double(float(objects[i].positions[k]))) << i << " " << k;
+    }
+}
+
+}  // namespace
+}  // namespace aggrelod
