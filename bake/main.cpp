@@ -541,6 +541,14 @@ int runBake(BakeOptions o) {
         (o.collision && !set.addFile(collisionPath, collisionTmp, error)))
         return fail(error);
     if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes)) return fail(error);
+    // The exact aggregates' meshes are in levels.glb now and nothing after needs them (the
+    // statistics keep counts): on a large world they are the largest part of what is held.
+    for (Level& level : hierarchy.levels)
+        for (Aggregate& a : level.aggregates) {
+            std::vector<double>().swap(a.positions);
+            std::vector<uint32_t>().swap(a.indices);
+            std::vector<float>().swap(a.faceColors);
+        }
     if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) return fail(error);
     if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
                                runtimeTmp.string(), error))
