@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <utility>
 
 namespace aggrelod::io {
 
@@ -26,20 +27,10 @@ bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObjec
         error = path + ": " + error;
         return false;
     }
-    std::vector<uint8_t> bytes;
-    if (!runtime::writeRuntimeFile(arrays.params(), bytes, error)) {
-        error = path + ": " + error;
-        return false;
-    }
-    std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) {
-        error = path + ": cannot open for writing";
-        return false;
-    }
-    const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    const bool closed = std::fclose(f) == 0;
-    if (!ok || !closed) {
-        error = path + ": write failed (disk full?)";
+    // Straight to the file: the arrays and a whole image of the file would be twice the
+    // hierarchy in memory.
+    if (!runtime::writeRuntimeFile(std::move(arrays), path, error)) {
+        if (error.rfind(path, 0) != 0) error = path + ": " + error;
         return false;
     }
     return true;

@@ -9,7 +9,9 @@
 #include "aglod_layout.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <limits>
 
 namespace aggrelod::runtime {
@@ -27,11 +29,20 @@ struct SectionSource {
     uint64_t count;
 };
 
-}  // namespace
+/// Where every section of a file for `params` goes; checks what the layout itself needs.
+struct FileLayout {
+    std::vector<uint32_t> roots;
+    std::vector<uint32_t> nameRanges;  ///< {offset, length} per object name into `names`
+    std::string names;
+    SectionSource sources[layout::kSectionCount + 1] = {};
+    size_t offsets[layout::kSectionCount + 1] = {};
+    size_t total = 0;
+    /// Magic, version, counts and the section table; the checksum field is 0.
+    std::vector<uint8_t> header;
+};
 
-bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error) {
+bool planFile(const BuildParams& params, FileLayout& plan, std::string& error) {
     using namespace layout;
-    bytes.clear();
     if (!hostIsLittleEndian()) {
         error = "aglod writer: big-endian hosts are not supported";
         return false;
@@ -71,68 +82,127 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
     }
 
     // The node records are the file's own layout: written as given.
-    std::vector<uint32_t> roots;
     for (size_t i = 0; i < params.nodeCount; ++i)
-        if (params.nodes[i].parent == kNoIndex) roots.push_back(static_cast<uint32_t>(i));
+        if (params.nodes[i].parent == kNoIndex) plan.roots.push_back(static_cast<uint32_t>(i));
 
     // Object names: {offset, length} pairs into one blob.
-    std::vector<uint32_t> nameRanges;
-    std::string blob;
-    nameRanges.reserve(params.objectCount * 2);
+    plan.nameRanges.reserve(params.objectCount * 2);
     for (size_t i = 0; i < params.objectCount; ++i) {
         const std::string& name = params.objectNames[i];
-        if (blob.size() + name.size() > kMaxU32) {
+        if (plan.names.size() + name.size() > kMaxU32) {
             error = "object names exceed 4 GiB";
             return false;
         }
-        nameRanges.push_back(static_cast<uint32_t>(blob.size()));
-        nameRanges.push_back(static_cast<uint32_t>(name.size()));
-        blob += name;
+        plan.nameRanges.push_back(static_cast<uint32_t>(plan.names.size()));
+        plan.nameRanges.push_back(static_cast<uint32_t>(name.size()));
+        plan.names += name;
     }
 
     const SectionSource sources[kSectionCount + 1] = {
         {nullptr, 0},
         {params.nodes, params.nodeCount},
-        {roots.data(), roots.size()},
+        {plan.roots.data(), plan.roots.size()},
         {params.childIndices, params.childIndexCount},
         {params.sourceObjects, params.sourceObjectCount},
         {params.positions, params.positionCount / 3},
         {params.indices, params.indexCount},
-        {nameRanges.data(), nameRanges.size() / 2},
-        {blob.data(), blob.size()},
+        {plan.nameRanges.data(), plan.nameRanges.size() / 2},
+        {plan.names.data(), plan.names.size()},
         {params.normals, params.normalCount / 3},
         {params.colors, params.colorCount / 4},
     };
+    std::copy(std::begin(sources), std::end(sources), plan.sources);
 
-    size_t offsets[kSectionCount + 1] = {};
     size_t cursor = kHeaderSize + kSectionEntrySize * kSectionCount;
     for (uint32_t s = 1; s <= kSectionCount; ++s) {
         cursor = alignUp(cursor, kSectionAlign);
-        offsets[s] = cursor;
-        cursor += sources[s].count * kSectionStride[s];
+        plan.offsets[s] = cursor;
+        cursor += plan.sources[s].count * kSectionStride[s];
     }
-    const size_t total = alignUp(cursor, kTotalSizeMultiple);
-    bytes.assign(total, 0);
-    uint8_t* out = bytes.data();
+    plan.total = alignUp(cursor, kTotalSizeMultiple);
 
+    plan.header.assign(kHeaderSize + kSectionEntrySize * kSectionCount, 0);
+    uint8_t* out = plan.header.data();
     std::memcpy(out, kMagic, sizeof(kMagic));
     storeU16(out + 8, kFormatMajor);
     storeU16(out + 10, kFormatMinor);
     storeU32(out + 12, kSectionCount);
-    storeU64(out + 16, total);
+    storeU64(out + 16, plan.total);
     storeU64(out + 32, params.settingsHash);
     std::memcpy(out + 40, params.toolVersion.data(), params.toolVersion.size());
     for (uint32_t s = 1; s <= kSectionCount; ++s) {
         uint8_t* e = out + kHeaderSize + kSectionEntrySize * (s - 1);
-        const uint64_t byteSize = sources[s].count * kSectionStride[s];
         storeU32(e, s);
         storeU32(e + 4, kSectionStride[s]);
-        storeU64(e + 8, offsets[s]);
-        storeU64(e + 16, sources[s].count);
-        storeU64(e + 24, byteSize);
-        if (byteSize) std::memcpy(out + offsets[s], sources[s].data, byteSize);
+        storeU64(e + 8, plan.offsets[s]);
+        storeU64(e + 16, plan.sources[s].count);
+        storeU64(e + 24, plan.sources[s].count * kSectionStride[s]);
     }
-    storeU64(out + kChecksumOffset, fileChecksum(out, total, kChecksumOffset));
+    return true;
+}
+
+/// Calls put(data, byteCount) for the file's bytes in order (checksum field 0).
+template <typename Put>
+void emitFile(const FileLayout& plan, Put&& put) {
+    using namespace layout;
+    static const uint8_t zeros[kSectionAlign > kTotalSizeMultiple ? kSectionAlign : kTotalSizeMultiple] = {};
+    size_t at = plan.header.size();
+    put(plan.header.data(), at);
+    for (uint32_t s = 1; s <= kSectionCount; ++s) {
+        put(zeros, plan.offsets[s] - at);
+        const size_t byteSize = plan.sources[s].count * kSectionStride[s];
+        if (byteSize) put(plan.sources[s].data, byteSize);
+        at = plan.offsets[s] + byteSize;
+    }
+    put(zeros, plan.total - at);
+}
+
+/// layout::fileChecksum over bytes given in pieces (the checksum field given as 0).
+class StreamChecksum {
+public:
+    void add(const void* data, size_t size) {
+        const auto* p = static_cast<const uint8_t*>(data);
+        while (size > 0) {
+            const size_t n = std::min(size, sizeof(block_) - filled_);
+            std::memcpy(block_ + filled_, p, n);
+            filled_ += n;
+            p += n;
+            size -= n;
+            if (filled_ == sizeof(block_)) {
+                for (int k = 0; k < 4; ++k) lane_[k] = (lane_[k] ^ layout::loadU64(block_ + 8 * k)) * kPrime;
+                filled_ = 0;
+                total_ += sizeof(block_);
+            }
+        }
+    }
+    uint64_t value() const {
+        uint64_t h = 0xcbf29ce484222325ull;
+        for (uint64_t l : lane_) h = (h ^ l) * kPrime;
+        return h ^ (total_ + filled_);
+    }
+
+private:
+    static constexpr uint64_t kPrime = 0x100000001b3ull;
+    uint64_t lane_[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull, 0x2325cbf29ce48422ull};
+    uint8_t block_[32] = {};
+    size_t filled_ = 0;
+    uint64_t total_ = 0;
+};
+
+}  // namespace
+
+bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, std::string& error) {
+    using namespace layout;
+    bytes.clear();
+    FileLayout plan;
+    if (!planFile(params, plan, error)) return false;
+    bytes.resize(plan.total);
+    uint8_t* cursor = bytes.data();
+    emitFile(plan, [&](const void* data, size_t size) {
+        if (size) std::memcpy(cursor, data, size);
+        cursor += size;
+    });
+    storeU64(bytes.data() + kChecksumOffset, fileChecksum(bytes.data(), plan.total, kChecksumOffset));
 
     // The reader's validator is the single definition of a consistent hierarchy.
     RuntimeFile check;
@@ -141,6 +211,45 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
     if (status != FileStatus::Ok) {
         error = std::string("inconsistent hierarchy (") + toString(status) + "): " + message;
         bytes.clear();
+        return false;
+    }
+    return true;
+}
+
+bool writeRuntimeFile(BuildArrays&& arrays, const std::string& path, std::string& error) {
+    using namespace layout;
+    {
+        FileLayout plan;
+        if (!planFile(arrays.params(), plan, error)) return false;
+        std::FILE* f = std::fopen(path.c_str(), "wb");
+        if (!f) {
+            error = path + ": cannot open for writing";
+            return false;
+        }
+        StreamChecksum checksum;
+        bool written = true;
+        emitFile(plan, [&](const void* data, size_t size) {
+            checksum.add(data, size);
+            if (written && size) written = std::fwrite(data, 1, size, f) == size;
+        });
+        uint8_t sum[8];
+        storeU64(sum, checksum.value());
+        written = written && std::fseek(f, long(kChecksumOffset), SEEK_SET) == 0 && std::fwrite(sum, 1, 8, f) == 8;
+        const bool closed = std::fclose(f) == 0;
+        if (!written || !closed) {
+            std::remove(path.c_str());
+            error = path + ": write failed (disk full?)";
+            return false;
+        }
+    }
+    arrays = BuildArrays{};  // released before the file is read back
+    // The reader's validator is the single definition of a consistent hierarchy.
+    RuntimeFile check;
+    std::string message;
+    const FileStatus status = RuntimeFile::openFile(path, check, message);
+    if (status != FileStatus::Ok) {
+        std::remove(path.c_str());
+        error = std::string("inconsistent hierarchy (") + toString(status) + "): " + message;
         return false;
     }
     return true;

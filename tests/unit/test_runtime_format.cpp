@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <set>
 
@@ -121,6 +122,32 @@ TEST(RuntimeFormat, WriterIsDeterministicAndFileOpensFromDisk) {
     EXPECT_EQ(RuntimeFile::openFile(path + ".empty", file, message), FileStatus::Truncated);
     std::remove(path.c_str());
     std::remove((path + ".empty").c_str());
+}
+
+// The file written straight to disk is the image writeRuntimeFile gives in memory, for
+// hierarchies of several sizes (sections of every length modulo the checksum's 32-byte
+// blocks); the arrays are consumed; a refused hierarchy leaves no file.
+TEST(RuntimeFormat, FileWrittenStraightToDiskIsTheSameImage) {
+    const std::string path = std::string(AGGRELOD_TEST_TMP) + "/streamed.aglod";
+    for (int objects : {1, 7, 40, 333}) {
+        BuildArrays p = makeSyntheticHierarchy(objects, 3 + objects % 5, 3, 2);
+        const std::vector<uint8_t> image = writeOrDie(p);
+        std::string error;
+        ASSERT_TRUE(writeRuntimeFile(std::move(p), path, error)) << objects << ": " << error;
+        EXPECT_TRUE(p.nodes.empty() && p.positions.empty() && p.objectNames.empty()) << objects;
+        std::ifstream in(path, std::ios::binary);
+        const std::vector<uint8_t> written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        EXPECT_EQ(written, image) << objects;
+    }
+    BuildArrays bad = makeSyntheticHierarchy(40, 2);
+    bad.sourceObjects[0] = 9999;
+    std::string error;
+    std::remove(path.c_str());
+    EXPECT_FALSE(writeRuntimeFile(std::move(bad), path, error));
+    EXPECT_NE(error.find("index out of range"), std::string::npos) << error;
+    EXPECT_FALSE(std::ifstream(path).good()) << "a refused hierarchy left " << path;
+    EXPECT_FALSE(writeRuntimeFile(makeSyntheticHierarchy(5, 1), std::string(AGGRELOD_TEST_TMP) + "/no/such/dir/x.aglod", error));
+    EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
 }
 
 TEST(RuntimeFormat, SectionsAreAlignedAndLittleEndianHeader) {

@@ -158,6 +158,11 @@ bool writeRuntimeFile(const BuildParams& params, std::vector<uint8_t>& bytes, st
 inline bool writeRuntimeFile(const BuildArrays& arrays, std::vector<uint8_t>& bytes, std::string& error) {
     return writeRuntimeFile(arrays.params(), bytes, error);
 }
+/// The same file written straight to `path` (the bytes writeRuntimeFile gives, never the whole
+/// file in memory): `arrays` are consumed (emptied once written, before the file is read back
+/// and checked with RuntimeFile::openFile), so a large hierarchy is not held twice. On failure
+/// nothing is left at `path`.
+bool writeRuntimeFile(BuildArrays&& arrays, const std::string& path, std::string& error);
 
 /// Linear RGBA in [0, 1] (glTF baseColorFactor / COLOR_0 meaning; clamped, NaN -> 0) to the
 /// file's colour bytes: RGB through the sRGB transfer function, alpha linear, rounded to
