@@ -18,6 +18,8 @@
 #include <array>
 #include <cmath>
 #include <exception>
+#include <algorithm>
+#include <numeric>
 
 namespace aggrelod::detail {
 
@@ -111,6 +113,39 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
     return true;
 }
 
+namespace {
+
+/// Vertices sorted by (x, y, z), each triangle rotated to start at its smallest index (its
+/// orientation kept), triangles sorted: the same surface always comes out in the same order.
+/// Vertices at the same position keep their relative order.
+void canonicalOrder(std::vector<double>& positions, std::vector<uint32_t>& triangles) {
+    const size_t n = positions.size() / 3;
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return std::lexicographical_compare(&positions[3 * a], &positions[3 * a] + 3, &positions[3 * b],
+                                            &positions[3 * b] + 3);
+    });
+    std::vector<uint32_t> newIndex(n);
+    std::vector<double> sorted(positions.size());
+    for (size_t i = 0; i < n; ++i) {
+        newIndex[order[i]] = static_cast<uint32_t>(i);
+        std::copy_n(&positions[3 * order[i]], 3, &sorted[3 * i]);
+    }
+    positions = std::move(sorted);
+    std::vector<std::array<uint32_t, 3>> faces(triangles.size() / 3);
+    for (size_t f = 0; f < faces.size(); ++f) {
+        std::array<uint32_t, 3> t = {newIndex[triangles[3 * f]], newIndex[triangles[3 * f + 1]],
+                                     newIndex[triangles[3 * f + 2]]};
+        std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+        faces[f] = t;
+    }
+    std::sort(faces.begin(), faces.end());
+    for (size_t f = 0; f < faces.size(); ++f) std::copy_n(faces[f].begin(), 3, &triangles[3 * f]);
+}
+
+}  // namespace
+
 bool exactUnion(const std::vector<const std::vector<double>*>& positions,
                 const std::vector<const std::vector<uint32_t>*>& triangles, std::vector<double>& outPositions,
                 std::vector<uint32_t>& outTriangles, std::string& error) {
@@ -175,6 +210,7 @@ bool exactUnion(const std::vector<const std::vector<double>*>& positions,
             error = "the union has a non-triangle face";
             return false;
         }
+        canonicalOrder(outPositions, outTriangles);
     } catch (const std::exception& e) {
         error = std::string("boolean union failed: ") + e.what();
         outPositions.clear();

@@ -29,8 +29,10 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
 /// doubles at the end): for objects that are valid solids on their own but touch or cross
 /// each other, the tightest solid there is (its surface lies on theirs).
 /// positions[i], triangles[i]: part i, as alphaWrap's input; each must be closed,
-/// edge-manifold, free of self-intersections and bound a volume. Output as alphaWrap's, in
-/// the order the corefinement made it (deterministic). Returns false with a reason in
+/// edge-manifold, free of self-intersections and bound a volume. Output as alphaWrap's, in a
+/// canonical order: vertices sorted by coordinates, each triangle starting at its smallest
+/// index, triangles sorted (the corefinement's own order follows memory addresses, so it
+/// differs between runs and thread counts). Returns false with a reason in
 /// `error` (never throws) when a part is not such a solid or the union is not a manifold
 /// surface (parts meeting along an edge or at a point). The rounding of new vertices can
 /// leave the output crossing itself: the caller checks it.

@@ -4,6 +4,7 @@
 // wraps are closed, contain their originals and stay near them; objects can be chosen in
 // real files (index paths, own meshes, assembly depth, animated nodes).
 #include "scene_io.h"
+#include "solidify.h"
 #include "tetgen_backend.h"
 #include "test_support.h"
 
@@ -201,6 +202,33 @@ TEST(RealArt, CrossingClosedSolidsBecomeTheirExactUnion) {
     EXPECT_EQ(h.solids[1].method, SolidifyMethod::Wrap);
     EXPECT_EQ(h.objectModel[0], h.objectModel[1]);
     EXPECT_NE(h.objectModel[0], h.objectModel[2]);
+}
+
+// The exact union comes out in one canonical order, whatever the order of its inputs' vertices
+// and triangles (CGAL's corefinement orders its output by memory addresses, which differ between
+// runs and thread counts): sorted vertices, triangles starting at their smallest index, sorted.
+TEST(RealArt, ExactUnionOrderDoesNotDependOnItsInput) {
+    const InputObject a = samples::makeBox("a", {0, 0, 0}, {1, 1, 1}, 0.25);
+    const InputObject b = samples::makeBox("b", {0.5, 0.5, 0.5}, {1.5, 1.5, 1.5}, 0.25);
+    std::vector<double> p1, p2;
+    std::vector<uint32_t> t1, t2;
+    std::string error;
+    ASSERT_TRUE(detail::exactUnion({&a.positions, &b.positions}, {&a.indices, &b.indices}, p1, t1, error)) << error;
+    // b again with its vertices in reverse order and its triangles rotated and reversed.
+    const size_t n = b.positions.size() / 3;
+    std::vector<double> bp(b.positions.size());
+    for (size_t v = 0; v < n; ++v) std::copy_n(&b.positions[3 * (n - 1 - v)], 3, &bp[3 * v]);
+    std::vector<uint32_t> bt;
+    for (size_t f = b.indices.size() / 3; f-- > 0;)
+        for (int k : {1, 2, 0}) bt.push_back(static_cast<uint32_t>(n - 1 - b.indices[3 * f + size_t(k)]));
+    ASSERT_TRUE(detail::exactUnion({&a.positions, &bp}, {&a.indices, &bt}, p2, t2, error)) << error;
+    EXPECT_EQ(p1, p2);
+    EXPECT_EQ(t1, t2);
+    ASSERT_GE(p1.size(), 6u);
+    for (size_t v = 3; v < p1.size(); v += 3)
+        EXPECT_TRUE(std::lexicographical_compare(&p1[v - 3], &p1[v], &p1[v], &p1[v] + 3) ||
+                    std::equal(&p1[v - 3], &p1[v], &p1[v]))
+            << "vertex " << v / 3 << " out of order";
 }
 
 TEST(RealArt, HullOnlyWhenAsked) {
