@@ -8,7 +8,8 @@
 The pieces of the tiled bake (`aggrelod bake --tile-task plan` lists them) run as Dask tasks,
 each one `aggrelod bake --tile-task PIECE` process on a worker, in waves: the cells' graphs
 (automatic thresholds only), the cells, then the parent cells quadtree level by quadtree level,
-and last the whole bake, which finds every piece in the cache and writes the outputs. Pieces go
+then the proxies of the whole hierarchy in two phases of shares, and last the whole bake, which
+finds every piece and every proxy in the cache and writes the outputs. Pieces go
 through the tile cache (a folder every worker sees: shared storage on several machines), so a
 task that is retried after its worker died redoes only its own piece, and the result is
 byte-identical to `aggrelod bake --tile-size S` on one machine. Without --scheduler, a
@@ -44,14 +45,17 @@ def run_piece(command):
     return done.stdout
 
 
-def piece_commands(plan):
-    """The waves of pieces, each a list of --tile-task values, in the order they must run."""
+def piece_commands(plan, proxy_shares):
+    """The waves of pieces, each a list of --tile-task values, in the order they must run:
+    the hierarchy's pieces, then the proxies' two phases, each cut into proxy_shares shares."""
     waves = []
     if plan["graphs"]:
         waves.append([f"graph:{c}" for c in plan["cells"]])
     waves.append([f"cell:{c}" for c in plan["cells"]])
     for level in sorted({j for j, _, _ in plan["parents"]}):
         waves.append([f"parent:{j}:{r}:{c}" for j, r, c in plan["parents"] if j == level])
+    for phase in (1, 2):
+        waves.append([f"proxies:{phase}:{k}:{proxy_shares}" for k in range(proxy_shares)])
     return waves
 
 
@@ -67,7 +71,10 @@ def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, thr
     base = [aggrelod, "bake", scene, "-o", outdir, "--tile-size", tile_size] + bake_options
     plan = json.loads(run_piece(base + ["--tile-task", "plan", "--quiet"]))
     if plan["tiled"]:
-        for wave in piece_commands(plan):
+        # Shares of the proxies: two per worker thread (each share loads the whole hierarchy;
+        # the bake balances their estimated work). The result does not depend on their number.
+        shares = max(1, 2 * sum(client.nthreads().values()))
+        for wave in piece_commands(plan, shares):
             started = time.monotonic()
             commands = [base + ["--tile-cache", cache, "--tile-task", task, "--quiet", "--threads", "1"] for task in wave]
             futures = client.map(run_piece, commands, retries=RETRIES, pure=False)

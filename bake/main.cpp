@@ -203,7 +203,9 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "(needs --tile-size)");
     cmd->add_option("--tile-task", o.tileTask,
                     "Bake one piece of a tiled bake into --tile-cache and write no outputs: plan (print the pieces "
-                    "as JSON), graph:N, cell:N or parent:J:ROW:COLUMN; what aggrelod-farm runs on its workers");
+                    "as JSON), graph:N, cell:N, parent:J:ROW:COLUMN, or proxies:PHASE:PART:PARTS (share PART of "
+                    "PARTS of the proxies' phase 1 or 2, after every other piece); what aggrelod-farm runs on its "
+                    "workers");
     cmd->add_option("--stats", o.statsPath, "Write the figures of every level and stage to this JSON file");
     cmd->add_flag("--constant-baseline", o.constantBaseline,
                   "Also measure the constant function (paper Eq. 1) at the same groups: volume_constant and "
@@ -400,6 +402,7 @@ int runBake(BakeOptions o) {
     // A tiled bake's cache and piece (--tile-cache, --tile-task).
     TiledBakeOptions tiling;
     TileCache tileCache;
+    ProxyShare proxyShare;
     if (!o.tileSize.empty()) tiling.tileSize = o.tileSize == "auto" ? 0.0 : std::strtod(o.tileSize.c_str(), nullptr);
     if (!o.tileCache.empty()) {
         tileCache = io::folderTileCache(o.tileCache);
@@ -423,8 +426,16 @@ int runBake(BakeOptions o) {
             t.level = static_cast<int>(a);
             t.row = static_cast<uint32_t>(b);
             t.column = static_cast<uint32_t>(c);
+        } else if (std::sscanf(o.tileTask.c_str(), "proxies:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && (a == 1 || a == 2) &&
+                   c >= 1 && c <= UINT32_MAX && b < c) {
+            t.kind = TileTask::Kind::Assemble;  // the whole hierarchy from the cache, then the share
+            proxyShare.phase = static_cast<int>(a);
+            proxyShare.part = static_cast<uint32_t>(b);
+            proxyShare.parts = static_cast<uint32_t>(c);
         } else {
-            printError("--tile-task " + o.tileTask + ": expects plan, graph:N, cell:N or parent:J:ROW:COLUMN");
+            printError("--tile-task " + o.tileTask +
+                       ": expects plan, graph:N, cell:N, parent:J:ROW:COLUMN or proxies:PHASE:PART:PARTS "
+                       "(PHASE 1 or 2, PART below PARTS)");
             return kUsage;
         }
     }
@@ -458,18 +469,31 @@ int runBake(BakeOptions o) {
     settings.progress = [&progress](const char* stage, double fraction) {
         progress.update(stage, fraction);
     };
+    // Proxies, their errors and the node tree for the runtime (docs/design.md §2.6); with a
+    // tile cache, each of their work items is kept there too.
+    ProxySettings proxySettings;
+    proxySettings.simplifyFraction = o.proxyError;
+    proxySettings.threadCount = o.threads;
+    proxySettings.progress = settings.progress;
+    proxySettings.cache = tiling.cache;
     Hierarchy3D hierarchy;
     TiledBakeReport tiled;
     if (!o.tileTask.empty()) {  // one piece: into the cache, no outputs
-        const bool done = buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled);
+        bool done = buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled);
+        std::string shareError;
+        size_t made = 0, loaded = 0;
+        const bool proxies = tiling.task.kind == TileTask::Kind::Assemble;
+        if (done && proxies) done = buildProxyShare(hierarchy, scene.objects, proxySettings, proxyShare, shareError, &made, &loaded);
         progress.finish();
         cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
         if (!done) {
-            printError(o.scene + ": tile task " + o.tileTask + " failed");
+            printError(o.scene + ": tile task " + o.tileTask + " failed" + (shareError.empty() ? "" : ": " + shareError));
             return kBakeFailed;
         }
         if (tiling.task.kind == TileTask::Kind::Plan) {
             std::printf("%s\n", io::tilePlanJson(tiled).c_str());
+        } else if (!o.quiet && proxies) {
+            std::printf("tile task %s: %zu proxy items made, %zu read from the cache\n", o.tileTask.c_str(), made, loaded);
         } else if (!o.quiet) {
             std::printf("tile task %s: %zu pieces baked, %zu read from the cache\n", o.tileTask.c_str(),
                         tiled.graphsBaked + tiled.cellsBaked + tiled.parentsBaked,
@@ -484,11 +508,6 @@ int runBake(BakeOptions o) {
     std::string nodeError;
     bool nodesOk = false;
     if (ok) {
-        // Proxies, their errors and the node tree for the runtime (docs/design.md §2.6).
-        ProxySettings proxySettings;
-        proxySettings.simplifyFraction = o.proxyError;
-        proxySettings.threadCount = o.threads;
-        proxySettings.progress = settings.progress;
         const auto start = std::chrono::steady_clock::now();
         nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
         hierarchy.timings.emplace_back("proxies", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -571,9 +590,11 @@ int runBake(BakeOptions o) {
                     cli::formatNumber(hierarchy.originals.sphericity).c_str());
         std::fputs(cli::formatLevelTable(hierarchy).c_str(), stdout);
         if (tiled.tiled)
-            std::printf("tiles: %zu cells and %zu parent cells baked, %zu and %zu read from %s\n",
+            std::printf("tiles: %zu cells and %zu parent cells baked, %zu and %zu read from %s; proxies: %zu items made, "
+                        "%zu read\n",
                         tiled.cellsBaked, tiled.parentsBaked, tiled.cellsLoaded, tiled.parentsLoaded,
-                        o.tileCache.empty() ? "a cache (none given)" : o.tileCache.c_str());
+                        o.tileCache.empty() ? "a cache (none given)" : o.tileCache.c_str(), nodes.proxyItemsMade,
+                        nodes.proxyItemsLoaded);
         size_t proxyTriangles = 0, exactTriangles = 0;
         for (size_t i = nodes.objectCount; i < nodes.nodes.size(); ++i) {
             proxyTriangles += nodes.nodes[i].indices.size() / 3;

@@ -4,6 +4,7 @@
 
 #include "json.h"
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -30,7 +31,10 @@ TileCache folderTileCache(const std::string& dir) {
         std::error_code ec;
         fs::create_directories(dir, ec);
         const fs::path path = fs::path(dir) / (key + ".piece");
-        const fs::path temporary = fs::path(dir) / (key + ".piece." + std::to_string(getpid()) + ".tmp");
+        // Unique per process and call: threads of one bake may store at once (tile_cache.h).
+        static std::atomic<uint64_t> stores{0};
+        const fs::path temporary =
+            fs::path(dir) / (key + ".piece." + std::to_string(getpid()) + "." + std::to_string(stores++) + ".tmp");
         {
             std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
             if (!out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()))) return false;

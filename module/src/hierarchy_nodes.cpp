@@ -10,6 +10,7 @@
 #include "bounding_polytope.h"
 #include "conservative_simplify.h"
 #include "convex_hull.h"
+#include "hierarchy_serialize.h"
 #include "mesh_optimize.h"
 #include "mesh_preparation.h"
 #include "parallel_for.h"
@@ -22,7 +23,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -640,10 +643,217 @@ std::vector<HierarchyNode> coarserChain(const HierarchyNode& node, const ExactPr
     return chain;
 }
 
-}  // namespace
+/// Whether a work item of the proxies stage is made (when the cache lacks it), only read from
+/// the cache (made by an earlier phase), or left to another share.
+enum class Work : char { Skip, Obtain, LoadOnly };
 
-bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                         const ProxySettings& settings, HierarchyNodes& out, std::string& error) {
+/// One kind of work item of the proxies stage, items [0, count): everything buildHierarchyNodes
+/// needs to read it back, make it, keep it and name it.
+struct WorkItems {
+    std::function<Work(size_t)> work;
+    std::function<std::string(size_t)> key;  ///< the cache key of the item's whole input
+    std::function<bool(size_t, const std::vector<uint8_t>&)> read;
+    std::function<void(size_t)> make;
+    std::function<void(size_t, std::vector<uint8_t>&)> write;
+    std::function<void(size_t, std::vector<char>&)> objects;  ///< marks the objects make(j) measures against
+    std::function<std::string(size_t)> name;
+};
+
+/// Layout of the proxies' cache entries and of their keys: a new layout never reads old ones.
+constexpr char kProxyItemTag[] = "aggrelod proxy item 1";
+
+/// ProxySettings::cache: the keys of the proxies' work items (each a hash of everything the
+/// item's result depends on) and what was made and read.
+class ProxyMemo {
+public:
+    explicit ProxyMemo(const ProxySettings& s)
+        : cache_(s.cache && s.cache->load && s.cache->store ? s.cache : nullptr) {
+        settings_.text(kProxyItemTag);
+        settings_.f64(s.simplifyFraction);
+        settings_.u64(uint64_t(int64_t(s.objectLodCount)));
+        settings_.u64(uint64_t(int64_t(s.coarserCount)));
+        settings_.u64(uint64_t(int64_t(s.polytopeVertices)));
+        settings_.f64(s.toleranceFraction);
+        settings_.u64(s.maxRefinementsPerDirection);
+    }
+    bool on() const { return cache_ != nullptr; }
+    bool load(const std::string& key, std::vector<uint8_t>& bytes) const { return cache_->load(key, bytes); }
+    void store(const std::string& key, const std::vector<uint8_t>& bytes) {
+        if (!cache_->store(key, bytes)) storeFailed = true;
+    }
+    /// What an object contributes to the results: its mesh and colours (not its name or id).
+    std::string objectKey(const InputObject& o) const {
+        detail::ContentHash h;
+        h.values(o.positions);
+        h.values(o.indices);
+        h.values(o.triangleColors);
+        return h.hex();
+    }
+    std::string aggregateKey(const Aggregate& a, const HierarchyNode& n, const std::vector<std::string>& objectKeys) const {
+        detail::ContentHash h = start('a');
+        h.f64(n.delta);
+        h.values(a.positions);
+        h.values(a.indices);
+        h.u64(n.sources.size());
+        for (uint32_t o : n.sources) h.text(objectKeys[o]);
+        return h.hex();
+    }
+    std::string ladderKey(const std::string& objectKey, const SolidReport* standIn) const {
+        detail::ContentHash h = start('l');
+        h.text(objectKey);
+        h.u64(standIn != nullptr);
+        if (standIn) {
+            h.values(standIn->positions);
+            h.values(standIn->triangles);
+            h.u64(standIn->closedManifold);
+            h.f64(standIn->distanceSolidToOriginal);
+            h.f64(standIn->distanceOriginalToSolid);
+        }
+        return h.hex();
+    }
+    /// ladderKeys: "-" for an object without versions made.
+    std::string coarserKey(const std::string& aggregateKey, size_t shells, double ceiling,
+                           const std::vector<uint32_t>& sources, const std::vector<std::string>& ladderKeys) const {
+        detail::ContentHash h = start('c');
+        h.text(aggregateKey);
+        h.u64(shells);
+        h.f64(ceiling);
+        for (uint32_t o : sources) h.text(ladderKeys[o]);
+        return h.hex();
+    }
+    std::atomic<size_t> made{0}, loaded{0};
+    std::atomic<bool> storeFailed{false};
+
+private:
+    detail::ContentHash start(char kind) const {
+        detail::ContentHash h = settings_;
+        h.bytes(&kind, 1);
+        return h;
+    }
+    const TileCache* cache_;
+    detail::ContentHash settings_;
+};
+
+void writeProxyNode(detail::ByteWriter& w, const HierarchyNode& n) {
+    w.array(n.positions);
+    w.array(n.indices);
+    w.array(n.faceColors);
+    w.pod(n.error);
+    w.pod(n.budget);
+}
+void readProxyNode(detail::ByteReader& r, HierarchyNode& n) {
+    r.array(n.positions);
+    r.array(n.indices);
+    r.array(n.faceColors);
+    n.error = r.pod<ProxyError>();
+    n.budget = r.pod<double>();
+}
+/// A read entry is used only when it is whole and its meshes index within themselves.
+bool wellFormed(const detail::ByteReader& r, const HierarchyNode& n) {
+    if (!r.ok() || !r.atEnd() || n.positions.size() % 3 || n.indices.size() % 3) return false;
+    return std::all_of(n.indices.begin(), n.indices.end(), [&](uint32_t i) { return i < n.positions.size() / 3; });
+}
+
+void writeAggregateProxy(const HierarchyNode& n, const ExactProxy& exact, std::vector<uint8_t>& bytes) {
+    detail::ByteWriter w(bytes);
+    w.pod('a');
+    writeProxyNode(w, n);
+    w.array(exact.positions);
+    w.array(exact.indices);
+}
+bool readAggregateProxy(const std::vector<uint8_t>& bytes, HierarchyNode& n, ExactProxy& exact) {
+    detail::ByteReader r(bytes);
+    HierarchyNode read;
+    ExactProxy readExact;
+    if (r.pod<char>() != 'a') return false;
+    readProxyNode(r, read);
+    r.array(readExact.positions);
+    r.array(readExact.indices);
+    if (!wellFormed(r, read) || readExact.positions.size() % 3 ||
+        !std::all_of(readExact.indices.begin(), readExact.indices.end(),
+                     [&](uint32_t i) { return i < readExact.positions.size() / 3; }))
+        return false;
+    n.positions = std::move(read.positions);
+    n.indices = std::move(read.indices);
+    n.faceColors = std::move(read.faceColors);
+    n.error = read.error;
+    n.budget = read.budget;
+    exact = std::move(readExact);
+    return true;
+}
+
+void writeLadder(const VersionLadder& ladder, std::vector<uint8_t>& bytes) {
+    detail::ByteWriter w(bytes);
+    w.pod('l');
+    w.pod(uint64_t(ladder.objectTriangles));
+    w.pod(uint64_t(ladder.versions.size()));
+    for (const Version& v : ladder.versions) {
+        writeProxyNode(w, v.node);
+        w.array(v.exact);
+    }
+}
+bool readLadder(const std::vector<uint8_t>& bytes, VersionLadder& ladder) {
+    detail::ByteReader r(bytes);
+    VersionLadder read;
+    if (r.pod<char>() != 'l') return false;
+    read.objectTriangles = static_cast<size_t>(r.pod<uint64_t>());
+    read.versions.resize(r.count(64));
+    for (Version& v : read.versions) {
+        readProxyNode(r, v.node);
+        r.array(v.exact);
+        if (!r.ok() || v.exact.size() != v.node.positions.size()) return false;
+    }
+    if (!r.ok() || !r.atEnd()) return false;
+    for (const Version& v : read.versions)
+        if (!wellFormed(r, v.node)) return false;
+    ladder = std::move(read);
+    return true;
+}
+
+void writeCoarser(const std::vector<HierarchyNode>& chain, std::vector<uint8_t>& bytes) {
+    detail::ByteWriter w(bytes);
+    w.pod('c');
+    w.pod(uint64_t(chain.size()));
+    for (const HierarchyNode& c : chain) writeProxyNode(w, c);
+}
+bool readCoarser(const std::vector<uint8_t>& bytes, std::vector<HierarchyNode>& chain) {
+    detail::ByteReader r(bytes);
+    std::vector<HierarchyNode> read;
+    if (r.pod<char>() != 'c') return false;
+    read.resize(r.count(64));
+    for (HierarchyNode& c : read) readProxyNode(r, c);
+    if (!r.ok() || !r.atEnd()) return false;
+    for (const HierarchyNode& c : read)
+        if (!wellFormed(r, c)) return false;
+    chain = std::move(read);
+    return true;
+}
+
+/// The share (ProxyShare::part) of each work item of a phase: heaviest expected work first,
+/// each to the share with the least so far (ties: the lower share), so that no share is left
+/// with a heavy item on top of its part. `costs`: estimated work per item (triangles to
+/// measure). Deterministic: every share computes the same assignment.
+std::vector<uint32_t> assignShares(const std::vector<double>& costs, uint32_t parts) {
+    std::vector<uint32_t> order(costs.size());
+    for (uint32_t j = 0; j < order.size(); ++j) order[j] = j;
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return costs[a] > costs[b]; });
+    std::vector<double> load(parts, 0.0);
+    std::vector<uint32_t> shareOf(costs.size(), 0);
+    for (uint32_t j : order) {
+        const uint32_t least = static_cast<uint32_t>(std::min_element(load.begin(), load.end()) - load.begin());
+        shareOf[j] = least;
+        load[least] += costs[j];
+    }
+    return shareOf;
+}
+
+/// Relative work of an object's versions per object triangle against an aggregate's proxy
+/// per triangle measured (a ladder simplifies and certifies at some twenty targets).
+constexpr double kLadderCostPerTriangle = 8.0;
+
+/// buildHierarchyNodes, or one share of its work (buildProxyShare) when `share` is given.
+bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects, const ProxySettings& settings,
+                const ProxyShare* share, HierarchyNodes& out, std::string& error) {
     out = HierarchyNodes{};
     const size_t objectCount = objects.size();
     const size_t levelCount = hierarchy.levels.size();
@@ -771,39 +981,171 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         }
     }
 
-    // Proxies and their errors: independent per aggregate node, each writes its own node.
+    // Proxies and their errors, in work items that each write their own slots: made here,
+    // or read back from the cache (ProxyMemo) where their whole input is unchanged.
+    ProxyMemo memo(settings);
     auto aggregateOf = [&](const HierarchyNode& n) -> const Aggregate& {
         return hierarchy.levels[size_t(n.firstLevel)].aggregates[n.aggregateIndex];
     };
     // One BVH per original object, shared by every node holding it at every level (an
     // object recurs at each level; merging the originals into one BVH per node would
-    // rebuild the coarse nodes' BVHs over nearly every triangle of the scene).
+    // rebuild the coarse nodes' BVHs over nearly every triangle of the scene). Built for the
+    // objects of the items made only.
     std::vector<detail::PreparedOriginal> prepared(objectCount);
-    detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
-        if (levelCount > 0 && groupOf[0][o] != kNoNode) detail::prepareOriginal(objects[o], prepared[o]);
-    });
+    std::vector<char> isPrepared(objectCount, 0);
+    const auto originalsOf = [&](const HierarchyNode& n) {
+        std::vector<const detail::PreparedOriginal*> originals;
+        for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
+        return originals;
+    };
+    const auto objectsOf = [&](const HierarchyNode& n) {
+        std::vector<const InputObject*> sourceObjects;
+        for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
+        return sourceObjects;
+    };
+    std::vector<std::string> objectKeys(memo.on() ? objectCount : 0);
+    detail::parallelFor(objectKeys.size(), settings.threadCount, [&](size_t o) { objectKeys[o] = memo.objectKey(objects[o]); });
+    // Runs the items [0, count) of one kind; false with `missing` naming the first item
+    // that had to be read from the cache and was not there.
+    std::string missing;
+    const auto runItems = [&](size_t count, const WorkItems& items, double progressFrom, double progressTo) {
+        std::vector<char> state(count, 0);  // 0: skipped or read back, 1: to make, 2: missing
+        std::vector<std::string> keys(memo.on() ? count : 0);
+        detail::parallelFor(count, settings.threadCount, [&](size_t j) {
+            const Work w = items.work(j);
+            if (w == Work::Skip) return;
+            if (memo.on()) {
+                keys[j] = items.key(j);
+                std::vector<uint8_t> bytes;
+                if (memo.load(keys[j], bytes) && items.read(j, bytes)) {
+                    ++memo.loaded;
+                    return;
+                }
+            }
+            state[j] = w == Work::Obtain ? 1 : 2;
+        });
+        std::vector<uint32_t> toMake;
+        std::vector<char> needed(objectCount, 0);
+        for (size_t j = 0; j < count; ++j) {
+            if (state[j] == 2) {
+                missing = items.name(j) + " (entry " + keys[j] + ")";
+                return false;
+            }
+            if (state[j] != 1) continue;
+            toMake.push_back(static_cast<uint32_t>(j));
+            items.objects(j, needed);
+        }
+        std::vector<uint32_t> unprepared;
+        for (uint32_t o = 0; o < objectCount; ++o)
+            if (needed[o] && !isPrepared[o]) unprepared.push_back(o);
+        detail::parallelFor(unprepared.size(), settings.threadCount, [&](size_t j) {
+            detail::prepareOriginal(objects[unprepared[j]], prepared[unprepared[j]]);
+            isPrepared[unprepared[j]] = 1;
+        });
+        detail::parallelFor(toMake.size(), settings.threadCount, [&](size_t m) {
+            const uint32_t j = toMake[m];
+            items.make(j);
+            ++memo.made;
+            if (memo.on()) {
+                std::vector<uint8_t> bytes;
+                items.write(j, bytes);
+                memo.store(keys[j], bytes);
+            }
+        }, [&](size_t done) {
+            if (settings.progress)
+                settings.progress("proxies", progressFrom + (progressTo - progressFrom) * double(done) / double(toMake.size()));
+        });
+        return true;
+    };
+    // Which items of a phase are this share's (assignShares); all of them without a share.
+    std::vector<uint32_t> shareOf;
+    const auto mine = [&](size_t j) { return !share || shareOf[j] == share->part ? Work::Obtain : Work::Skip; };
+    const auto sourceTriangles = [&](const HierarchyNode& n) {
+        double t = 0;
+        for (uint32_t o : n.sources) t += double(objects[o].indices.size() / 3);
+        return t;
+    };
+    const auto hasLadder = [&](size_t o) { return nodes[o].parent != kNoNode && !nodes[o].positions.empty(); };
+    const auto finish = [&](bool ok) {
+        if (!ok) error = "the cache holds no result for " + missing + ": run the proxies' phase 1 first";
+        // A share whose results are not kept did nothing; a whole bake just makes them again next time.
+        else if (share && memo.storeFailed) error = "could not store a result in the cache";
+        out.proxyItemsMade = memo.made;
+        out.proxyItemsLoaded = memo.loaded;
+        return ok && !(share && memo.storeFailed);
+    };
+
     // Proxies of the aggregates that hold several objects first: their errors cap the
     // per-object LOD chains below them.
     std::vector<ExactProxy> exactProxies(nodes.size());
-    const auto makeProxies = [&](const std::vector<uint32_t>& which, double progressFrom, double progressTo) {
-        detail::parallelFor(which.size(), settings.threadCount, [&](size_t j) {
+    std::vector<std::string> nodeKeys(memo.on() ? nodes.size() : 0);
+    const auto aggregateItems = [&](const std::vector<uint32_t>& which, const std::function<Work(size_t)>& work) {
+        WorkItems items;
+        items.work = work;
+        items.key = [&, which](size_t j) {
+            const uint32_t i = which[j];
+            nodeKeys[i] = memo.aggregateKey(aggregateOf(nodes[i]), nodes[i], objectKeys);
+            return nodeKeys[i];
+        };
+        items.read = [&, which](size_t j, const std::vector<uint8_t>& bytes) {
+            return readAggregateProxy(bytes, nodes[which[j]], exactProxies[which[j]]);
+        };
+        items.make = [&, which](size_t j) {
             HierarchyNode& n = nodes[which[j]];
-            std::vector<const detail::PreparedOriginal*> originals;
-            for (uint32_t o : n.sources) originals.push_back(&prepared[o]);
-            makeAggregateProxy(aggregateOf(n), originals, settings, n, exactProxies[which[j]]);
-            std::vector<const InputObject*> sourceObjects;
-            for (uint32_t o : n.sources) sourceObjects.push_back(&objects[o]);
-            detail::nearestSurfaceColors(n.positions, n.indices, sourceObjects, n.faceColors);
+            makeAggregateProxy(aggregateOf(n), originalsOf(n), settings, n, exactProxies[which[j]]);
+            detail::nearestSurfaceColors(n.positions, n.indices, objectsOf(n), n.faceColors);
             detail::optimizeVertexCache(n.positions, n.indices, n.faceColors);
-        }, [&](size_t done) {
-            if (settings.progress)
-                settings.progress("proxies", progressFrom + (progressTo - progressFrom) * double(done) / double(which.size()));
-        });
+        };
+        items.write = [&, which](size_t j, std::vector<uint8_t>& bytes) {
+            writeAggregateProxy(nodes[which[j]], exactProxies[which[j]], bytes);
+        };
+        items.objects = [&, which](size_t j, std::vector<char>& needed) {
+            for (uint32_t o : nodes[which[j]].sources) needed[o] = 1;
+        };
+        items.name = [&, which](size_t j) {
+            const HierarchyNode& n = nodes[which[j]];
+            return "the proxy of level " + std::to_string(n.firstLevel) + " aggregate " + std::to_string(n.aggregateIndex);
+        };
+        return items;
     };
     std::vector<uint32_t> groupNodes, singleNodes;
     for (uint32_t i = static_cast<uint32_t>(objectCount); i < nodes.size(); ++i)
         (nodes[i].sources.size() > 1 ? groupNodes : singleNodes).push_back(i);
-    makeProxies(groupNodes, 0.0, 0.5);
+    const bool phaseOne = !share || share->phase == 1;
+    if (share && phaseOne) {  // the groups' proxies, then the objects' versions
+        std::vector<double> costs;
+        for (uint32_t i : groupNodes) costs.push_back(double(nodes[i].exactTriangleCount) + sourceTriangles(nodes[i]));
+        for (size_t o = 0; o < objectCount; ++o)
+            costs.push_back(hasLadder(o) ? kLadderCostPerTriangle * double(objects[o].indices.size() / 3) : 0.0);
+        shareOf = assignShares(costs, share->parts);
+    }
+    if (!runItems(groupNodes.size(), aggregateItems(groupNodes, phaseOne ? std::function<Work(size_t)>(mine) : [](size_t) { return Work::LoadOnly; }),
+                  0.0, 0.5))
+        return finish(false);
+
+    // Every object's versions, up to its diagonal: its chain is cut at its first group's
+    // error, and the groups holding it unite them into coarser versions.
+    // The solid that stands in for an object alone (not for a model of several objects).
+    std::vector<const SolidReport*> standInOf(objectCount, nullptr);
+    for (const SolidReport& r : hierarchy.solids)
+        if (r.objects.size() == 1 && r.objects.front() < objectCount) standInOf[r.objects.front()] = &r;
+    std::vector<VersionLadder> ladders(objectCount);
+    std::vector<std::string> ladderKeys(memo.on() ? objectCount : 0, std::string("-"));
+    {
+        WorkItems items;
+        items.work = [&](size_t o) {
+            if (!hasLadder(o)) return Work::Skip;
+            return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
+        };
+        items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
+        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) { return readLadder(bytes, ladders[o]); };
+        items.make = [&](size_t o) { ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings); };
+        items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
+        items.objects = [](size_t o, std::vector<char>& needed) { needed[o] = 1; };
+        items.name = [&](size_t o) { return "the versions of object '" + objects[o].name + "'"; };
+        if (!runItems(objectCount, items, 0.5, 0.75)) return finish(false);
+    }
+    if (share && share->phase == 1) return finish(true);
 
     // Per-object LOD chains. An object's chain stands in for the aggregates of that object
     // alone (the object with its concavities filled), up to its first aggregate with other
@@ -815,25 +1157,16 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         while (up != kNoNode && nodes[up].sources.size() == 1) up = nodes[up].parent;
         firstGroup[o] = up;
     }
-    // The solid that stands in for an object alone (not for a model of several objects).
-    std::vector<const SolidReport*> standInOf(objectCount, nullptr);
-    for (const SolidReport& r : hierarchy.solids)
-        if (r.objects.size() == 1 && r.objects.front() < objectCount) standInOf[r.objects.front()] = &r;
-    // Every object's versions, up to its diagonal: its chain is cut at its first group's
-    // error, and the groups holding it unite them into coarser versions.
-    std::vector<VersionLadder> ladders(objectCount);
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
-        if (nodes[o].parent == kNoNode || nodes[o].positions.empty()) return;
-        ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+        if (ladders[o].versions.empty()) return;
         const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
         chains[o] = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceiling, settings);
+        if (share) return;  // only whether there is a chain matters to a share
         const detail::SurfaceColorSource colors({&objects[o]});
         for (HierarchyNode& c : chains[o]) {
             colors.colorsOf(c.positions, c.indices, c.faceColors);
             detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
         }
-    }, [&](size_t done) {
-        if (settings.progress) settings.progress("proxies", 0.5 + 0.25 * double(done) / double(objectCount));
     });
     std::vector<char> dropped(nodes.size(), 0);
     std::vector<uint32_t> keptSingles;
@@ -841,39 +1174,79 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
         if (!chains[nodes[i].sources.front()].empty()) dropped[i] = 1;
         else keptSingles.push_back(i);
     }
-    makeProxies(keptSingles, 0.75, 0.85);
-
     // Coarser versions of every aggregate kept, capped by its parent's error. The parent of
     // a kept aggregate is kept: it holds more objects, or the same object, which then has no
     // chain either.
-    std::vector<std::vector<HierarchyNode>> coarser(nodes.size());
     std::vector<uint32_t> keptAggregates;
     for (uint32_t i = static_cast<uint32_t>(objectCount); i < nodes.size(); ++i)
         if (!dropped[i]) keptAggregates.push_back(i);
-    detail::parallelFor(keptAggregates.size(), settings.threadCount, [&](size_t j) {
-        const uint32_t i = keptAggregates[j];
-        const HierarchyNode& n = nodes[i];
-        const double ceiling = n.parent == kNoNode ? INFINITY : nodes[n.parent].error.bound();
-        std::vector<const detail::PreparedOriginal*> originals;
-        std::vector<const InputObject*> sourceObjects;
-        for (uint32_t o : n.sources) {
-            originals.push_back(&prepared[o]);
-            sourceObjects.push_back(&objects[o]);
+    // Phase 2's shares: an aggregate of several objects alone; the kept aggregates of one
+    // object all together (each one's coarser versions are capped by the next one's error).
+    std::vector<uint32_t> shareOfNode(share ? nodes.size() : 0, 0);
+    if (share) {
+        std::vector<double> costs;
+        std::vector<uint32_t> unitOf(keptAggregates.size()), unitOfObject(objectCount, kNoNode);
+        for (size_t j = 0; j < keptAggregates.size(); ++j) {
+            const HierarchyNode& n = nodes[keptAggregates[j]];
+            uint32_t& single = unitOfObject[n.sources.front()];
+            if (n.sources.size() > 1 || single == kNoNode) costs.push_back(0.0);
+            if (n.sources.size() == 1 && single == kNoNode) single = static_cast<uint32_t>(costs.size() - 1);
+            unitOf[j] = n.sources.size() == 1 ? single : static_cast<uint32_t>(costs.size() - 1);
+            costs[unitOf[j]] += double(n.exactTriangleCount) + sourceTriangles(n);
         }
-        std::vector<const VersionLadder*> sourceLadders;
-        for (uint32_t o : n.sources) sourceLadders.push_back(ladders[o].versions.empty() ? nullptr : &ladders[o]);
-        coarser[i] = coarserChain(n, exactProxies[i], aggregateOf(n).componentCount, originals, sourceLadders, ceiling,
-                                  settings);
-        exactProxies[i] = ExactProxy{};
-        const detail::SurfaceColorSource colors(sourceObjects);
-        for (HierarchyNode& c : coarser[i]) {
-            colors.colorsOf(c.positions, c.indices, c.faceColors);
-            detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
+        const std::vector<uint32_t> unitShare = assignShares(costs, share->parts);
+        for (size_t j = 0; j < keptAggregates.size(); ++j) shareOfNode[keptAggregates[j]] = unitShare[unitOf[j]];
+    }
+    const auto mineInPhaseTwo = [&](uint32_t node) {
+        return !share || shareOfNode[node] == share->part ? Work::Obtain : Work::Skip;
+    };
+    if (!runItems(keptSingles.size(), aggregateItems(keptSingles, [&](size_t j) { return mineInPhaseTwo(keptSingles[j]); }),
+                  0.75, 0.85))
+        return finish(false);
+    std::vector<std::vector<HierarchyNode>> coarser(nodes.size());
+    const auto ceilingOf = [&](const HierarchyNode& n) { return n.parent == kNoNode ? INFINITY : nodes[n.parent].error.bound(); };
+    {
+        WorkItems items;
+        items.work = [&](size_t j) { return mineInPhaseTwo(keptAggregates[j]); };
+        items.key = [&](size_t j) {
+            const uint32_t i = keptAggregates[j];
+            return memo.coarserKey(nodeKeys[i], aggregateOf(nodes[i]).componentCount, ceilingOf(nodes[i]), nodes[i].sources,
+                                   ladderKeys);
+        };
+        items.read = [&](size_t j, const std::vector<uint8_t>& bytes) { return readCoarser(bytes, coarser[keptAggregates[j]]); };
+        items.make = [&](size_t j) {
+            const uint32_t i = keptAggregates[j];
+            const HierarchyNode& n = nodes[i];
+            std::vector<const VersionLadder*> sourceLadders;
+            for (uint32_t o : n.sources) sourceLadders.push_back(ladders[o].versions.empty() ? nullptr : &ladders[o]);
+            coarser[i] = coarserChain(n, exactProxies[i], aggregateOf(n).componentCount, originalsOf(n), sourceLadders,
+                                      ceilingOf(n), settings);
+            exactProxies[i] = ExactProxy{};
+            const detail::SurfaceColorSource colors(objectsOf(n));
+            for (HierarchyNode& c : coarser[i]) {
+                colors.colorsOf(c.positions, c.indices, c.faceColors);
+                detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
+            }
+        };
+        items.write = [&](size_t j, std::vector<uint8_t>& bytes) { writeCoarser(coarser[keptAggregates[j]], bytes); };
+        items.objects = [&](size_t j, std::vector<char>& needed) {
+            for (uint32_t o : nodes[keptAggregates[j]].sources) needed[o] = 1;
+        };
+        items.name = [&](size_t j) { return "the coarser versions of node " + std::to_string(keptAggregates[j]); };
+        if (!runItems(keptAggregates.size(), items, 0.85, 1.0)) return finish(false);
+    }
+    exactProxies = {};
+    if (share) return finish(true);
+    for (size_t i = objectCount; i < nodes.size(); ++i) {
+        if (dropped[i]) continue;
+        for (size_t j = 0; j < coarser[i].size(); ++j) {
+            HierarchyNode& c = coarser[i][j];
+            c.coarserStep = static_cast<int>(j) + 1;
+            c.sources = nodes[i].sources;
+            c.delta = nodes[i].delta;
+            c.exactTriangleCount = nodes[i].exactTriangleCount;
         }
-    }, [&](size_t done) {
-        if (settings.progress)
-            settings.progress("proxies", 0.85 + 0.15 * double(done) / double(std::max<size_t>(keptAggregates.size(), 1)));
-    });
+    }
 
     // The tree again: leaves, per-object chains (object by object, finest first), then each
     // aggregate kept followed by its coarser versions (finest first).
@@ -947,7 +1320,33 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
                                                                          : aggregateOf(n).positions;
         computeBounds(n, exact, nodes);
     }
-    return true;
+    return finish(true);
+}
+
+}  // namespace
+
+bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                         const ProxySettings& settings, HierarchyNodes& out, std::string& error) {
+    return buildNodes(hierarchy, objects, settings, nullptr, out, error);
+}
+
+bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                     const ProxySettings& settings, const ProxyShare& share, std::string& error, size_t* made,
+                     size_t* loaded) {
+    if (!(share.phase == 1 || share.phase == 2) || share.parts == 0 || share.part >= share.parts) {
+        error = "proxy share " + std::to_string(share.phase) + ":" + std::to_string(share.part) + ":" +
+                std::to_string(share.parts) + " is out of range (phase 1 or 2, part below parts)";
+        return false;
+    }
+    if (!settings.cache || !settings.cache->load || !settings.cache->store) {
+        error = "a share of the proxies needs a cache to keep its results";
+        return false;
+    }
+    HierarchyNodes nodes;
+    const bool ok = buildNodes(hierarchy, objects, settings, &share, nodes, error);
+    if (made) *made = nodes.proxyItemsMade;
+    if (loaded) *loaded = nodes.proxyItemsLoaded;
+    return ok;
 }
 
 std::vector<HierarchyNode> enclosingVersions(const InputObject& object, const SolidReport* standIn,

@@ -10,83 +10,12 @@ namespace {
 
 constexpr char kMagic[8] = {'A', 'G', 'L', 'O', 'D', 'H', '3', '1'};
 
-class Writer {
-public:
-    explicit Writer(std::vector<uint8_t>& out) : out_(out) {}
-    template <class T>
-    void pod(const T& v) {
-        static_assert(std::is_trivially_copyable_v<T>);
-        const auto* p = reinterpret_cast<const uint8_t*>(&v);
-        out_.insert(out_.end(), p, p + sizeof v);
-    }
-    template <class T>
-    void array(const std::vector<T>& v) {
-        pod(uint64_t(v.size()));
-        const auto* p = reinterpret_cast<const uint8_t*>(v.data());
-        out_.insert(out_.end(), p, p + v.size() * sizeof(T));
-    }
-    void text(const std::string& s) {
-        pod(uint64_t(s.size()));
-        out_.insert(out_.end(), s.begin(), s.end());
-    }
-
-private:
-    std::vector<uint8_t>& out_;
-};
-
-class Reader {
-public:
-    explicit Reader(const std::vector<uint8_t>& in) : in_(in) {}
-    bool ok() const { return ok_; }
-    bool atEnd() const { return at_ == in_.size(); }
-    template <class T>
-    T pod() {
-        T v{};
-        if (!take(sizeof v)) return v;
-        std::memcpy(&v, in_.data() + at_ - sizeof v, sizeof v);
-        return v;
-    }
-    /// A count of items of `itemBytes` each that must fit in the bytes left.
-    size_t count(size_t itemBytes) {
-        const uint64_t n = pod<uint64_t>();
-        if (!ok_ || (itemBytes && n > (in_.size() - at_) / itemBytes)) {
-            ok_ = false;
-            return 0;
-        }
-        return static_cast<size_t>(n);
-    }
-    template <class T>
-    void array(std::vector<T>& v) {
-        const size_t n = count(sizeof(T));
-        v.resize(n);
-        if (n && take(n * sizeof(T))) std::memcpy(v.data(), in_.data() + at_ - n * sizeof(T), n * sizeof(T));
-    }
-    std::string text() {
-        const size_t n = count(1);
-        if (!take(n)) return {};
-        return std::string(reinterpret_cast<const char*>(in_.data() + at_ - n), n);
-    }
-
-private:
-    bool take(size_t n) {
-        if (!ok_ || n > in_.size() - at_) {
-            ok_ = false;
-            return false;
-        }
-        at_ += n;
-        return true;
-    }
-    const std::vector<uint8_t>& in_;
-    size_t at_ = 0;
-    bool ok_ = true;
-};
-
-void write(Writer& w, const SolidMeasures& m) {
+void write(ByteWriter& w, const SolidMeasures& m) {
     w.pod(m.volume);
     w.pod(m.area);
     w.pod(m.sphericity);
 }
-void read(Reader& r, SolidMeasures& m) {
+void read(ByteReader& r, SolidMeasures& m) {
     m.volume = r.pod<double>();
     m.area = r.pod<double>();
     m.sphericity = r.pod<double>();
@@ -95,7 +24,7 @@ void read(Reader& r, SolidMeasures& m) {
 }  // namespace
 
 void serializeHierarchy(const Hierarchy3D& h, std::vector<uint8_t>& bytes) {
-    Writer w(bytes);
+    ByteWriter w(bytes);
     for (char c : kMagic) w.pod(c);
     w.pod(uint64_t(h.levels.size()));
     for (const Level& l : h.levels) {
@@ -154,7 +83,7 @@ void serializeHierarchy(const Hierarchy3D& h, std::vector<uint8_t>& bytes) {
 
 bool deserializeHierarchy(const std::vector<uint8_t>& bytes, Hierarchy3D& h) {
     h = Hierarchy3D{};
-    Reader r(bytes);
+    ByteReader r(bytes);
     for (char c : kMagic)
         if (r.pod<char>() != c) return false;
     // Smallest encoded sizes bound every count: a level is at least 8 + 8 + 3*8 + 3*8 + 1 + 8 bytes.

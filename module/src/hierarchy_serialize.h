@@ -8,10 +8,87 @@
 #include <aggrelod/aggregate3d.h>
 
 #include <cstdint>
+#include <cstring>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace aggrelod::detail {
+
+/// Appends little-endian values and length-prefixed arrays to a byte vector.
+class ByteWriter {
+public:
+    explicit ByteWriter(std::vector<uint8_t>& out) : out_(out) {}
+    template <class T>
+    void pod(const T& v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        out_.insert(out_.end(), p, p + sizeof v);
+    }
+    template <class T>
+    void array(const std::vector<T>& v) {
+        pod(uint64_t(v.size()));
+        const auto* p = reinterpret_cast<const uint8_t*>(v.data());
+        out_.insert(out_.end(), p, p + v.size() * sizeof(T));
+    }
+    void text(const std::string& s) {
+        pod(uint64_t(s.size()));
+        out_.insert(out_.end(), s.begin(), s.end());
+    }
+
+private:
+    std::vector<uint8_t>& out_;
+};
+
+/// Reads what ByteWriter wrote; every count is checked against the bytes left, and after the
+/// first failure every read gives zeros and ok() stays false.
+class ByteReader {
+public:
+    explicit ByteReader(const std::vector<uint8_t>& in) : in_(in) {}
+    bool ok() const { return ok_; }
+    bool atEnd() const { return at_ == in_.size(); }
+    template <class T>
+    T pod() {
+        T v{};
+        if (!take(sizeof v)) return v;
+        std::memcpy(&v, in_.data() + at_ - sizeof v, sizeof v);
+        return v;
+    }
+    /// A count of items of `itemBytes` each that must fit in the bytes left.
+    size_t count(size_t itemBytes) {
+        const uint64_t n = pod<uint64_t>();
+        if (!ok_ || (itemBytes && n > (in_.size() - at_) / itemBytes)) {
+            ok_ = false;
+            return 0;
+        }
+        return static_cast<size_t>(n);
+    }
+    template <class T>
+    void array(std::vector<T>& v) {
+        const size_t n = count(sizeof(T));
+        v.resize(n);
+        if (n && take(n * sizeof(T))) std::memcpy(v.data(), in_.data() + at_ - n * sizeof(T), n * sizeof(T));
+    }
+    std::string text() {
+        const size_t n = count(1);
+        if (!take(n)) return {};
+        return std::string(reinterpret_cast<const char*>(in_.data() + at_ - n), n);
+    }
+
+private:
+    bool take(size_t n) {
+        if (!ok_ || n > in_.size() - at_) {
+            ok_ = false;
+            return false;
+        }
+        at_ += n;
+        return true;
+    }
+    const std::vector<uint8_t>& in_;
+    size_t at_ = 0;
+    bool ok_ = true;
+};
+
 
 /// Appends the whole of `h` (levels, models, merges, solids, diagnostics, timings, counts).
 void serializeHierarchy(const Hierarchy3D& h, std::vector<uint8_t>& bytes);

@@ -131,7 +131,8 @@ void hashSettings(detail::ContentHash& h, const Settings3D& s) {
 bool TiledBaker::needCell(uint32_t cell) const {
     const TileTask& t = options_.task;
     switch (t.kind) {
-    case Kind::Everything: return true;
+    case Kind::Everything:
+    case Kind::Assemble: return true;
     case Kind::Plan: return false;
     case Kind::Graph:
     case Kind::Cell: return cell == t.cell;

@@ -346,6 +346,10 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
         {{"--tile-task", "plan"}, 1, "--tile-task needs --tile-size"},
         {{"--tile-size", "48", "--tile-task", "cell:0"}, 1, "needs --tile-cache"},
         {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "cell:x"}, 1, "expects plan, graph:N"},
+        {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "proxies:3:0:2"}, 1, "PHASE 1 or 2"},
+        {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "proxies:1:2:2"}, 1, "PART below PARTS"},
+        {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "proxies:1:0:2"}, 3,
+         "the tile cache holds no result for"},
         {{"--tile-size", "48", "--delta", "20"}, 3, "needs a delta of at most 6"},
         {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "parent:1:0:0"}, 3,
          "the tile cache holds no result for"},
@@ -370,6 +374,7 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
     const auto second = bake(cached);
     ASSERT_EQ(second.exitCode, 0) << second.describe();
     EXPECT_NE(second.out.find("tiles: 0 cells and 0 parent cells baked"), std::string::npos) << second.out;
+    EXPECT_NE(second.out.find("proxies: 0 items made"), std::string::npos) << second.out;
     EXPECT_EQ(aggrelod::testing::readFile(dir / "out" / "scene.aglod"), aglod) << "a cached rebake gives the same file";
 #ifdef AGGRELOD_CLI_ASAN
     // Damaged cache files through the AddressSanitizer build of the CLI: refused, baked again,
@@ -386,6 +391,7 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
     ASSERT_EQ(sanitized.exitCode, 0) << sanitized.describe();
     EXPECT_EQ(sanitized.err.find("AddressSanitizer"), std::string::npos) << sanitized.describe();
     EXPECT_NE(sanitized.out.find(" and 0 read from"), std::string::npos) << sanitized.out;
+    EXPECT_NE(sanitized.out.find(" items made, 0 read"), std::string::npos) << sanitized.out;
     EXPECT_EQ(aggrelod::testing::readFile(dir / "out" / "scene.aglod"), aglod);
 #endif
 }
@@ -420,4 +426,101 @@ TEST(TiledBake, CacheEntriesRoundTripAndDamagedOnesAreRefused) {
         detail::serializeHierarchy(back, rewritten);
         EXPECT_EQ(rewritten.size(), flipped.size()) << "flipped byte " << at;
     }
+}
+
+namespace {
+
+void expectSameNodes(const HierarchyNodes& a, const HierarchyNodes& b) {
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    EXPECT_EQ(a.roots, b.roots);
+    EXPECT_EQ(a.nodeOfAggregate, b.nodeOfAggregate);
+    for (size_t i = 0; i < a.nodes.size(); ++i) {
+        const HierarchyNode &x = a.nodes[i], &y = b.nodes[i];
+        SCOPED_TRACE("node " + std::to_string(i));
+        EXPECT_EQ(x.parent, y.parent);
+        EXPECT_EQ(x.children, y.children);
+        EXPECT_EQ(x.sources, y.sources);
+        EXPECT_EQ(x.objectLod, y.objectLod);
+        EXPECT_EQ(x.coarserStep, y.coarserStep);
+        EXPECT_EQ(x.positions, y.positions);
+        EXPECT_EQ(x.indices, y.indices);
+        EXPECT_EQ(x.faceColors, y.faceColors);
+        EXPECT_EQ(x.error.bound(), y.error.bound());
+        EXPECT_EQ(x.budget, y.budget);
+        EXPECT_EQ(x.geometricError, y.geometricError);
+        EXPECT_EQ(x.sphereRadius, y.sphereRadius);
+        EXPECT_EQ(x.exactTriangleCount, y.exactTriangleCount);
+        if (::testing::Test::HasFailure()) return;  // one node's differences say enough
+    }
+}
+
+}  // namespace
+
+// The proxies stage with a cache (ProxySettings::cache): the same nodes when shared out in
+// phases and parts (as aggrelod-farm runs it), when read back whole, after a local change
+// (only the items that depend on the moved object are made again) and from damaged entries.
+TEST(ProxyCache, SharesRebakesAndDamagedEntriesGiveTheSameNodes) {
+    std::vector<InputObject> objects = world(200, 3);
+    const Settings3D settings = worldSettings(objects, {1, 4, 12, 24});
+    Hierarchy3D h;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, h)) << errors(h);
+    ProxySettings proxies;
+    proxies.threadCount = 2;
+    HierarchyNodes plain;
+    std::string error;
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, proxies, plain, error)) << error;
+    EXPECT_GT(plain.proxyItemsMade, 0u);
+    EXPECT_EQ(plain.proxyItemsLoaded, 0u) << "no cache, nothing read";
+
+    MemoryCache memory;
+    const TileCache cache = memory.cache();
+    ProxySettings cached = proxies;
+    cached.cache = &cache;
+    // Refused: phase 2 before phase 1 (naming the missing item), no cache, a share out of range.
+    EXPECT_FALSE(buildProxyShare(h, objects, cached, ProxyShare{2, 0, 3}, error));
+    EXPECT_NE(error.find("the cache holds no result for the proxy of level"), std::string::npos) << error;
+    EXPECT_FALSE(buildProxyShare(h, objects, proxies, ProxyShare{1, 0, 1}, error));
+    EXPECT_NE(error.find("needs a cache"), std::string::npos) << error;
+    EXPECT_FALSE(buildProxyShare(h, objects, cached, ProxyShare{1, 3, 3}, error));
+    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+
+    size_t sharedMade = 0;
+    for (int phase : {1, 2})
+        for (uint32_t part = 0; part < 3; ++part) {
+            size_t made = 0, loaded = 0;
+            ASSERT_TRUE(buildProxyShare(h, objects, cached, ProxyShare{phase, part, 3}, error, &made, &loaded)) << error;
+            EXPECT_GT(made, 0u) << "phase " << phase << " part " << part;
+            sharedMade += made;
+        }
+    HierarchyNodes whole;
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, cached, whole, error)) << error;
+    EXPECT_EQ(whole.proxyItemsMade, 0u) << "the shares made every item";
+    EXPECT_GE(sharedMade, whole.proxyItemsLoaded);
+    expectSameNodes(whole, plain);
+
+    // Move one object by 2 cm: only the items whose input changed (the nodes holding it, and
+    // those of the parent cells baked again) are made again.
+    size_t moved = 0;
+    while (std::binary_search(settings.supportObjects.begin(), settings.supportObjects.end(), uint32_t(moved))) ++moved;
+    for (size_t i = 0; i < objects[moved].positions.size(); i += 3) objects[moved].positions[i] += 0.02;
+    Hierarchy3D changed;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, 48.0, changed)) << errors(changed);
+    HierarchyNodes rebaked, fresh;
+    ASSERT_TRUE(buildHierarchyNodes(changed, objects, cached, rebaked, error)) << error;
+    ASSERT_TRUE(buildHierarchyNodes(changed, objects, proxies, fresh, error)) << error;
+    std::printf("moved %s: %zu proxy items made again, %zu read back\n", objects[moved].name.c_str(),
+                rebaked.proxyItemsMade, rebaked.proxyItemsLoaded);
+    EXPECT_GT(rebaked.proxyItemsMade, 0u);
+    EXPECT_LT(rebaked.proxyItemsMade * 4, rebaked.proxyItemsMade + rebaked.proxyItemsLoaded);
+    expectSameNodes(rebaked, fresh);
+
+    // Damaged entries (cut short, a byte flipped) are refused and made again: the same nodes.
+    for (auto& [key, bytes] : memory.entries) {
+        bytes.resize(bytes.size() * 2 / 3);
+        if (!bytes.empty()) bytes[bytes.size() / 2] ^= 0x5a;
+    }
+    HierarchyNodes repaired;
+    ASSERT_TRUE(buildHierarchyNodes(changed, objects, cached, repaired, error)) << error;
+    EXPECT_EQ(repaired.proxyItemsLoaded, 0u);
+    expectSameNodes(repaired, fresh);
 }

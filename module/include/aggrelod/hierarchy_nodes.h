@@ -16,6 +16,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/tile_cache.h>
 
 #include <cstdint>
 #include <string>
@@ -55,6 +56,12 @@ struct ProxySettings {
     size_t maxRefinementsPerDirection = 20000;
     int threadCount = 0;  ///< 0 = hardware concurrency; results identical for every count
     ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
+    /// Optional: keeps every work item of the proxies (an aggregate's proxy, an object's
+    /// versions, an aggregate's coarser versions) under a hash of its whole input and reads it
+    /// back instead of making it again, so a rebake after a local change redoes only the items
+    /// it touched, and separate processes can share the work (buildProxyShare). The nodes are
+    /// bit-identical with or without. Called from several threads at once (tile_cache.h).
+    const TileCache* cache = nullptr;
 };
 
 /// One-sided Hausdorff distances between a proxy and the original objects it stands for:
@@ -121,6 +128,20 @@ struct HierarchyNodes {
     size_t objectCount = 0;
     /// nodeOfAggregate[k][g]: node standing for levels[k].aggregates[g].
     std::vector<std::vector<uint32_t>> nodeOfAggregate;
+    /// Work items of the proxies made in this run and read from ProxySettings::cache.
+    size_t proxyItemsMade = 0, proxyItemsLoaded = 0;
+};
+
+/// One share of buildHierarchyNodes's work, for processes that share ProxySettings::cache
+/// (aggrelod-farm). Phase 1 makes the proxies of the aggregates of several objects and every
+/// object's versions; phase 2, which reads all of phase 1 from the cache, the proxies of the
+/// aggregates of one object that stay and the coarser versions of every aggregate. The items
+/// of a phase are dealt to the `parts` shares by their estimated work, heaviest first, each to
+/// the share with the least so far (one object's aggregates of phase 2 go together).
+struct ProxyShare {
+    int phase = 1;       ///< 1 or 2
+    uint32_t part = 0;   ///< < parts
+    uint32_t parts = 1;  ///< >= 1
 };
 
 /// Builds the node tree of `hierarchy`, baked from `objects` (same array, same order).
@@ -131,6 +152,16 @@ struct HierarchyNodes {
 /// coarser than the previous one). Never throws for such input.
 bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                          const ProxySettings& settings, HierarchyNodes& out, std::string& error);
+
+/// Makes one share of the proxies of `hierarchy` into settings.cache (required) and nothing
+/// else; buildHierarchyNodes with the same cache afterwards makes only what no share made.
+/// `made` and `loaded` (optional) count the share's work items. Returns false with a message
+/// in `error` for what buildHierarchyNodes refuses, a share out of range, no cache, or (phase
+/// 2) a phase-1 item missing from the cache, named. The cache's entries do not depend on how
+/// the work was shared.
+bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
+                     const ProxySettings& settings, const ProxyShare& share, std::string& error,
+                     size_t* made = nullptr, size_t* loaded = nullptr);
 
 /// The aggregate node that coarser version `node` simplifies (the end of its chain of single
 /// children); `node` itself when it is not a coarser version. `node` < nodes.nodes.size().

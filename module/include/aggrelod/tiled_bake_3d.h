@@ -22,6 +22,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/tile_cache.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -54,18 +55,6 @@ struct TiledBakeReport {
     std::vector<std::vector<std::pair<uint32_t, uint32_t>>> parents;
 };
 
-/// Where the tiled bake keeps the results of its pieces (cell graphs, cells, parent cells)
-/// between runs and between processes. A key (32 hex digits) names a piece's whole input: its
-/// objects (names, ids, meshes, colours) and the settings that shape it, so a piece whose
-/// input did not change is read back instead of baked (incremental rebake), and a stale entry
-/// is never used. Both functions may be called from the calling thread only.
-struct TileCache {
-    /// Fills `bytes` with the entry `key`; false when there is none.
-    std::function<bool(const std::string& key, std::vector<uint8_t>& bytes)> load;
-    /// Keeps `bytes` as entry `key`; false when it could not (the bake goes on, with a warning).
-    std::function<bool(const std::string& key, const std::vector<uint8_t>& bytes)> store;
-};
-
 /// One piece of a tiled bake, so that pieces can run in separate processes (aggrelod-farm).
 /// A piece reads what it depends on from the cache and fails, naming it, when it is missing:
 /// graphs (automatic thresholds only) before cells, cells before parents, quadtree level j
@@ -76,7 +65,8 @@ struct TileTask {
         Plan,        ///< nothing baked: TiledBakeReport::cells and ::parents list the pieces
         Graph,       ///< the neighbourhood graph of cell `cell` (automatic thresholds)
         Cell,        ///< the levels of cell `cell`
-        Parent       ///< the levels of parent cell (row, column) of quadtree level `level`
+        Parent,      ///< the levels of parent cell (row, column) of quadtree level `level`
+        Assemble     ///< the whole hierarchy from the cache, baking nothing (fails naming a missing piece)
     } kind = Kind::Everything;
     uint32_t cell = 0;
     int level = 0;
