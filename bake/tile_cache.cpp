@@ -37,7 +37,13 @@ TileCache folderTileCache(const std::string& dir) {
             fs::path(dir) / (key + ".piece." + std::to_string(getpid()) + "." + std::to_string(stores++) + ".tmp");
         {
             std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-            if (!out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()))) return false;
+            out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+            out.close();  // a full disk may show only here: never rename a short file into place
+            if (!out) {
+                std::error_code ignored;
+                fs::remove(temporary, ignored);
+                return false;
+            }
         }
         fs::rename(temporary, path, ec);
         if (!ec) return true;

@@ -660,6 +660,8 @@ struct WorkItems {
 };
 
 /// Layout of the proxies' cache entries and of their keys: a new layout never reads old ones.
+/// Change it too whenever what an item makes changes (any constant or step of this file or
+/// of the simplifier, the error measure or the colours), so that no stale entry is read.
 constexpr char kProxyItemTag[] = "aggrelod proxy item 1";
 
 /// ProxySettings::cache: the keys of the proxies' work items (each a hash of everything the
@@ -751,6 +753,7 @@ void readProxyNode(detail::ByteReader& r, HierarchyNode& n) {
 /// A read entry is used only when it is whole and its meshes index within themselves.
 bool wellFormed(const detail::ByteReader& r, const HierarchyNode& n) {
     if (!r.ok() || !r.atEnd() || n.positions.size() % 3 || n.indices.size() % 3) return false;
+    if (!n.faceColors.empty() && n.faceColors.size() != 4 * (n.indices.size() / 3)) return false;
     return std::all_of(n.indices.begin(), n.indices.end(), [&](uint32_t i) { return i < n.positions.size() / 3; });
 }
 
@@ -769,7 +772,7 @@ bool readAggregateProxy(const std::vector<uint8_t>& bytes, HierarchyNode& n, Exa
     readProxyNode(r, read);
     r.array(readExact.positions);
     r.array(readExact.indices);
-    if (!wellFormed(r, read) || readExact.positions.size() % 3 ||
+    if (!wellFormed(r, read) || readExact.positions.size() % 3 || readExact.indices.size() % 3 ||
         !std::all_of(readExact.indices.begin(), readExact.indices.end(),
                      [&](uint32_t i) { return i < readExact.positions.size() / 3; }))
         return false;

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <set>
 #include <string>
 #include <vector>
@@ -186,18 +187,21 @@ TEST(TiledBake, RefusesBadTileSizesAndThresholdsAboveTheCells) {
 
 namespace {
 
-/// A TileCache in memory, counting what it was asked.
+/// A TileCache in memory; safe to call from several threads (as the proxies stage does).
 struct MemoryCache {
     std::map<std::string, std::vector<uint8_t>> entries;
+    std::mutex mutex;
     TileCache cache() {
         TileCache c;
         c.load = [this](const std::string& key, std::vector<uint8_t>& bytes) {
+            std::lock_guard<std::mutex> lock(mutex);
             auto it = entries.find(key);
             if (it == entries.end()) return false;
             bytes = it->second;
             return true;
         };
         c.store = [this](const std::string& key, const std::vector<uint8_t>& bytes) {
+            std::lock_guard<std::mutex> lock(mutex);
             entries[key] = bytes;
             return true;
         };
@@ -514,7 +518,8 @@ TEST(ProxyCache, SharesRebakesAndDamagedEntriesGiveTheSameNodes) {
     EXPECT_LT(rebaked.proxyItemsMade * 4, rebaked.proxyItemsMade + rebaked.proxyItemsLoaded);
     expectSameNodes(rebaked, fresh);
 
-    // Damaged entries (cut short, a byte flipped) are refused and made again: the same nodes.
+    // Damaged entries (cut short, and a byte flipped) are refused and made again: the same
+    // nodes. (Entries carry no checksum: a flipped coordinate alone would be read back.)
     for (auto& [key, bytes] : memory.entries) {
         bytes.resize(bytes.size() * 2 / 3);
         if (!bytes.empty()) bytes[bytes.size() / 2] ^= 0x5a;
