@@ -6,7 +6,8 @@
                   [--aggrelod PATH] [--tile-size S|auto] [--tile-cache DIR] [any bake option]
 
 The pieces of the tiled bake (`aggrelod bake --tile-task plan` lists them) run as Dask tasks,
-each one `aggrelod bake --tile-task PIECE` process on a worker, in waves: the cells' graphs
+each one `aggrelod bake --tile-task PIECE[,PIECE...]` process on a worker (a batch of a wave's
+pieces, so that the scene is read once per batch), in waves: the cells' graphs
 (automatic thresholds only), the cells, then the parent cells quadtree level by quadtree level,
 then the proxies of the whole hierarchy in two phases of shares, and last the whole bake, which
 finds every piece and every proxy in the cache and writes the outputs. Pieces go
@@ -59,6 +60,15 @@ def piece_commands(plan, proxy_shares):
     return waves
 
 
+def batches(wave, count):
+    """A wave's pieces as at most `count` comma-separated --tile-task lists, dealt in turn: each
+    aggrelod process reads the whole scene once for its batch, not once per piece (proxies
+    shares stay one per process)."""
+    if wave[0].startswith("proxies:") or len(wave) <= count:
+        return wave
+    return [",".join(wave[k::count]) for k in range(count)]
+
+
 def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, threads="0", log=print):
     """The whole farm bake on a connected dask.distributed Client; returns the final bake's output.
     bake_options: further `aggrelod bake` options (not --threads, --tile-*)."""
@@ -73,10 +83,11 @@ def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, thr
     if plan["tiled"]:
         # Shares of the proxies: two per worker thread (each share loads the whole hierarchy;
         # the bake balances their estimated work). The result does not depend on their number.
-        shares = max(1, 2 * sum(client.nthreads().values()))
-        for wave in piece_commands(plan, shares):
+        slots = max(1, sum(client.nthreads().values()))
+        for wave in piece_commands(plan, 2 * slots):
             started = time.monotonic()
-            commands = [base + ["--tile-cache", cache, "--tile-task", task, "--quiet", "--threads", "1"] for task in wave]
+            commands = [base + ["--tile-cache", cache, "--tile-task", task, "--quiet", "--threads", "1"]
+                        for task in batches(wave, 4 * slots)]
             futures = client.map(run_piece, commands, retries=RETRIES, pure=False)
             client.gather(futures)
             log(f"aggrelod-farm: {len(wave)} {wave[0].split(':')[0]} pieces in {time.monotonic() - started:.1f} s")

@@ -408,36 +408,57 @@ int runBake(BakeOptions o) {
         tileCache = io::folderTileCache(o.tileCache);
         tiling.cache = &tileCache;
     }
+    // One piece, or a comma-separated list of graph, cell and parent pieces (one read of the
+    // scene for all of them: aggrelod-farm hands a worker a batch).
+    std::vector<TileTask> tileTasks;
     if (!o.tileTask.empty()) {
-        unsigned long a = 0, b = 0, c = 0;
-        char tail = 0;
-        TileTask& t = tiling.task;
-        if (o.tileTask == "plan") {
-            t.kind = TileTask::Kind::Plan;
-        } else if (std::sscanf(o.tileTask.c_str(), "graph:%lu%c", &a, &tail) == 1 && a <= UINT32_MAX) {
-            t.kind = TileTask::Kind::Graph;
-            t.cell = static_cast<uint32_t>(a);
-        } else if (std::sscanf(o.tileTask.c_str(), "cell:%lu%c", &a, &tail) == 1 && a <= UINT32_MAX) {
-            t.kind = TileTask::Kind::Cell;
-            t.cell = static_cast<uint32_t>(a);
-        } else if (std::sscanf(o.tileTask.c_str(), "parent:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && a >= 1 && a <= 64 &&
-                   b <= UINT32_MAX && c <= UINT32_MAX) {
-            t.kind = TileTask::Kind::Parent;
-            t.level = static_cast<int>(a);
-            t.row = static_cast<uint32_t>(b);
-            t.column = static_cast<uint32_t>(c);
-        } else if (std::sscanf(o.tileTask.c_str(), "proxies:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && (a == 1 || a == 2) &&
-                   c >= 1 && c <= UINT32_MAX && b < c) {
-            t.kind = TileTask::Kind::Assemble;  // the whole hierarchy from the cache, then the share
-            proxyShare.phase = static_cast<int>(a);
-            proxyShare.part = static_cast<uint32_t>(b);
-            proxyShare.parts = static_cast<uint32_t>(c);
-        } else {
+        const auto parseTask = [&](const std::string& text, TileTask& t) {
+            unsigned long a = 0, b = 0, c = 0;
+            char tail = 0;
+            if (text == "plan") {
+                t.kind = TileTask::Kind::Plan;
+            } else if (std::sscanf(text.c_str(), "graph:%lu%c", &a, &tail) == 1 && a <= UINT32_MAX) {
+                t.kind = TileTask::Kind::Graph;
+                t.cell = static_cast<uint32_t>(a);
+            } else if (std::sscanf(text.c_str(), "cell:%lu%c", &a, &tail) == 1 && a <= UINT32_MAX) {
+                t.kind = TileTask::Kind::Cell;
+                t.cell = static_cast<uint32_t>(a);
+            } else if (std::sscanf(text.c_str(), "parent:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && a >= 1 && a <= 64 &&
+                       b <= UINT32_MAX && c <= UINT32_MAX) {
+                t.kind = TileTask::Kind::Parent;
+                t.level = static_cast<int>(a);
+                t.row = static_cast<uint32_t>(b);
+                t.column = static_cast<uint32_t>(c);
+            } else if (std::sscanf(text.c_str(), "proxies:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && (a == 1 || a == 2) &&
+                       c >= 1 && c <= UINT32_MAX && b < c) {
+                t.kind = TileTask::Kind::Assemble;  // the whole hierarchy from the cache, then the share
+                proxyShare.phase = static_cast<int>(a);
+                proxyShare.part = static_cast<uint32_t>(b);
+                proxyShare.parts = static_cast<uint32_t>(c);
+            } else {
+                return false;
+            }
+            return true;
+        };
+        bool valid = true;
+        for (size_t start = 0; valid;) {
+            const size_t comma = o.tileTask.find(',', start);
+            TileTask t;
+            valid = parseTask(o.tileTask.substr(start, comma == std::string::npos ? std::string::npos : comma - start), t);
+            tileTasks.push_back(t);
+            if (comma == std::string::npos) break;
+            start = comma + 1;
+        }
+        if (valid && tileTasks.size() > 1)
+            for (const TileTask& t : tileTasks)
+                valid = valid && (t.kind == TileTask::Kind::Graph || t.kind == TileTask::Kind::Cell || t.kind == TileTask::Kind::Parent);
+        if (!valid || tileTasks.size() > (size_t(1) << 20)) {
             printError("--tile-task " + o.tileTask +
                        ": expects plan, graph:N, cell:N, parent:J:ROW:COLUMN or proxies:PHASE:PART:PARTS "
-                       "(PHASE 1 or 2, PART below PARTS)");
+                       "(PHASE 1 or 2, PART below PARTS), or a comma-separated list of graph, cell and parent pieces");
             return kUsage;
         }
+        tiling.task = tileTasks.front();
     }
     // Bake.
     cli::ProgressLine progress(!o.quiet && cli::stderrIsTerminal());
@@ -478,12 +499,29 @@ int runBake(BakeOptions o) {
     proxySettings.cache = tiling.cache;
     Hierarchy3D hierarchy;
     TiledBakeReport tiled;
-    if (!o.tileTask.empty()) {  // one piece: into the cache, no outputs
-        bool done = buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled);
+    if (!o.tileTask.empty()) {  // pieces: into the cache, no outputs
+        bool done = true;
         std::string shareError;
         size_t made = 0, loaded = 0;
         const bool proxies = tiling.task.kind == TileTask::Kind::Assemble;
-        if (done && proxies) done = buildProxyShare(hierarchy, scene.objects, proxySettings, proxyShare, shareError, &made, &loaded);
+        for (const TileTask& task : tileTasks) {
+            tiling.task = task;
+            Hierarchy3D piece;
+            done = buildTiledHierarchy3D(scene.objects, settings, tiling, piece, &tiled);
+            if (done && proxies) {
+                done = buildProxyShare(piece, scene.objects, proxySettings, proxyShare, shareError, &made, &loaded);
+            } else {
+                made += tiled.graphsBaked + tiled.cellsBaked + tiled.parentsBaked;
+                loaded += tiled.graphsLoaded + tiled.cellsLoaded + tiled.parentsLoaded;
+            }
+            for (Diagnostic& d : piece.diagnostics) {  // once each, however many pieces say it
+                const bool said = std::any_of(hierarchy.diagnostics.begin(), hierarchy.diagnostics.end(), [&](const Diagnostic& e) {
+                    return e.severity == d.severity && e.object == d.object && e.message == d.message;
+                });
+                if (!said) hierarchy.diagnostics.push_back(std::move(d));
+            }
+            if (!done) break;
+        }
         progress.finish();
         cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
         if (!done) {
@@ -492,12 +530,9 @@ int runBake(BakeOptions o) {
         }
         if (tiling.task.kind == TileTask::Kind::Plan) {
             std::printf("%s\n", io::tilePlanJson(tiled).c_str());
-        } else if (!o.quiet && proxies) {
-            std::printf("tile task %s: %zu proxy items made, %zu read from the cache\n", o.tileTask.c_str(), made, loaded);
         } else if (!o.quiet) {
-            std::printf("tile task %s: %zu pieces baked, %zu read from the cache\n", o.tileTask.c_str(),
-                        tiled.graphsBaked + tiled.cellsBaked + tiled.parentsBaked,
-                        tiled.graphsLoaded + tiled.cellsLoaded + tiled.parentsLoaded);
+            std::printf("tile task %s: %zu %s, %zu read from the cache\n", o.tileTask.c_str(), made,
+                        proxies ? "proxy items made" : "pieces baked", loaded);
         }
         std::fflush(stdout);
         return kOk;

@@ -656,6 +656,7 @@ struct WorkItems {
     std::function<void(size_t)> make;
     std::function<void(size_t, std::vector<uint8_t>&)> write;
     std::function<void(size_t, std::vector<char>&)> objects;  ///< marks the objects make(j) measures against
+    std::function<void(const std::vector<uint32_t>&)> beforeMaking;  ///< optional, with the items to make
     std::function<std::string(size_t)> name;
 };
 
@@ -764,7 +765,9 @@ void writeAggregateProxy(const HierarchyNode& n, const ExactProxy& exact, std::v
     w.array(exact.positions);
     w.array(exact.indices);
 }
-bool readAggregateProxy(const std::vector<uint8_t>& bytes, HierarchyNode& n, ExactProxy& exact) {
+/// `exact`: null to read the entry without keeping its exact proxy (only coarser versions made
+/// in this run need it: read again then).
+bool readAggregateProxy(const std::vector<uint8_t>& bytes, HierarchyNode& n, ExactProxy* exact) {
     detail::ByteReader r(bytes);
     HierarchyNode read;
     ExactProxy readExact;
@@ -781,7 +784,7 @@ bool readAggregateProxy(const std::vector<uint8_t>& bytes, HierarchyNode& n, Exa
     n.faceColors = std::move(read.faceColors);
     n.error = read.error;
     n.budget = read.budget;
-    exact = std::move(readExact);
+    if (exact) *exact = std::move(readExact);
     return true;
 }
 
@@ -795,7 +798,8 @@ void writeLadder(const VersionLadder& ladder, std::vector<uint8_t>& bytes) {
         w.array(v.exact);
     }
 }
-bool readLadder(const std::vector<uint8_t>& bytes, VersionLadder& ladder) {
+/// whole: keep the versions' exact vertices too (only unions made in this run need them).
+bool readLadder(const std::vector<uint8_t>& bytes, VersionLadder& ladder, bool whole) {
     detail::ByteReader r(bytes);
     VersionLadder read;
     if (r.pod<char>() != 'l') return false;
@@ -809,6 +813,8 @@ bool readLadder(const std::vector<uint8_t>& bytes, VersionLadder& ladder) {
     if (!r.ok() || !r.atEnd()) return false;
     for (const Version& v : read.versions)
         if (!wellFormed(r, v.node)) return false;
+    if (!whole)
+        for (Version& v : read.versions) std::vector<double>().swap(v.exact);
     ladder = std::move(read);
     return true;
 }
@@ -1045,6 +1051,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             detail::prepareOriginal(objects[unprepared[j]], prepared[unprepared[j]]);
             isPrepared[unprepared[j]] = 1;
         });
+        if (items.beforeMaking) items.beforeMaking(toMake);
         detail::parallelFor(toMake.size(), settings.threadCount, [&](size_t m) {
             const uint32_t j = toMake[m];
             items.make(j);
@@ -1081,6 +1088,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // Proxies of the aggregates that hold several objects first: their errors cap the
     // per-object LOD chains below them.
     std::vector<ExactProxy> exactProxies(nodes.size());
+    std::vector<char> exactHeld(nodes.size(), 0);  // exactProxies[i] is there (made, not read lean)
     std::vector<std::string> nodeKeys(memo.on() ? nodes.size() : 0);
     const auto aggregateItems = [&](const std::vector<uint32_t>& which, const std::function<Work(size_t)>& work) {
         WorkItems items;
@@ -1091,11 +1099,12 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             return nodeKeys[i];
         };
         items.read = [&, which](size_t j, const std::vector<uint8_t>& bytes) {
-            return readAggregateProxy(bytes, nodes[which[j]], exactProxies[which[j]]);
+            return readAggregateProxy(bytes, nodes[which[j]], nullptr);
         };
         items.make = [&, which](size_t j) {
             HierarchyNode& n = nodes[which[j]];
             makeAggregateProxy(aggregateOf(n), originalsOf(n), settings, n, exactProxies[which[j]]);
+            exactHeld[which[j]] = 1;
             detail::nearestSurfaceColors(n.positions, n.indices, objectsOf(n), n.faceColors);
             detail::optimizeVertexCache(n.positions, n.indices, n.faceColors);
         };
@@ -1133,6 +1142,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     for (const SolidReport& r : hierarchy.solids)
         if (r.objects.size() == 1 && r.objects.front() < objectCount) standInOf[r.objects.front()] = &r;
     std::vector<VersionLadder> ladders(objectCount);
+    std::vector<char> ladderWhole(objectCount, 0);  // with the versions' exact vertices (made, not read lean)
     std::vector<std::string> ladderKeys(memo.on() ? objectCount : 0, std::string("-"));
     {
         WorkItems items;
@@ -1141,8 +1151,11 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
         };
         items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
-        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) { return readLadder(bytes, ladders[o]); };
-        items.make = [&](size_t o) { ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings); };
+        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) { return readLadder(bytes, ladders[o], false); };
+        items.make = [&](size_t o) {
+            ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+            ladderWhole[o] = 1;
+        };
         items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
         items.objects = [](size_t o, std::vector<char>& needed) { needed[o] = 1; };
         items.name = [&](size_t o) { return "the versions of object '" + objects[o].name + "'"; };
@@ -1232,6 +1245,31 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             }
         };
         items.write = [&](size_t j, std::vector<uint8_t>& bytes) { writeCoarser(coarser[keptAggregates[j]], bytes); };
+        // What was read without its exact vertices and is needed now: read again whole (or,
+        // should the entry have gone meanwhile, made again: the same result).
+        items.beforeMaking = [&](const std::vector<uint32_t>& toMake) {
+            std::vector<uint32_t> lackingNodes, lackingLadders;
+            std::vector<char> lacking(objectCount, 0);
+            for (uint32_t j : toMake) {
+                const uint32_t i = keptAggregates[j];
+                if (!exactHeld[i]) lackingNodes.push_back(i);
+                for (uint32_t o : nodes[i].sources)
+                    if (!ladderWhole[o] && hasLadder(o) && !lacking[o]) lacking[o] = 1, lackingLadders.push_back(o);
+            }
+            detail::parallelFor(lackingNodes.size(), settings.threadCount, [&](size_t k) {
+                const uint32_t i = lackingNodes[k];
+                HierarchyNode again = nodes[i];
+                std::vector<uint8_t> bytes;
+                if (!(memo.on() && memo.load(nodeKeys[i], bytes) && readAggregateProxy(bytes, again, &exactProxies[i])))
+                    makeAggregateProxy(aggregateOf(nodes[i]), originalsOf(nodes[i]), settings, again, exactProxies[i]);
+            });
+            detail::parallelFor(lackingLadders.size(), settings.threadCount, [&](size_t k) {
+                const uint32_t o = lackingLadders[k];
+                std::vector<uint8_t> bytes;
+                if (!(memo.on() && memo.load(ladderKeys[o], bytes) && readLadder(bytes, ladders[o], true)))
+                    ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+            });
+        };
         items.objects = [&](size_t j, std::vector<char>& needed) {
             for (uint32_t o : nodes[keptAggregates[j]].sources) needed[o] = 1;
         };

@@ -354,6 +354,9 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
         {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "proxies:1:2:2"}, 1, "PART below PARTS"},
         {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "proxies:1:0:2"}, 3,
          "the tile cache holds no result for"},
+        {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "cell:0,proxies:1:0:2"}, 1,
+         "or a comma-separated list of graph, cell and parent pieces"},
+        {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "cell:0,"}, 1, "expects plan"},
         {{"--tile-size", "48", "--delta", "20"}, 3, "needs a delta of at most 6"},
         {{"--tile-size", "48", "--tile-cache", (dir / "c").string(), "--tile-task", "parent:1:0:0"}, 3,
          "the tile cache holds no result for"},
@@ -369,6 +372,29 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
     ASSERT_EQ(plan.exitCode, 0) << plan.describe();
     EXPECT_EQ(plan.out.rfind("{\"tiled\":true,\"graphs\":true,\"cells\":[", 0), 0u) << plan.out;
     EXPECT_NE(plan.out.find("\"parents\":[[1,"), std::string::npos) << plan.out;
+
+    // Every cell in one process (a comma-separated list, as aggrelod-farm batches them): all
+    // baked into the cache, so that the whole bake then bakes no cell.
+    {
+        const std::string cells = plan.out.substr(plan.out.find("\"cells\":[") + 9,
+                                                  plan.out.find(']', plan.out.find("\"cells\":[")) - plan.out.find("\"cells\":[") - 9);
+        std::string list;
+        for (size_t at = 0; at < cells.size();) {
+            const size_t comma = std::min(cells.find(',', at), cells.size());
+            list += (list.empty() ? "cell:" : ",cell:") + cells.substr(at, comma - at);
+            at = comma + 1;
+        }
+        const std::vector<std::string> listed{"--tile-size", "48", "--tile-cache", (dir / "listed").string(), "--delta", "1,4,12"};
+        std::vector<std::string> args = listed;
+        args.insert(args.end(), {"--tile-task", list});
+        const auto batch = bake(args);
+        ASSERT_EQ(batch.exitCode, 0) << batch.describe();
+        const size_t cellCount = std::count(list.begin(), list.end(), ',') + 1;
+        EXPECT_NE(batch.out.find(": " + std::to_string(cellCount) + " pieces baked, 0 read"), std::string::npos) << batch.out;
+        const auto whole = bake(listed);
+        ASSERT_EQ(whole.exitCode, 0) << whole.describe();
+        EXPECT_NE(whole.out.find("tiles: 0 cells and "), std::string::npos) << whole.out;
+    }
 
     const std::vector<std::string> cached{"--tile-size", "48", "--tile-cache", (dir / "cache").string(), "--delta", "1,4,12"};
     const auto first = bake(cached);
