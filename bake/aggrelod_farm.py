@@ -81,10 +81,10 @@ def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, thr
     base = [aggrelod, "bake", scene, "-o", outdir, "--tile-size", tile_size] + bake_options
     plan = json.loads(run_piece(base + ["--tile-task", "plan", "--quiet"]))
     if plan["tiled"]:
-        # Shares of the proxies: two per worker thread (each share loads the whole hierarchy;
+        # Shares of the proxies: one per worker thread (each share reads the whole hierarchy;
         # the bake balances their estimated work). The result does not depend on their number.
         slots = max(1, sum(client.nthreads().values()))
-        for wave in piece_commands(plan, 2 * slots):
+        for wave in piece_commands(plan, slots):
             started = time.monotonic()
             commands = [base + ["--tile-cache", cache, "--tile-task", task, "--quiet", "--threads", "1"]
                         for task in batches(wave, 4 * slots)]
