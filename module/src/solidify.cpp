@@ -6,6 +6,8 @@
 // (they are heavy: keep them here).
 #include "solidify.h"
 
+#include "mesh_distance.h"
+
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
@@ -56,6 +58,146 @@ bool meshToArrays(const Mesh& mesh, std::vector<double>& outPositions, std::vect
     return true;
 }
 
+/// CGAL's triangle-soup oracle with two quick answers in front of its own queries, which
+/// are most of a wrap's time: "does this ball meet the input?" (asked for every gate, almost
+/// always of a ball far from it) and "does this tetrahedron meet the input?" (mostly not).
+/// A query is answered here only when a double-precision test decides it with a margin far
+/// above its rounding error; every other one goes to CGAL's exact one. The answers are
+/// therefore CGAL's, and so is the wrap, bit for bit; only faster.
+template <class Kernel>
+class QuickOracle : public CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<Kernel> {
+    using Base = CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<Kernel>;
+    using Ball = CGAL::Alpha_wraps_3::internal::Ball_3<Kernel>;
+
+public:
+    QuickOracle(double alpha, const std::vector<double>& positions, const std::vector<uint32_t>& triangles)
+        : Base(alpha, Kernel()) {
+        bvh_.build(positions.data(), positions.size() / 3, triangles.data(), triangles.size() / 3);
+        // CGAL splits long input triangles at rounded midpoints: its soup differs from this
+        // one by rounding only. A margin a million times the rounding covers that and the
+        // error of the tests below.
+        double extent = bvh_.maxAbsCoordinate();
+        margin_ = 1e-9 * std::max(extent, 1.0);
+    }
+
+    template <class Query>
+    bool do_intersect(const Query& query) const {
+        return Base::do_intersect(query);
+    }
+
+    bool do_intersect(const Ball& ball) const {
+        const auto& sphere = ball.boundary();
+        const double c[3] = {CGAL::to_double(sphere.center().x()), CGAL::to_double(sphere.center().y()),
+                             CGAL::to_double(sphere.center().z())};
+        const double r = std::sqrt(CGAL::to_double(sphere.squared_radius()));
+        const double m = margin_ + 1e-9 * (r + std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
+        const ClosestPoint nearest = closestPoint(bvh_, c, r + m);
+        if (nearest.triangle == ~0u) return false;  // nothing within r + margin
+        if (nearest.distance < r - m) return true;
+        return Base::do_intersect(ball);
+    }
+
+    template <class K2>
+    bool do_intersect(const CGAL::Alpha_wraps_3::internal::Tetrahedron_with_outside_info<K2>& tet) const {
+        // False when every input triangle near the tetrahedron is apart from the solid
+        // tetrahedron by a separating axis with room to spare (then none meets a face of it or
+        // lies inside it: CGAL's answer is false too); else CGAL's test.
+        double v[4][3];
+        for (int i = 0; i < 4; ++i)
+            for (int k = 0; k < 3; ++k) v[i][k] = CGAL::to_double(tet.m_tet[i][k]);
+        double lo[3], hi[3];
+        double scale = margin_;
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::min(std::min(v[0][k], v[1][k]), std::min(v[2][k], v[3][k]));
+            hi[k] = std::max(std::max(v[0][k], v[1][k]), std::max(v[2][k], v[3][k]));
+            scale = std::max(scale, std::max(std::fabs(lo[k]), std::fabs(hi[k])));
+        }
+        const double m = 1e-9 * std::max(scale, bvh_.maxAbsCoordinate());
+        for (int k = 0; k < 3; ++k) {
+            lo[k] -= m;
+            hi[k] += m;
+        }
+        const std::vector<TriangleBvh::Node>& nodes = bvh_.nodes();
+        if (nodes.empty()) return Base::do_intersect(tet);
+        thread_local std::vector<uint32_t> stack;
+        stack.clear();
+        stack.push_back(0);
+        while (!stack.empty()) {
+            const TriangleBvh::Node& node = nodes[stack.back()];
+            stack.pop_back();
+            bool overlaps = true;
+            for (int k = 0; k < 3; ++k) overlaps = overlaps && node.lo[k] <= hi[k] && node.hi[k] >= lo[k];
+            if (!overlaps) continue;
+            if (node.count == 0) {
+                stack.push_back(node.first);
+                stack.push_back(node.first + 1);
+                continue;
+            }
+            for (uint32_t i = 0; i < node.count; ++i)
+                if (!separated(v, bvh_.slotCorners(node.first + i), m)) return Base::do_intersect(tet);
+        }
+        return false;
+    }
+
+private:
+    /// A separating axis between tetrahedron v and triangle t (9 doubles) with a gap wider
+    /// than `margin` (a length): the face normals of both and the cross products of their
+    /// edges (Gottschalk et al. 1996; Ericson, Real-Time Collision Detection, 5.2.1).
+    static bool separated(const double v[4][3], const double* t, double margin) {
+        auto sub = [](const double* a, const double* b, double* out) {
+            for (int k = 0; k < 3; ++k) out[k] = a[k] - b[k];
+        };
+        auto cross = [](const double* a, const double* b, double* out) {
+            out[0] = a[1] * b[2] - a[2] * b[1];
+            out[1] = a[2] * b[0] - a[0] * b[2];
+            out[2] = a[0] * b[1] - a[1] * b[0];
+        };
+        auto apart = [&](const double* n) {
+            const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (!(length > 0)) return false;
+            double tetLo = INFINITY, tetHi = -INFINITY, triLo = INFINITY, triHi = -INFINITY;
+            for (int i = 0; i < 4; ++i) {
+                const double d = n[0] * v[i][0] + n[1] * v[i][1] + n[2] * v[i][2];
+                tetLo = std::min(tetLo, d);
+                tetHi = std::max(tetHi, d);
+            }
+            for (int i = 0; i < 3; ++i) {
+                const double d = n[0] * t[3 * i] + n[1] * t[3 * i + 1] + n[2] * t[3 * i + 2];
+                triLo = std::min(triLo, d);
+                triHi = std::max(triHi, d);
+            }
+            const double gap = margin * length;
+            return triLo > tetHi + gap || tetLo > triHi + gap;
+        };
+        static const int faces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+        static const int edges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+        double a[3], b[3], n[3];
+        for (const auto& f : faces) {
+            sub(v[f[1]], v[f[0]], a);
+            sub(v[f[2]], v[f[0]], b);
+            cross(a, b, n);
+            if (apart(n)) return true;
+        }
+        double triEdges[3][3];
+        sub(t + 3, t, triEdges[0]);
+        sub(t + 6, t + 3, triEdges[1]);
+        sub(t, t + 6, triEdges[2]);
+        cross(triEdges[0], triEdges[1], n);
+        if (apart(n)) return true;
+        for (const auto& e : edges) {
+            sub(v[e[1]], v[e[0]], a);
+            for (const auto& te : triEdges) {
+                cross(a, te, n);
+                if (apart(n)) return true;
+            }
+        }
+        return false;
+    }
+
+    TriangleBvh bvh_;
+    double margin_ = 0;
+};
+
 }  // namespace
 
 bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double alpha,
@@ -95,7 +237,11 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
     }
     Mesh wrap;
     try {
-        CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
+        // As CGAL::alpha_wrap_3 does it, with the quicker oracle.
+        QuickOracle<Kernel> oracle(alpha, positions, triangles);
+        oracle.add_triangle_soup(points, faces, CGAL::parameters::default_values());
+        CGAL::Alpha_wraps_3::internal::Alpha_wrap_3<QuickOracle<Kernel>> wrapper(oracle);
+        wrapper(alpha, offset, wrap, CGAL::parameters::default_values());
     } catch (const std::exception& e) {
         error = std::string("alpha wrap failed: ") + e.what();
         return false;
