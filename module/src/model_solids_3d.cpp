@@ -11,6 +11,7 @@
 #include <aggrelod/disjoint_sets.h>
 
 #include <array>
+#include <cfloat>
 
 namespace aggrelod::detail {
 
@@ -122,6 +123,25 @@ void Baker3D::measureSolids() {
 // the model's surface when it is one closed, edge-manifold shell that does not cross itself
 // after rounding (the tightest solid: its surface lies on theirs). False leaves m unchanged.
 bool Baker3D::uniteClosedParts(Model& m) const {
+    // The union is one shell only if the parts hang together by surfaces that meet or by one
+    // lying inside another; parts that only come near each other (spheres resting on each
+    // other) give several shells whatever the corefinement does, and it is the costly step:
+    // find that out first.
+    {
+        DisjointSets joined(m.objects.size());
+        size_t pieces = m.objects.size();
+        for (size_t a = 0; a < m.objects.size() && pieces > 1; ++a)
+            for (size_t b = a + 1; b < m.objects.size() && pieces > 1; ++b) {
+                const PreparedObject& pa = prepared_[m.objects[a]];
+                const PreparedObject& pb = prepared_[m.objects[b]];
+                if (!boxesOverlap(pa.bounds, pb.bounds, 0) || joined.find(a) == joined.find(b)) continue;
+                bool together = meshDistance(objectBvh_[m.objects[a]], objectBvh_[m.objects[b]], 0.0, DBL_MIN).intersecting;
+                if (!together) together = windingNumber(pb.positions, pb.triangles, &pa.positions[0]) > 0.5 ||
+                                          windingNumber(pa.positions, pa.triangles, &pb.positions[0]) > 0.5;
+                if (together && joined.unite(a, b)) --pieces;
+            }
+        if (pieces > 1) return false;
+    }
     std::vector<const std::vector<double>*> positions;
     std::vector<const std::vector<uint32_t>*> triangles;
     for (uint32_t o : m.objects) {
