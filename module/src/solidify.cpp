@@ -202,7 +202,7 @@ private:
 
 bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double alpha,
                double offset, std::vector<double>& outPositions, std::vector<uint32_t>& outTriangles,
-               std::string& error) {
+               std::string& error, WrapOracle oracle) {
     using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
     using Point = Kernel::Point_3;
     using Mesh = CGAL::Surface_mesh<Point>;
@@ -237,11 +237,15 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
     }
     Mesh wrap;
     try {
-        // As CGAL::alpha_wrap_3 does it, with the quicker oracle.
-        QuickOracle<Kernel> oracle(alpha, positions, triangles);
-        oracle.add_triangle_soup(points, faces, CGAL::parameters::default_values());
-        CGAL::Alpha_wraps_3::internal::Alpha_wrap_3<QuickOracle<Kernel>> wrapper(oracle);
-        wrapper(alpha, offset, wrap, CGAL::parameters::default_values());
+        if (oracle == WrapOracle::Quick) {
+            // As CGAL::alpha_wrap_3 does it, with the quicker oracle.
+            QuickOracle<Kernel> quick(alpha, positions, triangles);
+            quick.add_triangle_soup(points, faces, CGAL::parameters::default_values());
+            CGAL::Alpha_wraps_3::internal::Alpha_wrap_3<QuickOracle<Kernel>> wrapper(quick);
+            wrapper(alpha, offset, wrap, CGAL::parameters::default_values());
+        } else {
+            CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
+        }
     } catch (const std::exception& e) {
         error = std::string("alpha wrap failed: ") + e.what();
         return false;

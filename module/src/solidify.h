@@ -13,6 +13,11 @@
 
 namespace aggrelod::detail {
 
+/// How the wrap asks whether a ball or a tetrahedron meets the input: CGAL's own exact
+/// queries on its AABB tree, or quick double-precision answers that fall back to those
+/// whenever rounding could matter (the same wrap, bit for bit, in a fraction of the time).
+enum class WrapOracle { Quick, Cgal };
+
 /// Wraps a triangle soup (open, non-manifold, self-intersecting, several pieces: anything)
 /// into a closed, edge-manifold, intersection-free, outward-oriented triangle mesh that
 /// strictly contains it.
@@ -20,10 +25,10 @@ namespace aggrelod::detail {
 /// alpha: the smallest cavity or tunnel the wrap may enter (world units, > 0); offset: how
 /// far the wrap's vertices lie from the input (world units, > 0). Cost grows as either one
 /// shrinks. Output: outPositions 3 * n', outTriangles 3 * m'. Deterministic (same input, same
-/// bytes). Returns false with a reason in `error` (never throws).
+/// bytes, whichever `oracle`). Returns false with a reason in `error` (never throws).
 bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double alpha,
                double offset, std::vector<double>& outPositions, std::vector<uint32_t>& outTriangles,
-               std::string& error);
+               std::string& error, WrapOracle oracle = WrapOracle::Quick);
 
 /// The exact boolean union of closed parts (CGAL corefinement in exact arithmetic, rounded to
 /// doubles at the end): for objects that are valid solids on their own but touch or cross

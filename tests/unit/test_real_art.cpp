@@ -204,6 +204,81 @@ TEST(RealArt, CrossingClosedSolidsBecomeTheirExactUnion) {
     EXPECT_NE(h.objectModel[0], h.objectModel[2]);
 }
 
+// A closed part inside another, its surface a hair's breadth from the outer one's (an engine's
+// sleeve in its housing): the parts neither cross nor meet, yet their union is one shell, the
+// outer part. The check that spares the corefinement where the union cannot be one shell must
+// keep this case. Spheres resting on each other meet nowhere: wrapped.
+TEST(RealArt, NestedClosedPartsStillUniteTouchingSpheresAreWrapped) {
+    std::vector<InputObject> objects = {samples::makeBox("outer", {0, 0, 0}, {2, 2, 2}),
+                                        samples::makeBox("inner", {1e-7, 0.5, 0.5}, {1, 1, 1}),
+                                        samples::makeUvSphere("s1", {6, 1, 1}, 1.0, 24, 12),
+                                        samples::makeUvSphere("s2", {8 + 1e-7, 1, 1}, 1.0, 24, 12)};
+    Settings3D settings;
+    settings.automaticLevelCount = 2;
+    Hierarchy3D h;
+    ASSERT_TRUE(buildHierarchy3D(objects, settings, h));
+    ASSERT_EQ(h.solids.size(), 2u);
+    EXPECT_EQ(h.solids[0].objects, (std::vector<uint32_t>{0, 1}));
+    EXPECT_EQ(h.solids[0].method, SolidifyMethod::Union);
+    EXPECT_NEAR(h.solids[0].volumeSolid, 8.0, 1e-9);
+    EXPECT_EQ(h.solids[1].objects, (std::vector<uint32_t>{2, 3}));
+    EXPECT_EQ(h.solids[1].method, SolidifyMethod::Wrap);
+}
+
+// The wrap's quick oracle answers only what double precision decides with room to spare and
+// leaves the rest to CGAL's exact queries: the wraps are CGAL's own, bit for bit, on open
+// houses, self-crossing ramps and a soup of random triangles.
+TEST(RealArt, QuickWrapOracleGivesCgalsOwnWrap) {
+    std::vector<std::pair<std::string, InputObject>> inputs;
+    const std::string relative = "3d/truck_town/town_model.gltf";
+    if (std::filesystem::exists(sharedData(relative))) {
+        io::SceneReadResult scene;
+        std::string error;
+        ASSERT_TRUE(io::readGltfScene(sharedData(relative).string(), {}, scene, error)) << error;
+        for (const InputObject& o : scene.objects)
+            if (o.name == "House04Mesh" || o.name == "Ramp2Mesh") inputs.emplace_back(o.name, o);
+        ASSERT_EQ(inputs.size(), 2u);
+    }
+    InputObject soup;
+    uint64_t state = 12345;
+    auto next = [&state] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) / double(1ull << 53);
+    };
+    for (uint32_t t = 0; t < 60; ++t) {
+        const double c[3] = {4 * next(), 4 * next(), 4 * next()};
+        for (int k = 0; k < 3; ++k) {
+            for (int d = 0; d < 3; ++d) soup.positions.push_back(c[d] + next() - 0.5);
+            soup.indices.push_back(3 * t + k);
+        }
+    }
+    inputs.emplace_back("random soup", soup);
+    for (const auto& [name, object] : inputs) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t v = 0; v + 2 < object.positions.size(); v += 3)
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::min(lo[k], object.positions[v + k]);
+                hi[k] = std::max(hi[k], object.positions[v + k]);
+            }
+        const double size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        for (double scale : {0.02, 0.05}) {
+            std::vector<double> quickPositions, cgalPositions;
+            std::vector<uint32_t> quickTriangles, cgalTriangles;
+            std::string error;
+            ASSERT_TRUE(detail::alphaWrap(object.positions, object.indices, scale * size, scale * size / 4, quickPositions,
+                                          quickTriangles, error, detail::WrapOracle::Quick))
+                << name << ": " << error;
+            ASSERT_TRUE(detail::alphaWrap(object.positions, object.indices, scale * size, scale * size / 4, cgalPositions,
+                                          cgalTriangles, error, detail::WrapOracle::Cgal))
+                << name << ": " << error;
+            EXPECT_GT(quickTriangles.size(), 100u) << name;
+            EXPECT_TRUE(quickPositions == cgalPositions) << name << " at alpha " << scale;
+            EXPECT_TRUE(quickTriangles == cgalTriangles) << name << " at alpha " << scale;
+        }
+    }
+}
+
 // The exact union comes out in one canonical order, whatever the order of its inputs' vertices
 // and triangles (CGAL's corefinement orders its output by memory addresses, which differ between
 // runs and thread counts): sorted vertices, triangles starting at their smallest index, sorted.
