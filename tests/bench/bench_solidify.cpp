@@ -5,11 +5,14 @@
 // memory during solidification (sampled at every progress report of that stage) against the
 // bake's peak (getrusage; each scene runs in its own process), and per scene the solids' added volume and sampled Hausdorff
 // distance (worst solid, in % of its own bounding-box diagonal). With --solids, one line per
-// solid with its own time. A benchmark: nothing is asserted.
+// solid with its own time, and for each wrap the time of the same wrap (one thread) with the
+// quick oracle the bake uses and with CGAL's own exact queries, and whether both give the same
+// wrap. A benchmark: nothing is asserted.
 //
 // Usage: bench_solidify [--threads 2] [--data DIR] [--solids] [SCENE.glb|gltf ...]
 //   (default scenes: every real scene under DIR/3d)
 #include "scene_io.h"
+#include "solidify.h"
 
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/hierarchy_nodes.h>
@@ -125,9 +128,33 @@ int main(int argc, char** argv) {
                 std::string names;
                 for (uint32_t o : r.objects) names += (names.empty() ? "" : ",") + scene.objects[o].name;
                 if (names.size() > 40) names.resize(40);
-                std::printf("    %-40s %6.2f s  alpha %.4g offset %.4g  %6zu tris  hausdorff %.2f %% diag\n", names.c_str(),
+                std::printf("    %-40s %6.2f s  alpha %.4g offset %.4g  %6zu tris  hausdorff %.2f %% diag", names.c_str(),
                             r.seconds, r.alpha, r.offset, r.triangles.size() / 3,
                             100 * std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid) / r.bboxDiagonal);
+                if (r.method == SolidifyMethod::Wrap) {
+                    // The same wrap of the objects as read, with either oracle.
+                    std::vector<double> positions;
+                    std::vector<uint32_t> triangles;
+                    for (uint32_t o : r.objects) {
+                        const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
+                        positions.insert(positions.end(), scene.objects[o].positions.begin(), scene.objects[o].positions.end());
+                        for (uint32_t i : scene.objects[o].indices) triangles.push_back(base + i);
+                    }
+                    double seconds[2] = {0, 0};
+                    std::vector<double> outPositions[2];
+                    std::vector<uint32_t> outTriangles[2];
+                    for (int k = 0; k < 2; ++k) {
+                        std::string ignored;
+                        const auto begin = std::chrono::steady_clock::now();
+                        detail::alphaWrap(positions, triangles, r.alpha, r.offset, outPositions[k], outTriangles[k], ignored,
+                                          k == 0 ? detail::WrapOracle::Quick : detail::WrapOracle::Cgal);
+                        seconds[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+                    }
+                    const bool same = outPositions[0] == outPositions[1] && outTriangles[0] == outTriangles[1];
+                    std::printf("  wrap %.2f s, with CGAL's queries %.2f s (%.1fx), %s", seconds[0], seconds[1],
+                                seconds[1] / seconds[0], same ? "same wrap" : "DIFFERENT WRAP");
+                }
+                std::printf("\n");
             }
         std::fflush(stdout);
         ::_exit(0);
