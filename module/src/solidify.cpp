@@ -70,9 +70,18 @@ class QuickOracle : public CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<K
     using Ball = CGAL::Alpha_wraps_3::internal::Ball_3<Kernel>;
 
 public:
-    QuickOracle(double alpha, const std::vector<double>& positions, const std::vector<uint32_t>& triangles)
+    /// points: the input's corners; faces: its triangles, as given to add_triangle_soup.
+    QuickOracle(double alpha, const std::vector<double>& positions, const std::vector<typename Kernel::Point_3>& points,
+                const std::vector<std::array<size_t, 3>>& faces)
         : Base(alpha, Kernel()) {
-        bvh_.build(positions.data(), positions.size() / 3, triangles.data(), triangles.size() / 3);
+        // The same triangles as CGAL's soup: it leaves out the exactly degenerate ones.
+        std::vector<uint32_t> kept;
+        kept.reserve(3 * faces.size());
+        const typename Kernel::Collinear_3 collinear = Kernel().collinear_3_object();
+        for (const auto& f : faces)
+            if (!collinear(points[f[0]], points[f[1]], points[f[2]]))
+                for (size_t corner : f) kept.push_back(static_cast<uint32_t>(corner));
+        bvh_.build(positions.data(), positions.size() / 3, kept.data(), kept.size() / 3);
         // CGAL splits long input triangles at rounded midpoints: its soup differs from this
         // one by rounding only. A margin a million times the rounding covers that and the
         // error of the tests below.
@@ -239,7 +248,7 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
     try {
         if (oracle == WrapOracle::Quick) {
             // As CGAL::alpha_wrap_3 does it, with the quicker oracle.
-            QuickOracle<Kernel> quick(alpha, positions, triangles);
+            QuickOracle<Kernel> quick(alpha, positions, points, faces);
             quick.add_triangle_soup(points, faces, CGAL::parameters::default_values());
             CGAL::Alpha_wraps_3::internal::Alpha_wrap_3<QuickOracle<Kernel>> wrapper(quick);
             wrapper(alpha, offset, wrap, CGAL::parameters::default_values());
