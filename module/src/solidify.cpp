@@ -21,6 +21,7 @@
 #include <cmath>
 #include <exception>
 #include <algorithm>
+#include <memory>
 #include <numeric>
 
 namespace aggrelod::detail {
@@ -74,19 +75,52 @@ public:
     QuickOracle(double alpha, const std::vector<double>& positions, const std::vector<typename Kernel::Point_3>& points,
                 const std::vector<std::array<size_t, 3>>& faces)
         : Base(alpha, Kernel()) {
-        // The same triangles as CGAL's soup: it leaves out the exactly degenerate ones.
-        std::vector<uint32_t> kept;
+        // The same triangles as CGAL's soup: it leaves out the exactly degenerate ones (CGAL
+        // tests each original triangle; its splitting only makes tighter boxes).
+        std::vector<uint32_t> kept, forBalls;
         kept.reserve(3 * faces.size());
+        forBalls.reserve(3 * faces.size());
         const typename Kernel::Collinear_3 collinear = Kernel().collinear_3_object();
-        for (const auto& f : faces)
-            if (!collinear(points[f[0]], points[f[1]], points[f[2]]))
-                for (size_t corner : f) kept.push_back(static_cast<uint32_t>(corner));
+        for (const auto& f : faces) {
+            if (collinear(points[f[0]], points[f[1]], points[f[2]])) continue;
+            for (size_t corner : f) kept.push_back(static_cast<uint32_t>(corner));
+            // The point-triangle distance projects along the computed normal, which rounding
+            // can tilt on a sliver (corners collinear but for a few ulps): it could then
+            // overstate the distance. A sliver is given to the ball query as its three edges,
+            // whose distance is exact and overstates the sliver's by at most its width.
+            const double* a = &positions[3 * f[0]];
+            const double* b = &positions[3 * f[1]];
+            const double* c = &positions[3 * f[2]];
+            double ab[3], ac[3], bc[3];
+            for (int k = 0; k < 3; ++k) {
+                ab[k] = b[k] - a[k];
+                ac[k] = c[k] - a[k];
+                bc[k] = c[k] - b[k];
+            }
+            const double n[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
+            const double twiceArea = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            const double lab = std::sqrt(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]);
+            const double lac = std::sqrt(ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]);
+            const double lbc = std::sqrt(bc[0] * bc[0] + bc[1] * bc[1] + bc[2] * bc[2]);
+            if (twiceArea > 1e-4 * lab * lac) {
+                for (size_t corner : f) forBalls.push_back(static_cast<uint32_t>(corner));
+                continue;
+            }
+            const uint32_t i = static_cast<uint32_t>(f[0]), j = static_cast<uint32_t>(f[1]), k = static_cast<uint32_t>(f[2]);
+            forBalls.insert(forBalls.end(), {i, j, i, j, k, j, k, i, k});
+            // Its width: twice the area over its longest side (computed area errs by far less
+            // than the factor two).
+            sliverWidth_ = std::max(sliverWidth_, 2 * twiceArea / std::max(lab, std::max(lac, lbc)) +
+                                                      1e-12 * std::max(lab, std::max(lac, lbc)));
+        }
         bvh_.build(positions.data(), positions.size() / 3, kept.data(), kept.size() / 3);
-        // CGAL splits long input triangles at rounded midpoints: its soup differs from this
-        // one by rounding only. A margin a million times the rounding covers that and the
-        // error of the tests below.
-        double extent = bvh_.maxAbsCoordinate();
-        margin_ = 1e-9 * std::max(extent, 1.0);
+        if (forBalls != kept) {
+            ballBvh_ = std::make_unique<TriangleBvh>();
+            ballBvh_->build(positions.data(), positions.size() / 3, forBalls.data(), forBalls.size() / 3);
+        }
+        // The tests below err by rounding only (a few ulps of the coordinates): a margin of a
+        // billionth of the largest coordinate is far above that.
+        margin_ = 1e-9 * bvh_.maxAbsCoordinate();
     }
 
     template <class Query>
@@ -100,8 +134,10 @@ public:
                              CGAL::to_double(sphere.center().z())};
         const double r = std::sqrt(CGAL::to_double(sphere.squared_radius()));
         const double m = margin_ + 1e-9 * (r + std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
-        const ClosestPoint nearest = closestPoint(bvh_, c, r + m);
-        if (nearest.triangle == ~0u) return false;  // nothing within r + margin
+        // Slivers' edges stand in for them: nothing within r + margin + their width means
+        // nothing within r; an edge point within r - margin is a point of the input.
+        const ClosestPoint nearest = closestPoint(ballBvh_ ? *ballBvh_ : bvh_, c, r + m + sliverWidth_);
+        if (nearest.triangle == ~0u) return false;
         if (nearest.distance < r - m) return true;
         return Base::do_intersect(ball);
     }
@@ -203,7 +239,9 @@ private:
         return false;
     }
 
-    TriangleBvh bvh_;
+    TriangleBvh bvh_;                      ///< the input's triangles (tetrahedron queries)
+    std::unique_ptr<TriangleBvh> ballBvh_;  ///< the same with slivers as their edges, if any
+    double sliverWidth_ = 0;                ///< the widest sliver's width (world units)
     double margin_ = 0;
 };
 

@@ -253,6 +253,17 @@ TEST(RealArt, QuickWrapOracleGivesCgalsOwnWrap) {
         }
     }
     inputs.emplace_back("random soup", soup);
+    // Slivers: triangles whose third corner lies a few ulps off the line of the other two
+    // (CGAL keeps them; the normal of one is mostly rounding), alone and beside a fan.
+    InputObject slivers;
+    for (uint32_t t = 0; t < 40; ++t) {
+        const double x = 3 * next(), y = 3 * next(), z = 3 * next(), dx = next(), dy = next(), dz = next();
+        const double mid[3] = {x + 0.5 * dx, y + 0.5 * dy, std::nextafter(z + 0.5 * dz, 1e9)};
+        const double corners[9] = {x, y, z, x + dx, y + dy, z + dz, mid[0], mid[1], mid[2]};
+        for (int k = 0; k < 9; ++k) slivers.positions.push_back(corners[k]);
+        for (int k = 0; k < 3; ++k) slivers.indices.push_back(3 * t + k);
+    }
+    inputs.emplace_back("slivers", slivers);
     for (const auto& [name, object] : inputs) {
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t v = 0; v + 2 < object.positions.size(); v += 3)
