@@ -151,13 +151,13 @@ public:
         for (int i = 0; i < 4; ++i)
             for (int k = 0; k < 3; ++k) v[i][k] = CGAL::to_double(tet.m_tet[i][k]);
         double lo[3], hi[3];
-        double scale = margin_;
+        double scale = bvh_.maxAbsCoordinate();
         for (int k = 0; k < 3; ++k) {
             lo[k] = std::min(std::min(v[0][k], v[1][k]), std::min(v[2][k], v[3][k]));
             hi[k] = std::max(std::max(v[0][k], v[1][k]), std::max(v[2][k], v[3][k]));
             scale = std::max(scale, std::max(std::fabs(lo[k]), std::fabs(hi[k])));
         }
-        const double m = 1e-9 * std::max(scale, bvh_.maxAbsCoordinate());
+        const double m = 1e-9 * scale;
         for (int k = 0; k < 3; ++k) {
             lo[k] -= m;
             hi[k] += m;
