@@ -7,6 +7,7 @@
 #include "test_support.h"
 
 #include "output_set.h"
+#include "sha256.h"
 
 #include <aggrelod/samples.h>
 
@@ -279,6 +280,35 @@ TEST(OutputSet, ManifestNamesEveryFileOfTheSet) {
     EXPECT_EQ(io::sha256Hex("", 0), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
     const std::string million(1000000, 'a');
     EXPECT_EQ(io::sha256Hex(million.data(), million.size()), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+// The hardware path (x86 SHA extensions, where the processor has them) and the portable one give
+// the same digests, for every length around the block and padding boundaries and whatever
+// pieces the stream comes in.
+TEST(OutputSet, Sha256HardwareAndPortablePathsAgree) {
+    std::printf("SHA extensions on this processor: %s\n", io::Sha256::hardwareAvailable() ? "yes" : "no");
+    std::vector<unsigned char> data(4096 + 200);
+    uint32_t x = 12345;
+    for (unsigned char& b : data) b = static_cast<unsigned char>((x = x * 1664525u + 1013904223u) >> 24);
+    auto digest = [&](io::Sha256::Path path, size_t length, size_t piece) {
+        io::Sha256 h(path);
+        for (size_t at = 0; at < length; at += piece) h.update(data.data() + at, std::min(piece, length - at));
+        return h.hex();
+    };
+    for (size_t length = 0; length <= data.size(); length += length < 300 ? 1 : 97) {
+        const std::string portable = digest(io::Sha256::Path::Portable, length, data.size());
+        EXPECT_EQ(digest(io::Sha256::Path::Fastest, length, data.size()), portable) << length;
+        EXPECT_EQ(digest(io::Sha256::Path::Fastest, length, 1), portable) << length;
+        EXPECT_EQ(digest(io::Sha256::Path::Fastest, length, 63), portable) << length;
+        EXPECT_EQ(digest(io::Sha256::Path::Portable, length, 65), portable) << length;
+    }
+    // A known digest through both paths (FIPS 180-4 example, two blocks).
+    const char* two = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq";
+    for (auto path : {io::Sha256::Path::Fastest, io::Sha256::Path::Portable}) {
+        io::Sha256 h(path);
+        h.update(two, std::strlen(two));
+        EXPECT_EQ(h.hex(), "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+    }
 }
 
 // Fault injection: AGGRELOD_TEST_KILL_AFTER_COMMIT_STEP=K makes the bake kill itself (SIGKILL)
