@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include <memory>
 #include <charconv>
 #include <stdexcept>
+#include <thread>
 #include <type_traits>
 #include <utility>
 
@@ -387,79 +389,52 @@ public:
                 const std::vector<uint32_t>& indicesIn, int material,
                 const std::vector<float>* faceColors = nullptr, bool renderAttributes = true) {
         if (positionsIn.empty() || indicesIn.empty()) return -1;
-        const bool coloured = faceColors && faceColors->size() == 4 * (indicesIn.size() / 3) &&
-                              indicesIn.size() % 3 == 0;
-        // A vertex shared by faces of different colours (exact float values) is split first, one
-        // copy per colour, so that every output vertex carries the exact colour of its faces.
-        std::vector<float> positions;
-        std::vector<uint32_t> indices;
-        if (coloured) {
-            // New vertex per (vertex, colour) pair, numbered in order of first use.
-            std::map<std::pair<uint32_t, std::array<float, 4>>, uint32_t> copies;
-            indices.reserve(indicesIn.size());
-            for (size_t i = 0; i < indicesIn.size(); ++i) {
-                if (indicesIn[i] >= positionsIn.size() / 3) throw std::runtime_error(name + ": index out of range");
-                const float* c = &(*faceColors)[4 * (i / 3)];
-                const std::array<float, 4> colour = {c[0], c[1], c[2], c[3]};
-                const auto key = std::make_pair(indicesIn[i], colour);
-                auto it = copies.find(key);
-                if (it == copies.end()) {
-                    it = copies.emplace(key, uint32_t(positions.size() / 3)).first;
-                    for (int k = 0; k < 3; ++k) positions.push_back(float(positionsIn[3 * size_t(indicesIn[i]) + k]));
+        flushDeferred();
+        return appendMesh(prepareMesh(name, positionsIn, indicesIn, material, faceColors, renderAttributes));
+    }
+
+    /// addMesh, with the mesh's attributes computed later, many meshes at once on the
+    /// builder's threads (setThreads): the same file as addMesh in the same order. Takes the
+    /// positions; `indicesIn` and `faceColors` must stay alive until the next addMesh, flush
+    /// or write. Returns the index the mesh will have, or -1 when there is nothing to draw.
+    int addMeshDeferred(const std::string& name, std::vector<double>&& positionsIn, const std::vector<uint32_t>& indicesIn,
+                        int material, const std::vector<float>* faceColors = nullptr) {
+        if (positionsIn.empty() || indicesIn.empty()) return -1;
+        deferred_.push_back({name, std::move(positionsIn), &indicesIn, material, faceColors});
+        const int index = int(meshes_.size() + deferred_.size()) - 1;
+        // A bounded batch: the prepared meshes of one batch are all that is held at once.
+        if (deferred_.size() >= 64 * threadCount()) flushDeferred();
+        return index;
+    }
+
+    /// Threads for the deferred meshes (0: all cores).
+    void setThreads(int threads) { threads_ = threads; }
+
+    /// Computes and appends the deferred meshes, in the order they were added.
+    void flushDeferred() {
+        if (deferred_.empty()) return;
+        std::vector<PreparedMesh> prepared(deferred_.size());
+        std::vector<std::exception_ptr> failed(deferred_.size());
+        std::atomic<size_t> next{0};
+        auto work = [&] {
+            for (size_t k = next++; k < deferred_.size(); k = next++) {
+                const DeferredMesh& d = deferred_[k];
+                try {
+                    prepared[k] = prepareMesh(d.name, d.positions, *d.indices, d.material, d.faceColors, true);
+                } catch (...) {
+                    failed[k] = std::current_exception();
                 }
-                indices.push_back(it->second);
             }
-        } else {
-            positions.reserve(positionsIn.size());
-            for (double x : positionsIn) positions.push_back(float(x));
-            indices = indicesIn;
+        };
+        std::vector<std::thread> pool;
+        for (size_t t = 1; t < std::min(threadCount(), deferred_.size()); ++t) pool.emplace_back(work);
+        work();
+        for (std::thread& t : pool) t.join();
+        deferred_.clear();
+        for (size_t k = 0; k < prepared.size(); ++k) {
+            if (failed[k]) std::rethrow_exception(failed[k]);
+            appendMesh(std::move(prepared[k]));
         }
-        RenderMesh render;
-        if (renderAttributes) {
-            if (!buildRenderMesh(positions, indices, coloured ? *faceColors : std::vector<float>(), render))
-                throw std::runtime_error(name + ": a triangle index is out of range");
-        } else {
-            render.positions = std::move(positions);
-            render.indices = std::move(indices);
-        }
-        const size_t vertexCount = render.positions.size() / 3;
-        std::vector<float> colours(4 * vertexCount, 1.0f);
-        if (coloured)
-            for (size_t c = 0; c < render.indices.size(); ++c)
-                std::copy_n(&(*faceColors)[4 * (c / 3)], 4, &colours[4 * size_t(render.indices[c])]);
-
-        // min/max (required for POSITION) over the finite values of each component.
-        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-        bool any[3] = {false, false, false};
-        for (size_t v = 0; v < vertexCount; ++v) {
-            for (size_t c = 0; c < 3; ++c) {
-                const float f = render.positions[3 * v + c];
-                if (!std::isfinite(f)) continue;
-                const double x = double(f);
-                if (!any[c] || x < lo[c]) lo[c] = x;
-                if (!any[c] || x > hi[c]) hi[c] = x;
-                any[c] = true;
-            }
-        }
-
-        MeshRecord mesh;
-        mesh.name = name;
-        mesh.material = material;
-        mesh.position = addAccessor(render.positions.data(), render.positions.size() * sizeof(float),
-                                    TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
-                                    vertexCount, lo, hi);
-        if (renderAttributes)
-            mesh.normal = addAccessor(render.normals.data(), render.normals.size() * sizeof(float),
-                                      TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
-                                      vertexCount);
-        if (renderAttributes || coloured)
-            mesh.color = addAccessor(colours.data(), colours.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER,
-                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, vertexCount);
-        mesh.indices = addAccessor(render.indices.data(), render.indices.size() * sizeof(uint32_t),
-                                   TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                   TINYGLTF_TYPE_SCALAR, render.indices.size());
-        meshes_.push_back(std::move(mesh));
-        return int(meshes_.size()) - 1;
     }
 
     /// Adds a mesh of float positions without normals or colours (collision geometry): POSITION
@@ -486,7 +461,7 @@ public:
         return int(meshes_.size()) - 1;
     }
 
-    size_t meshCount() const { return meshes_.size(); }
+    size_t meshCount() const { return meshes_.size() + deferred_.size(); }
 
     int addNode(tinygltf::Node node) {
         model_.nodes.push_back(std::move(node));
@@ -502,6 +477,12 @@ public:
     /// Writes the model with these scenes (name, root nodes); the first is the default scene.
     bool writeScenes(const std::string& path, const std::vector<std::pair<std::string, std::vector<int>>>& scenes,
                      std::string& error) {
+        try {
+            flushDeferred();
+        } catch (const std::exception& e) {
+            error = path + ": " + e.what();
+            return false;
+        }
         for (const auto& [name, roots] : scenes) {
             tinygltf::Scene scene;
             scene.name = name;
@@ -572,6 +553,120 @@ public:
     }
 
 private:
+    /// A mesh's vertices, normals, colours and bounds, ready to be appended.
+    struct PreparedMesh {
+        std::string name;
+        int material = -1;
+        bool renderAttributes = true, coloured = false;
+        RenderMesh render;
+        std::vector<float> colours;
+        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    };
+    struct DeferredMesh {
+        std::string name;
+        std::vector<double> positions;
+        const std::vector<uint32_t>* indices;
+        int material;
+        const std::vector<float>* faceColors;
+    };
+
+    size_t threadCount() const {
+        return threads_ > 0 ? size_t(threads_) : std::max<size_t>(1, std::thread::hardware_concurrency());
+    }
+
+    /// The part of addMesh that depends on the mesh alone (no shared state: any thread).
+    static PreparedMesh prepareMesh(const std::string& name, const std::vector<double>& positionsIn,
+                                    const std::vector<uint32_t>& indicesIn, int material,
+                                    const std::vector<float>* faceColors, bool renderAttributes) {
+        PreparedMesh out;
+        out.name = name;
+        out.material = material;
+        out.renderAttributes = renderAttributes;
+        const bool coloured = faceColors && faceColors->size() == 4 * (indicesIn.size() / 3) &&
+                              indicesIn.size() % 3 == 0;
+        out.coloured = coloured;
+        // A vertex shared by faces of different colours (exact float values) is split first, one
+        // copy per colour, so that every output vertex carries the exact colour of its faces.
+        std::vector<float> positions;
+        std::vector<uint32_t> indices;
+        if (coloured) {
+            // New vertex per (vertex, colour) pair, numbered in order of first use.
+            std::map<std::pair<uint32_t, std::array<float, 4>>, uint32_t> copies;
+            indices.reserve(indicesIn.size());
+            for (size_t i = 0; i < indicesIn.size(); ++i) {
+                if (indicesIn[i] >= positionsIn.size() / 3) throw std::runtime_error(name + ": index out of range");
+                const float* c = &(*faceColors)[4 * (i / 3)];
+                const std::array<float, 4> colour = {c[0], c[1], c[2], c[3]};
+                const auto key = std::make_pair(indicesIn[i], colour);
+                auto it = copies.find(key);
+                if (it == copies.end()) {
+                    it = copies.emplace(key, uint32_t(positions.size() / 3)).first;
+                    for (int k = 0; k < 3; ++k) positions.push_back(float(positionsIn[3 * size_t(indicesIn[i]) + k]));
+                }
+                indices.push_back(it->second);
+            }
+        } else {
+            positions.reserve(positionsIn.size());
+            for (double x : positionsIn) positions.push_back(float(x));
+            indices = indicesIn;
+        }
+        RenderMesh& render = out.render;
+        if (renderAttributes) {
+            if (!buildRenderMesh(positions, indices, coloured ? *faceColors : std::vector<float>(), render))
+                throw std::runtime_error(name + ": a triangle index is out of range");
+        } else {
+            render.positions = std::move(positions);
+            render.indices = std::move(indices);
+        }
+        const size_t vertexCount = render.positions.size() / 3;
+        out.colours.assign(4 * vertexCount, 1.0f);
+        if (coloured)
+            for (size_t c = 0; c < render.indices.size(); ++c)
+                std::copy_n(&(*faceColors)[4 * (c / 3)], 4, &out.colours[4 * size_t(render.indices[c])]);
+
+        // min/max (required for POSITION) over the finite values of each component.
+        bool any[3] = {false, false, false};
+        for (size_t v = 0; v < vertexCount; ++v) {
+            for (size_t c = 0; c < 3; ++c) {
+                const float f = render.positions[3 * v + c];
+                if (!std::isfinite(f)) continue;
+                const double x = double(f);
+                if (!any[c] || x < out.lo[c]) out.lo[c] = x;
+                if (!any[c] || x > out.hi[c]) out.hi[c] = x;
+                any[c] = true;
+            }
+        }
+        return out;
+    }
+
+    /// Appends a prepared mesh's accessors and record; returns its index.
+    int appendMesh(PreparedMesh&& prepared) {
+        const RenderMesh& render = prepared.render;
+        const size_t vertexCount = render.positions.size() / 3;
+        MeshRecord mesh;
+        mesh.name = std::move(prepared.name);
+        mesh.material = prepared.material;
+        mesh.position = addAccessor(render.positions.data(), render.positions.size() * sizeof(float),
+                                    TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                    vertexCount, prepared.lo, prepared.hi);
+        if (prepared.renderAttributes)
+            mesh.normal = addAccessor(render.normals.data(), render.normals.size() * sizeof(float),
+                                      TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                      vertexCount);
+        if (prepared.renderAttributes || prepared.coloured)
+            mesh.color = addAccessor(prepared.colours.data(), prepared.colours.size() * sizeof(float),
+                                     TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4,
+                                     vertexCount);
+        mesh.indices = addAccessor(render.indices.data(), render.indices.size() * sizeof(uint32_t),
+                                   TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                   TINYGLTF_TYPE_SCALAR, render.indices.size());
+        meshes_.push_back(std::move(mesh));
+        return int(meshes_.size()) - 1;
+    }
+
+    std::vector<DeferredMesh> deferred_;
+    int threads_ = 1;
+
     int addView(const void* data, size_t bytes, int target) {
         ViewRecord view;
         view.byteOffset = (binSize_ + 3) / 4 * 4;
@@ -771,13 +866,14 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 }
 
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                    const std::string& path, std::string& error, const HierarchyNodes* nodes) {
+                    const std::string& path, std::string& error, const HierarchyNodes* nodes, int threadCount) {
     if (nodes && (nodes->nodeOfAggregate.size() != hierarchy.levels.size() || nodes->objectCount != objects.size())) {
         error = path + ": the hierarchy nodes do not belong to this hierarchy";
         return false;
     }
     try {
         GlbBuilder glb(path);
+        glb.setThreads(threadCount);
         tinygltf::Model& model = glb.model();
         std::vector<int> roots;
         const size_t levelCount = hierarchy.levels.size();
@@ -829,7 +925,8 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 }
                 tinygltf::Node node;
                 node.name = name;
-                node.mesh = glb.addMesh(name, agg.positions, agg.indices, materialIndex, &agg.faceColors);
+                node.mesh = glb.addMeshDeferred(name, std::vector<double>(agg.positions), agg.indices, materialIndex,
+                                                &agg.faceColors);
                 tinygltf::Value::Object extras;
                 extras["level"] = intValue(k);
                 extras["group"] = intValue(g);
@@ -943,13 +1040,14 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
 }
 
 bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
-                     const std::string& path, std::string& error) {
+                     const std::string& path, std::string& error, int threadCount) {
     if (nodes.objectCount != objects.size() || nodes.nodes.size() < objects.size()) {
         error = path + ": the hierarchy nodes do not belong to these objects";
         return false;
     }
     try {
         GlbBuilder glb(path);
+        glb.setThreads(threadCount);
         tinygltf::Model& model = glb.model();
         int levelCount = 0;
         bool anyColours = false;
@@ -1031,8 +1129,8 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
             const int material = n.leaf || n.objectLod >= 1
                                      ? (n.leaf ? originalMaterial : 0)
                                      : std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0);
-            const std::vector<double> positions(n.positions.begin(), n.positions.end());
-            node.mesh = glb.addMesh(name, positions, n.indices, material, &n.faceColors);
+            node.mesh = glb.addMeshDeferred(name, std::vector<double>(n.positions.begin(), n.positions.end()), n.indices,
+                                            material, &n.faceColors);
             node.extras = tinygltf::Value(extrasOf(i, lod));
             return glb.addNode(std::move(node));
         };

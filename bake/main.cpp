@@ -594,7 +594,7 @@ int runBake(BakeOptions o) {
         !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)) ||
         (o.collision && !set.addFile(collisionPath, collisionTmp, error)))
         return fail(error);
-    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes)) return fail(error);
+    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes, o.threads)) return fail(error);
     // The exact aggregates' meshes are in levels.glb now and nothing after needs them (the
     // statistics keep counts): on a large world they are the largest part of what is held.
     for (Level& level : hierarchy.levels)
@@ -603,9 +603,9 @@ int runBake(BakeOptions o) {
             std::vector<uint32_t>().swap(a.indices);
             std::vector<float>().swap(a.faceColors);
         }
-    if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error)) return fail(error);
+    if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error, o.threads)) return fail(error);
     if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
-                               runtimeTmp.string(), error))
+                               runtimeTmp.string(), error, o.threads))
         return fail(error);
     CollisionSummary collision;
     if (o.collision && !writeCollisionInto(nodes, scene.objects, collisionShapes, runtimeTmp, collisionTmp, collision, error))

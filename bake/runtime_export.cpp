@@ -21,9 +21,9 @@ uint64_t settingsHash(const std::string& text) {
 
 bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                        uint64_t hash, const std::string& toolVersion, const std::string& path,
-                       std::string& error) {
+                       std::string& error, int threadCount) {
     runtime::BuildArrays arrays;
-    if (!exportHierarchy(nodes, objects, hash, toolVersion, arrays, error)) {
+    if (!exportHierarchy(nodes, objects, hash, toolVersion, arrays, error, threadCount)) {
         error = path + ": " + error;
         return false;
     }

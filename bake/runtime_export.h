@@ -15,9 +15,10 @@ namespace aggrelod::io {
 uint64_t settingsHash(const std::string& text);
 
 /// exportHierarchy + runtime::writeRuntimeFile + writing `path` (the caller renames it into
-/// place). Deterministic: the same nodes give the same bytes.
+/// place). Meshes built on up to `threadCount` threads (0: all cores). Deterministic: the
+/// same nodes give the same bytes, for any thread count.
 bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                        uint64_t settingsHash, const std::string& toolVersion, const std::string& path,
-                       std::string& error);
+                       std::string& error, int threadCount = 1);
 
 }  // namespace aggrelod::io

@@ -106,18 +106,20 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 /// proxy_triangles. World units throughout. Aggregates with face colours carry them as
 /// COLOR_0 (linear RGBA) and the level materials are white; without colours each level's
 /// material has its own tint.
+/// Meshes are made on up to `threadCount` threads (0: all cores); the file is the same for any.
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                     const std::string& path, std::string& error,
-                    const HierarchyNodes* nodes = nullptr);
+                    const HierarchyNodes* nodes = nullptr, int threadCount = 1);
 
 /// Writes OUTDIR/proxies.glb: glTF node i = hierarchy node i, nested as the hierarchy (scene
 /// roots = its roots). Aggregate nodes carry their simplified proxy as a mesh (one material
 /// per level; face colours as COLOR_0 as in levels.glb) and extras {node, level, last_level, delta, geometric_error, proxy_error_bound,
 /// exact_triangles, bounding_sphere [x, y, z, r], sources, source_ids}; leaves (the original
 /// objects, named "object_<name>") have no mesh and extras {node, leaf, geometric_error 0,
-/// bounding_sphere, sources, source_ids}. World units.
+/// bounding_sphere, sources, source_ids}. World units. Meshes are made on up to `threadCount`
+/// threads (0: all cores); the file is the same for any.
 bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
-                     const std::string& path, std::string& error);
+                     const std::string& path, std::string& error, int threadCount = 1);
 
 /// A named set of hierarchy nodes that covers every object once (a scene of collision.glb).
 struct CollisionCut {

@@ -6,6 +6,8 @@
 
 #include <aggrelod/disjoint_sets.h>
 
+#include "parallel_for.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -49,18 +51,35 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
     }
 
     // Corners of one vertex are joined across smooth edges shared by exactly two faces.
-    // Edges sorted by (low vertex, high vertex, face): deterministic, no hashing.
+    // Edges sorted by (low vertex, high vertex, face): deterministic, no hashing. A counting
+    // sort by the low vertex (corners in order), then each vertex's few edges by the high one.
     struct EdgeUse {
         uint32_t lo, hi, corner;  // corner = 3 * face + slot of the edge's start
     };
-    std::vector<EdgeUse> edges(cornerCount);
-    for (uint32_t c = 0; c < cornerCount; ++c) {
+    std::vector<uint32_t> start(vertexCount + 1, 0);
+    auto edgeOf = [&](uint32_t c) {
         const uint32_t a = indices[c], b = indices[c - c % 3 + (c + 1) % 3];
-        edges[c] = {std::min(a, b), std::max(a, b), c};
+        return EdgeUse{std::min(a, b), std::max(a, b), c};
+    };
+    for (uint32_t c = 0; c < cornerCount; ++c) ++start[edgeOf(c).lo + 1];
+    for (size_t v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
+    std::vector<EdgeUse> edges(cornerCount);
+    {
+        std::vector<uint32_t> next(start.begin(), start.end() - 1);
+        for (uint32_t c = 0; c < cornerCount; ++c) {
+            const EdgeUse e = edgeOf(c);
+            edges[next[e.lo]++] = e;
+        }
     }
-    std::sort(edges.begin(), edges.end(), [](const EdgeUse& x, const EdgeUse& y) {
-        return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.corner < y.corner;
-    });
+    for (size_t v = 0; v < vertexCount; ++v) {  // stable: equal high vertices keep corner order
+        if (start[v + 1] - start[v] > 32) {  // a fan's hub
+            std::stable_sort(edges.begin() + start[v], edges.begin() + start[v + 1],
+                             [](const EdgeUse& x, const EdgeUse& y) { return x.hi < y.hi; });
+            continue;
+        }
+        for (uint32_t i = start[v] + 1; i < start[v + 1]; ++i)
+            for (uint32_t j = i; j > start[v] && edges[j - 1].hi > edges[j].hi; --j) std::swap(edges[j - 1], edges[j]);
+    }
     const double cosCrease = std::cos(kCreaseAngleDegrees * 3.14159265358979323846 / 180.0);
     DisjointSets group(cornerCount);  // the smallest corner of a group is its root
     for (size_t i = 0; i < edges.size();) {
@@ -123,16 +142,21 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
 
 bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                      uint64_t hash, const std::string& toolVersion, runtime::BuildArrays& params,
-                     std::string& error) {
+                     std::string& error, int threadCount) {
     params = runtime::BuildArrays{};
     params.settingsHash = hash;
     params.toolVersion = toolVersion;
     for (const InputObject& o : objects) params.objectNames.push_back(o.name);
     size_t totalChildren = 0, totalSources = 0, totalPositions = 0, totalIndices = 0;
     std::vector<RenderMesh> meshes(nodes.nodes.size());
+    std::vector<char> built(nodes.nodes.size(), 0);
+    detail::parallelFor(nodes.nodes.size(), threadCount, [&](size_t i) {
+        const HierarchyNode& n = nodes.nodes[i];
+        built[i] = buildRenderMesh(n.positions, n.indices, n.faceColors, meshes[i]);
+    });
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
         const HierarchyNode& n = nodes.nodes[i];
-        if (!buildRenderMesh(n.positions, n.indices, n.faceColors, meshes[i])) {
+        if (!built[i]) {
             error = "node " + std::to_string(i) + ": a triangle index is out of range";
             return false;
         }

@@ -111,6 +111,36 @@ TEST(RuntimeExport, SmoothSurfaceKeepsSharedVerticesWithRadialNormals) {
     }
 }
 
+// A flat disc of 200 triangles around one hub (the hub's many edges take another sorting path):
+// every corner at the hub is one output vertex, every rim vertex too, all facing +z. A second
+// disc with a crease through the hub splits it in two.
+TEST(RuntimeExport, FanHubIsOneVertexUnlessACreaseCrossesIt) {
+    const int segments = 200;
+    for (bool crease : {false, true}) {
+        std::vector<float> p = {0, 0, 0};
+        std::vector<uint32_t> t;
+        for (int i = 0; i < segments; ++i) {
+            const double a = 2 * M_PI * i / segments;
+            // With a crease: the half with y < 0 folded down by 60 degrees about the x axis.
+            const double y = std::sin(a), fold = crease && y < 0 ? M_PI / 3 : 0;
+            p.insert(p.end(), {float(std::cos(a)), float(y * std::cos(fold)), float(y * std::sin(fold))});
+        }
+        for (int i = 0; i < segments; ++i) t.insert(t.end(), {0u, uint32_t(1 + i), uint32_t(1 + (i + 1) % segments)});
+        RenderMesh m;
+        ASSERT_TRUE(buildRenderMesh(p, t, {}, m));
+        expectCornersKeepPositions(p, t, m);
+        std::set<uint32_t> hub;
+        for (size_t c = 0; c < t.size(); c += 3) hub.insert(m.indices[c]);
+        if (!crease) {
+            EXPECT_EQ(hub.size(), 1u);
+            EXPECT_EQ(m.positions.size(), p.size());
+            for (size_t v = 0; v < m.normals.size(); v += 3) EXPECT_NEAR(m.normals[v + 2], 1.0f, 1e-6f);
+        } else {
+            EXPECT_EQ(hub.size(), 2u);  // one copy per side of the crease
+        }
+    }
+}
+
 TEST(RuntimeExport, ColourBoundariesSplitEvenOnAFlatSurfaceAndColoursAreSrgb) {
     // A flat square of two triangles, one red one blue: the diagonal's two vertices split.
     const std::vector<float> p = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
@@ -239,9 +269,9 @@ TEST(RuntimeExport, FileCarriesNormalsColoursAndPerObjectLodLevels) {
     EXPECT_EQ(cut, (std::vector<uint32_t>{plain, 3}));
     runtime::cutAtLevel(file, runtime::kLeafLevel, cut);
     EXPECT_EQ(cut, (std::vector<uint32_t>{red, plain}));
-    // Deterministic.
+    // Deterministic, also with the meshes built on several threads.
     runtime::BuildArrays again;
-    ASSERT_TRUE(exportHierarchy(nodes, objects, 7, "test", again, error));
+    ASSERT_TRUE(exportHierarchy(nodes, objects, 7, "test", again, error, 3));
     std::vector<uint8_t> bytesAgain;
     ASSERT_TRUE(runtime::writeRuntimeFile(again, bytesAgain, error));
     EXPECT_EQ(bytes, bytesAgain);

@@ -47,9 +47,10 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
 /// leaves kLeafLevel, per-object LOD nodes (objectLod >= 1) kObjectLodLevel, coarser versions
 /// kCoarserLevel, aggregates their firstLevel. `objects`: the baked input (names only).
 /// Returns false with a message when a count does not fit 32 bits or an index is out of range.
-/// Deterministic.
+/// The nodes' meshes are built on up to `threadCount` threads (0: all cores). Deterministic:
+/// the same output for any thread count.
 bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                      uint64_t settingsHash, const std::string& toolVersion,
-                     runtime::BuildArrays& out, std::string& error);
+                     runtime::BuildArrays& out, std::string& error, int threadCount = 1);
 
 }  // namespace aggrelod
