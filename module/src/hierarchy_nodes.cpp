@@ -221,6 +221,11 @@ public:
             for (int k = 0; k < 3; ++k)
                 c[k] = (hullPositions[3 * hullIndices[t] + k] + hullPositions[3 * hullIndices[t + 1] + k] +
                         hullPositions[3 * hullIndices[t + 2] + k]) / 3.0;
+            // A centroid with an original within the largest distance so far cannot raise it.
+            if (t > 0 && std::any_of(originals.begin(), originals.end(), [&](const detail::PreparedOriginal* o) {
+                    return detail::anyWithin(o->bvh, c, hullReach_);
+                }))
+                continue;
             double nearest = INFINITY;
             for (const detail::PreparedOriginal* o : originals)
                 nearest = std::min(nearest, detail::closestPoint(o->bvh, c, nearest).distance);

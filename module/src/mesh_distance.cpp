@@ -798,4 +798,38 @@ ClosestPoint closestPoint(const TriangleBvh& bvh, const double p[3], double maxD
     return result;
 }
 
+bool anyWithin(const TriangleBvh& bvh, const double p[3], double distance) {
+    if (bvh.triangleCount() == 0 || !(distance >= 0)) return false;
+    const std::vector<TriangleBvh::Node>& nodes = bvh.nodes();
+    const double pAbs = std::max(std::fabs(p[0]), std::max(std::fabs(p[1]), std::fabs(p[2])));
+    // The same conservative pruning as closestPoint: no triangle it would find is skipped.
+    const double bound2 = pruneBound2(distance, 64 * DBL_EPSILON * std::max(bvh.maxAbsCoordinate(), pAbs));
+    const Vec3 P = load(p);
+    static thread_local std::vector<uint32_t> stack;
+    stack.clear();
+    if (pointBoxDist2(p, nodes[0].lo, nodes[0].hi) <= bound2) stack.push_back(0);
+    while (!stack.empty()) {
+        const TriangleBvh::Node& N = nodes[stack.back()];
+        stack.pop_back();
+        if (N.count) {
+            for (uint32_t i = 0; i < N.count; ++i) {
+                const double* c = bvh.slotCorners(N.first + i);
+                double lo[3], hi[3];
+                triangleBox(c, lo, hi);
+                if (pointBoxDist2(p, lo, hi) > bound2) continue;
+                Vec3 A = load(c), B = load(c + 3), C = load(c + 6), q;
+                if (std::sqrt(pointTriangle2(P, A, B, C, cross(B - A, C - A), q)) <= distance) return true;
+            }
+            continue;
+        }
+        // Nearer child on top: a yes is found sooner.
+        const double d0 = pointBoxDist2(p, nodes[N.first].lo, nodes[N.first].hi);
+        const double d1 = pointBoxDist2(p, nodes[N.first + 1].lo, nodes[N.first + 1].hi);
+        const uint32_t nearer = d0 <= d1 ? N.first : N.first + 1, farther = nearer == N.first ? N.first + 1 : N.first;
+        if (std::max(d0, d1) <= bound2) stack.push_back(farther);
+        if (std::min(d0, d1) <= bound2) stack.push_back(nearer);
+    }
+    return false;
+}
+
 }  // namespace aggrelod::detail

@@ -103,6 +103,12 @@ struct ClosestPoint {
 ClosestPoint closestPoint(const TriangleBvh& bvh, const double p[3],
                           double maxDistance = std::numeric_limits<double>::infinity());
 
+/// Whether some triangle of the mesh lies within `distance` of p (3 doubles), distances
+/// computed exactly as closestPoint computes them: true exactly when
+/// closestPoint(bvh, p).distance <= distance. Stops at the first such triangle, so it is much
+/// quicker than closestPoint when the answer is yes.
+bool anyWithin(const TriangleBvh& bvh, const double p[3], double distance);
+
 // ---- Low-level primitives, exposed for tests. Output pointers may be null. ----
 
 /// Distance between triangles (a0,a1,a2) and (b0,b1,b2); outA/outB get the closest points

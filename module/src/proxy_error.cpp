@@ -531,7 +531,11 @@ struct OriginalsTarget {
         const size_t i = size_t(mesh - meshes.data());
         if (i >= objects.size() || !objects[i]->convexSolid) return INFINITY;
         double worst = 0;
-        for (int v = 0; v < n; ++v) worst = std::max(worst, detail::closestPoint(objects[i]->bvh, corners + 3 * v).distance);
+        for (int v = 0; v < n; ++v) {
+            // A corner with the surface within the largest distance so far cannot raise it.
+            if (v > 0 && detail::anyWithin(objects[i]->bvh, corners + 3 * v, worst)) continue;
+            worst = std::max(worst, detail::closestPoint(objects[i]->bvh, corners + 3 * v).distance);
+        }
         return worst + 2 * objects[i]->convexSlack;
     }
 };
@@ -1105,6 +1109,8 @@ ProxyError measureProxyErrorPrepared(const std::vector<float>& proxyPositions,
         double worst = 0;
         for (size_t v = 0; v + 2 < proxyPositions.size(); v += 3) {
             const double q[3] = {proxyPositions[v], proxyPositions[v + 1], proxyPositions[v + 2]};
+            // A corner with K within the largest distance so far cannot raise it.
+            if (v > 0 && anyWithin(originals[0]->bvh, q, worst)) continue;
             worst = std::max(worst, closestPoint(originals[0]->bvh, q).distance);
         }
         // A solid convex up to convexSlack lies within about that of a convex one: twice that margin.

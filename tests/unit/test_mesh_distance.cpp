@@ -525,6 +525,7 @@ TEST(MeshDistance, MaxDistanceAndStopBelow) {
     empty.build(nullptr, 0, nullptr, 0);
     EXPECT_EQ(meshDistance(empty, bb).distance, kInf);
     EXPECT_EQ(closestPoint(empty, pa).triangle, ~0u);
+    EXPECT_FALSE(anyWithin(empty, pa, kInf));
     double lo[3], hi[3];
     empty.bounds(lo, hi);
     EXPECT_EQ(lo[0], kInf);
@@ -641,6 +642,12 @@ TEST(MeshDistance, RandomMeshesMatchBruteForce) {
             ClosestPoint cm = closestPoint(ba, p, bp.distance * 0.999);
             if (bp.distance > 0) {
                 EXPECT_EQ(cm.triangle, ~0u);
+            }
+            // Yes exactly at the closest distance and above it, no just below it.
+            EXPECT_TRUE(anyWithin(ba, p, bp.distance)) << seed;
+            EXPECT_TRUE(anyWithin(ba, p, bp.distance * 1.5 + 1e-3)) << seed;
+            if (bp.distance > 0) {
+                EXPECT_FALSE(anyWithin(ba, p, std::nextafter(bp.distance, 0.0))) << seed;
             }
         }
     }
