@@ -112,9 +112,9 @@ void Baker3D::measureSolids() {
         if (models_[m].standIn() && !models_[m].objects.empty()) which.push_back(m);
     if (which.empty()) return;
     timer_.begin("solid measures");
-    // Fewer solids than threads (an engine wrapped whole): each measure uses them all.
+    // Fewer solids than threads (an engine wrapped whole): each measure uses its share of them.
     const int threads = settings_.threadCount > 0 ? settings_.threadCount : int(std::max(1u, std::thread::hardware_concurrency()));
-    const int inner = which.size() < size_t(threads) ? threads : 1;
+    const int inner = std::max(1, threads / int(which.size()));
     const auto sampled = [inner](const std::vector<double>& p, const std::vector<uint32_t>& t, const TriangleBvh& target) {
         return sampledDistance(p, t, target, inner);
     };
