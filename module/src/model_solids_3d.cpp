@@ -54,22 +54,26 @@ double windingNumber(const std::vector<double>& p, const std::vector<uint32_t>& 
     return total / (4.0 * M_PI);
 }
 
-// Largest distance from the vertices and triangle centroids of (p, t) to the surface in
-// `target`: a sampled one-sided Hausdorff distance, not certified (a point between samples
-// may lie a little farther). A sample with some triangle within the largest distance so far
-// cannot raise it and is skipped by a quick yes-or-no query (the result is the same as
-// measuring every sample); on `threads` threads in blocks, each with its own largest so far.
+// Sample i of a surface (p, t) for the sampled distances: its vertices, then its triangles'
+// centroids (c: 3 doubles).
+void surfaceSample(const std::vector<double>& p, const std::vector<uint32_t>& t, size_t i, double* c) {
+    const size_t vertices = p.size() / 3;
+    if (i < vertices) {
+        for (int k = 0; k < 3; ++k) c[k] = p[3 * i + k];
+        return;
+    }
+    const uint32_t* f = &t[3 * (i - vertices)];
+    for (int k = 0; k < 3; ++k) c[k] = (p[3 * f[0] + k] + p[3 * f[1] + k] + p[3 * f[2] + k]) / 3.0;
+}
+
+// Largest distance from the samples of (p, t) to the surface in `target`: a sampled
+// one-sided Hausdorff distance, not certified (a point between samples may lie a little
+// farther). A sample with some triangle within the largest distance so far cannot raise it
+// and is skipped by a quick yes-or-no query (the result is the same as measuring every
+// sample); on `threads` threads in blocks, each with its own largest so far.
 double sampledDistance(const std::vector<double>& p, const std::vector<uint32_t>& t, const TriangleBvh& target,
                        int threads = 1) {
-    const size_t vertices = p.size() / 3, samples = vertices + t.size() / 3;
-    auto sample = [&](size_t i, double* c) {
-        if (i < vertices) {
-            for (int k = 0; k < 3; ++k) c[k] = p[3 * i + k];
-            return;
-        }
-        const uint32_t* f = &t[3 * (i - vertices)];
-        for (int k = 0; k < 3; ++k) c[k] = (p[3 * f[0] + k] + p[3 * f[1] + k] + p[3 * f[2] + k]) / 3.0;
-    };
+    const size_t samples = p.size() / 3 + t.size() / 3;
     const size_t blocks = threads > 1 ? std::min<size_t>(4 * size_t(threads), samples / 256 + 1) : 1;
     std::vector<double> worst(blocks, 0.0);
     parallelFor(blocks, threads, [&](size_t b) {
@@ -77,24 +81,22 @@ double sampledDistance(const std::vector<double>& p, const std::vector<uint32_t>
         bool any = false;
         for (size_t i = samples * b / blocks; i < samples * (b + 1) / blocks; ++i) {
             double c[3];
-            sample(i, c);
+            surfaceSample(p, t, i, c);
             if (any && anyWithin(target, c, largest)) continue;
             largest = std::max(largest, closestPoint(target, c).distance);
             any = true;
         }
         worst[b] = largest;
     });
-    return worst.empty() ? 0.0 : *std::max_element(worst.begin(), worst.end());
+    return *std::max_element(worst.begin(), worst.end());
 }
 
 // Whether sampledDistance(p, t, target) <= tolerance, stopping at the first sample farther.
 bool sampledWithin(const std::vector<double>& p, const std::vector<uint32_t>& t, const TriangleBvh& target,
                    double tolerance) {
-    for (size_t v = 0; v + 2 < p.size(); v += 3)
-        if (!anyWithin(target, &p[v], tolerance)) return false;
-    for (size_t i = 0; i + 2 < t.size(); i += 3) {
+    for (size_t i = 0; i < p.size() / 3 + t.size() / 3; ++i) {
         double c[3];
-        for (int k = 0; k < 3; ++k) c[k] = (p[3 * t[i] + k] + p[3 * t[i + 1] + k] + p[3 * t[i + 2] + k]) / 3.0;
+        surfaceSample(p, t, i, c);
         if (!anyWithin(target, c, tolerance)) return false;
     }
     return true;
