@@ -7,7 +7,7 @@
 
 The pieces of the tiled bake (`aggrelod bake --tile-task plan` lists them) run as Dask tasks,
 each one `aggrelod bake --tile-task PIECE[,PIECE...]` process on a worker (a batch of a wave's
-pieces, so that the scene is read once per batch), in waves: the cells' graphs
+pieces, so that the scene is read and laid out once per batch), in waves: the cells' graphs
 (automatic thresholds only), the cells, then the parent cells quadtree level by quadtree level,
 then the proxies of the whole hierarchy in two phases of shares, and last the whole bake, which
 finds every piece and every proxy in the cache and writes the outputs. Pieces go

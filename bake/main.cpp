@@ -459,6 +459,8 @@ int runBake(BakeOptions o) {
             return kUsage;
         }
         tiling.task = tileTasks.front();
+        // The world's layout (support surfaces, grid, clusters) once for the whole list.
+        if (tileTasks.size() > 1) tiling.layout = newTiledLayout();
     }
     // Bake.
     cli::ProgressLine progress(!o.quiet && cli::stderrIsTerminal());

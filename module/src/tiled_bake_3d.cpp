@@ -91,6 +91,7 @@ private:
     double origin_[2] = {0, 0};
     double size_ = 0;
     double tolerance_ = 0;
+    double diagonal_ = 0;  ///< the whole scene's, as the untiled bake measures it
     std::vector<uint32_t> cellOf_;                  ///< per object: its cell (row-major), aggregated objects only
     std::map<uint32_t, std::vector<uint32_t>> cells_;  ///< cell -> its objects, ascending
     std::vector<uint32_t> unusable_;                 ///< objects with no finite triangle
@@ -98,6 +99,11 @@ private:
 
     void findSupport();
     void assignCells();
+    /// Support surfaces, the grid and the cells; false when the world is to be baked untiled.
+    bool layOut(double tileSize);
+    /// The layout of options_.layout when it was made for these objects, settings and tile size.
+    bool reuseLayout(double tileSize);
+    void keepLayout(double tileSize) const;
     Settings3D cellSettings(const std::vector<double>& deltas) const;
     std::vector<InputObject> cellObjects(const std::vector<uint32_t>& ids) const;
     bool automaticCellDeltas(std::vector<double>& deltas);
@@ -322,10 +328,10 @@ bool TiledBaker::automaticCellDeltas(std::vector<double>& deltas) {
     return true;
 }
 
-bool TiledBaker::run(double tileSize) {
+bool TiledBaker::layOut(double tileSize) {
     findSupport();
-    const double diagonal = detail::finiteDiagonal(objects_);  // as the untiled bake measures the scene
-    tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal;
+    diagonal_ = detail::finiteDiagonal(objects_);  // as the untiled bake measures the scene
+    tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal_;
 
     // The footprint of the aggregated objects and its two longest axes.
     double world[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
@@ -338,14 +344,14 @@ bool TiledBaker::run(double tileSize) {
             world[3 + k] = std::max(world[3 + k], boxes_[i][3 + k]);
         }
     }
-    if (aggregated == 0) return buildHierarchy3D(objects_, settings_, out_);
+    if (aggregated == 0) return false;
     int axes[3] = {0, 1, 2};
     std::stable_sort(axes, axes + 3, [&](int x, int y) { return world[3 + x] - world[x] > world[3 + y] - world[y]; });
     axes_[0] = axes[0];
     axes_[1] = axes[1];
     const double extent[2] = {world[3 + axes_[0]] - world[axes_[0]], world[3 + axes_[1]] - world[axes_[1]]};
     if (tileSize <= 0) {
-        if (aggregated <= 2 * kAutomaticTileObjects) return buildHierarchy3D(objects_, settings_, out_);
+        if (aggregated <= 2 * kAutomaticTileObjects) return false;
         const double area = std::max(extent[0], 1e-300) * std::max(extent[1], extent[0] * 1e-3);
         tileSize = std::sqrt(area * double(kAutomaticTileObjects) / double(aggregated));
     }
@@ -359,7 +365,7 @@ bool TiledBaker::run(double tileSize) {
     };
     report_.columns = cellsAlong(extent[0]);
     report_.rows = cellsAlong(extent[1]);
-    if (report_.columns * report_.rows == 1) return buildHierarchy3D(objects_, settings_, out_);
+    if (report_.columns * report_.rows == 1) return false;
     report_.tiled = true;
     while ((size_t(1) << report_.quadtreeDepth) < std::max(report_.columns, report_.rows)) ++report_.quadtreeDepth;
 
@@ -368,6 +374,86 @@ bool TiledBaker::run(double tileSize) {
         std::vector<uint32_t>& first = cells_.begin()->second;
         first.insert(first.end(), unusable_.begin(), unusable_.end());
         std::sort(first.begin(), first.end());
+    }
+    return true;
+}
+
+std::string layoutKey(const Settings3D& settings) {
+    detail::ContentHash h;
+    hashSettings(h, settings);
+    h.u64(uint64_t(settings.support));
+    h.values(settings.supportObjects);
+    return h.hex();
+}
+
+}  // namespace
+
+struct TiledLayout {
+    // What it was made for.
+    const InputObject* objects = nullptr;
+    size_t objectCount = 0;
+    double tileSize = 0;
+    std::string settings;  ///< layoutKey
+    // The layout.
+    std::vector<std::array<double, 6>> boxes;
+    std::vector<char> usable, support;
+    std::vector<uint32_t> unusable, cellOf;
+    std::map<uint32_t, std::vector<uint32_t>> cells;
+    int axes[2] = {0, 1};
+    double origin[2] = {0, 0};
+    double size = 0, tolerance = 0, diagonal = 0;
+    TiledBakeReport report;
+};
+
+std::shared_ptr<TiledLayout> newTiledLayout() { return std::make_shared<TiledLayout>(); }
+
+namespace {
+
+bool TiledBaker::reuseLayout(double tileSize) {
+    const TiledLayout* kept = options_.layout.get();
+    if (!kept || kept->objects != objects_.data() || kept->objectCount != objects_.size() || kept->tileSize != tileSize ||
+        kept->settings != layoutKey(settings_))
+        return false;
+    boxes_ = kept->boxes;
+    usable_ = kept->usable;
+    support_ = kept->support;
+    unusable_ = kept->unusable;
+    cellOf_ = kept->cellOf;
+    cells_ = kept->cells;
+    std::copy_n(kept->axes, 2, axes_);
+    std::copy_n(kept->origin, 2, origin_);
+    size_ = kept->size;
+    tolerance_ = kept->tolerance;
+    diagonal_ = kept->diagonal;
+    report_ = kept->report;
+    return true;
+}
+
+void TiledBaker::keepLayout(double tileSize) const {
+    TiledLayout* kept = options_.layout.get();
+    if (!kept) return;
+    kept->objects = objects_.data();
+    kept->objectCount = objects_.size();
+    kept->tileSize = tileSize;
+    kept->settings = layoutKey(settings_);
+    kept->boxes = boxes_;
+    kept->usable = usable_;
+    kept->support = support_;
+    kept->unusable = unusable_;
+    kept->cellOf = cellOf_;
+    kept->cells = cells_;
+    std::copy_n(axes_, 2, kept->axes);
+    std::copy_n(origin_, 2, kept->origin);
+    kept->size = size_;
+    kept->tolerance = tolerance_;
+    kept->diagonal = diagonal_;
+    kept->report = report_;
+}
+
+bool TiledBaker::run(double tileSize) {
+    if (!reuseLayout(tileSize)) {
+        if (!layOut(tileSize)) return buildHierarchy3D(objects_, settings_, out_);
+        keepLayout(tileSize);
     }
 
     // Thresholds: the cells' and those of each quadtree level j (delta <= S / 8 * 2^j).
@@ -602,7 +688,7 @@ bool TiledBaker::run(double tileSize) {
     for (uint32_t i = 0; i < objects_.size(); ++i) {
         if (support_[i]) {  // counted in the originals as the untiled bake counts them
             detail::PreparedObject prepared;
-            detail::prepareObject(objects_[i], 1e-14 * diagonal * diagonal, prepared, out_.diagnostics);
+            detail::prepareObject(objects_[i], 1e-14 * diagonal_ * diagonal_, prepared, out_.diagnostics);
             out_.supportObjects.push_back(i);
             out_.inputTriangleCount += prepared.triangles.size() / 3;
             out_.originals.volume += prepared.volume;

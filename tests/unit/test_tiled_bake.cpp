@@ -288,10 +288,37 @@ TEST(TiledBake, PiecesBakedApartGiveTheWholeBake) {
         options.tileSize = 48;
         options.cache = &cache;
         options.task.kind = TileTask::Kind::Plan;
+        // One layout for every piece, as in a list of pieces in one process: the whole bake from
+        // their cache entries is still the plain bake (checked at the end).
+        options.layout = newTiledLayout();
         Hierarchy3D h;
         TiledBakeReport plan;
         ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, h, &plan)) << errors(h);
         ASSERT_TRUE(plan.tiled);
+        {
+            // A layout kept for another tile size or other objects is not reused.
+            TiledBakeOptions other = options;
+            other.layout = newTiledLayout();
+            TiledBakeReport at48, at24, fresh24, moved;
+            ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, other, h, &at48)) << errors(h);
+            other.tileSize = 24;
+            ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, other, h, &at24)) << errors(h);
+            TiledBakeOptions alone = other;
+            alone.layout = nullptr;
+            ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, alone, h, &fresh24)) << errors(h);
+            EXPECT_GT(at24.columns, at48.columns);
+            EXPECT_EQ(at24.columns, fresh24.columns);
+            EXPECT_EQ(at24.cells, fresh24.cells);
+            std::vector<InputObject> stretched = objects;  // as many objects, twice as far apart
+            for (InputObject& o : stretched)
+                for (size_t i = 0; i < o.positions.size(); i += 3) o.positions[i] *= 2;
+            ASSERT_TRUE(buildTiledHierarchy3D(stretched, settings, other, h, &moved)) << errors(h);
+            TiledBakeReport movedFresh;
+            ASSERT_TRUE(buildTiledHierarchy3D(stretched, settings, alone, h, &movedFresh)) << errors(h);
+            EXPECT_GT(moved.columns, at24.columns);
+            EXPECT_EQ(moved.columns, movedFresh.columns);
+            EXPECT_EQ(moved.cells, movedFresh.cells);
+        }
         ASSERT_FALSE(plan.cells.empty());
         EXPECT_TRUE(h.levels.empty());
         EXPECT_EQ(plan.automaticDeltas, deltas.empty());
