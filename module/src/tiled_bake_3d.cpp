@@ -71,6 +71,20 @@ void addTimings(Hierarchy3D& out, const Hierarchy3D& part) {
     }
 }
 
+/// What a tiled bake works out from the whole world before any piece (TiledBaker::layOut).
+struct WorldLayout {
+    std::vector<std::array<double, 6>> boxes;
+    std::vector<char> usable, support;
+    int axes[2] = {0, 1};
+    double origin[2] = {0, 0};
+    double size = 0;
+    double tolerance = 0;
+    double diagonal = 0;                            ///< the whole scene's, as the untiled bake measures it
+    std::vector<uint32_t> cellOf;                   ///< per object: its cell (row-major), aggregated objects only
+    std::map<uint32_t, std::vector<uint32_t>> cells;  ///< cell -> its objects, ascending
+    std::vector<uint32_t> unusable;                 ///< objects with no finite triangle
+};
+
 class TiledBaker {
 public:
     TiledBaker(const std::vector<InputObject>& objects, const Settings3D& settings, const TiledBakeOptions& options,
@@ -85,16 +99,7 @@ private:
     const TiledBakeOptions& options_;
     Hierarchy3D& out_;
     TiledBakeReport& report_;
-    std::vector<std::array<double, 6>> boxes_;
-    std::vector<char> usable_, support_;
-    int axes_[2] = {0, 1};
-    double origin_[2] = {0, 0};
-    double size_ = 0;
-    double tolerance_ = 0;
-    double diagonal_ = 0;  ///< the whole scene's, as the untiled bake measures it
-    std::vector<uint32_t> cellOf_;                  ///< per object: its cell (row-major), aggregated objects only
-    std::map<uint32_t, std::vector<uint32_t>> cells_;  ///< cell -> its objects, ascending
-    std::vector<uint32_t> unusable_;                 ///< objects with no finite triangle
+    WorldLayout world_;                              ///< what layOut works out (or reuseLayout finds)
     bool keepOut_ = false;                           ///< the piece just baked is not to be cached
 
     void findSupport();
@@ -193,29 +198,29 @@ bool TiledBaker::obtain(const std::string& key, const std::string& name, bool ma
 
 void TiledBaker::findSupport() {
     const size_t n = objects_.size();
-    boxes_.resize(n);
-    usable_.assign(n, 0);
+    world_.boxes.resize(n);
+    world_.usable.assign(n, 0);
     std::vector<const double*> bounds(n, nullptr);
     for (size_t i = 0; i < n; ++i)
-        if (objectBox(objects_[i], boxes_[i].data())) {
-            usable_[i] = 1;
-            bounds[i] = boxes_[i].data();
+        if (objectBox(objects_[i], world_.boxes[i].data())) {
+            world_.usable[i] = 1;
+            bounds[i] = world_.boxes[i].data();
         } else {
-            unusable_.push_back(static_cast<uint32_t>(i));
+            world_.unusable.push_back(static_cast<uint32_t>(i));
         }
-    support_ = detail::findSupportSurfaces(bounds, settings_);
+    world_.support = detail::findSupportSurfaces(bounds, settings_);
 }
 
 void TiledBaker::assignCells() {
     std::vector<uint32_t> ids;
     for (uint32_t i = 0; i < objects_.size(); ++i)
-        if (usable_[i] && !support_[i]) ids.push_back(i);
-    cellOf_.assign(objects_.size(), UINT32_MAX);
+        if (world_.usable[i] && !world_.support[i]) ids.push_back(i);
+    world_.cellOf.assign(objects_.size(), UINT32_MAX);
     const auto cellAt = [&](const double* box) {
         size_t c[2];
         for (int j = 0; j < 2; ++j) {
-            const double centre = 0.5 * (box[axes_[j]] + box[3 + axes_[j]]);
-            const double f = std::floor((centre - origin_[j]) / size_);
+            const double centre = 0.5 * (box[world_.axes[j]] + box[3 + world_.axes[j]]);
+            const double f = std::floor((centre - world_.origin[j]) / world_.size);
             const size_t limit = j == 0 ? report_.columns : report_.rows;
             c[j] = f <= 0 ? 0 : std::min(limit - 1, static_cast<size_t>(f));
         }
@@ -223,7 +228,7 @@ void TiledBaker::assignCells() {
     };
     // Clusters: boxes within the cells' top delta of each other, chained.
     DisjointSets sets(ids.size());
-    for (auto [a, b] : detail::overlappingPairs(ids.size(), [&](uint32_t k) { return boxes_[ids[k]].data(); },
+    for (auto [a, b] : detail::overlappingPairs(ids.size(), [&](uint32_t k) { return world_.boxes[ids[k]].data(); },
                                                 report_.cellTopDelta))
         sets.unite(a, b);
     std::map<uint32_t, std::vector<uint32_t>> clusters;  // root (smallest member) -> members, ascending
@@ -233,23 +238,23 @@ void TiledBaker::assignCells() {
         double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
         for (uint32_t k : members)
             for (int j = 0; j < 2; ++j) {
-                lo[j] = std::min(lo[j], boxes_[ids[k]][axes_[j]]);
-                hi[j] = std::max(hi[j], boxes_[ids[k]][3 + axes_[j]]);
+                lo[j] = std::min(lo[j], world_.boxes[ids[k]][world_.axes[j]]);
+                hi[j] = std::max(hi[j], world_.boxes[ids[k]][3 + world_.axes[j]]);
             }
-        const bool split = hi[0] - lo[0] > size_ || hi[1] - lo[1] > size_;
+        const bool split = hi[0] - lo[0] > world_.size || hi[1] - lo[1] > world_.size;
         if (split) {
             ++report_.splitClusterCount;
             report_.splitClusterObjects += members.size();
         }
-        const uint32_t cell = cellAt(boxes_[ids[root]].data());
-        for (uint32_t k : members) cellOf_[ids[k]] = split ? cellAt(boxes_[ids[k]].data()) : cell;
+        const uint32_t cell = cellAt(world_.boxes[ids[root]].data());
+        for (uint32_t k : members) world_.cellOf[ids[k]] = split ? cellAt(world_.boxes[ids[k]].data()) : cell;
     }
-    for (uint32_t i : ids) cells_[cellOf_[i]].push_back(i);
-    for (auto& [cell, members] : cells_) {
+    for (uint32_t i : ids) world_.cells[world_.cellOf[i]].push_back(i);
+    for (auto& [cell, members] : world_.cells) {
         std::sort(members.begin(), members.end());
         report_.largestCellObjects = std::max(report_.largestCellObjects, members.size());
     }
-    report_.cellCount = cells_.size();
+    report_.cellCount = world_.cells.size();
 }
 
 Settings3D TiledBaker::cellSettings(const std::vector<double>& deltas) const {
@@ -257,7 +262,7 @@ Settings3D TiledBaker::cellSettings(const std::vector<double>& deltas) const {
     s.deltas = deltas;
     s.support = SupportDetection::None;
     s.supportObjects.clear();
-    s.touchTolerance = tolerance_;  // the whole world's, not the cell's
+    s.touchTolerance = world_.tolerance;  // the whole world's, not the cell's
     s.progress = nullptr;
     return s;
 }
@@ -282,7 +287,7 @@ bool TiledBaker::fail(const Hierarchy3D& part, const std::string& where) {
 bool TiledBaker::automaticCellDeltas(std::vector<double>& deltas) {
     std::vector<Merge> merges;
     size_t done = 0;
-    for (const auto& [cell, ids] : cells_) {
+    for (const auto& [cell, ids] : world_.cells) {
         if (isTask(Kind::Graph) && cell != options_.task.cell) continue;  // the others are not this task's
         const Settings3D settings = cellSettings({});
         Hierarchy3D part;
@@ -301,16 +306,16 @@ bool TiledBaker::automaticCellDeltas(std::vector<double>& deltas) {
         for (const Merge& m : part.merges)
             if (m.height <= report_.cellTopDelta) merges.push_back(m);
         addTimings(out_, part);
-        if (settings_.progress) settings_.progress("tile graphs", double(++done) / double(cells_.size()));
+        if (settings_.progress) settings_.progress("tile graphs", double(++done) / double(world_.cells.size()));
     }
     if (isTask(Kind::Graph)) return true;
     std::sort(merges.begin(), merges.end(), [](const Merge& a, const Merge& b) { return a.height < b.height; });
     double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-    for (const auto& [cell, ids] : cells_)
+    for (const auto& [cell, ids] : world_.cells)
         for (uint32_t i : ids)
             for (int k = 0; k < 3; ++k) {
-                box[k] = std::min(box[k], boxes_[i][k]);
-                box[3 + k] = std::max(box[3 + k], boxes_[i][3 + k]);
+                box[k] = std::min(box[k], world_.boxes[i][k]);
+                box[3 + k] = std::max(box[3 + k], world_.boxes[i][3 + k]);
             }
     const double diagonal = std::sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
                                       (box[5] - box[2]) * (box[5] - box[2]));
@@ -330,35 +335,35 @@ bool TiledBaker::automaticCellDeltas(std::vector<double>& deltas) {
 
 bool TiledBaker::layOut(double tileSize) {
     findSupport();
-    diagonal_ = detail::finiteDiagonal(objects_);  // as the untiled bake measures the scene
-    tolerance_ = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * diagonal_;
+    world_.diagonal = detail::finiteDiagonal(objects_);  // as the untiled bake measures the scene
+    world_.tolerance = settings_.touchTolerance >= 0 ? settings_.touchTolerance : 1e-6 * world_.diagonal;
 
     // The footprint of the aggregated objects and its two longest axes.
     double world[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     size_t aggregated = 0;
     for (size_t i = 0; i < objects_.size(); ++i) {
-        if (!usable_[i] || support_[i]) continue;
+        if (!world_.usable[i] || world_.support[i]) continue;
         ++aggregated;
         for (int k = 0; k < 3; ++k) {
-            world[k] = std::min(world[k], boxes_[i][k]);
-            world[3 + k] = std::max(world[3 + k], boxes_[i][3 + k]);
+            world[k] = std::min(world[k], world_.boxes[i][k]);
+            world[3 + k] = std::max(world[3 + k], world_.boxes[i][3 + k]);
         }
     }
     if (aggregated == 0) return false;
     int axes[3] = {0, 1, 2};
     std::stable_sort(axes, axes + 3, [&](int x, int y) { return world[3 + x] - world[x] > world[3 + y] - world[y]; });
-    axes_[0] = axes[0];
-    axes_[1] = axes[1];
-    const double extent[2] = {world[3 + axes_[0]] - world[axes_[0]], world[3 + axes_[1]] - world[axes_[1]]};
+    world_.axes[0] = axes[0];
+    world_.axes[1] = axes[1];
+    const double extent[2] = {world[3 + world_.axes[0]] - world[world_.axes[0]], world[3 + world_.axes[1]] - world[world_.axes[1]]};
     if (tileSize <= 0) {
         if (aggregated <= 2 * kAutomaticTileObjects) return false;
         const double area = std::max(extent[0], 1e-300) * std::max(extent[1], extent[0] * 1e-3);
         tileSize = std::sqrt(area * double(kAutomaticTileObjects) / double(aggregated));
     }
-    size_ = tileSize;
+    world_.size = tileSize;
     report_.tileSize = tileSize;
     report_.cellTopDelta = tileSize / 8;
-    for (int j = 0; j < 2; ++j) origin_[j] = world[axes_[j]];
+    for (int j = 0; j < 2; ++j) world_.origin[j] = world[world_.axes[j]];
     const auto cellsAlong = [&](double e) {
         const double c = std::ceil(e / tileSize);
         return c < 1 ? size_t(1) : c > 65536 ? size_t(65536) : static_cast<size_t>(c);
@@ -370,9 +375,9 @@ bool TiledBaker::layOut(double tileSize) {
     while ((size_t(1) << report_.quadtreeDepth) < std::max(report_.columns, report_.rows)) ++report_.quadtreeDepth;
 
     assignCells();
-    if (!unusable_.empty()) {  // reported (and left out) by the first cell's bake
-        std::vector<uint32_t>& first = cells_.begin()->second;
-        first.insert(first.end(), unusable_.begin(), unusable_.end());
+    if (!world_.unusable.empty()) {  // reported (and left out) by the first cell's bake
+        std::vector<uint32_t>& first = world_.cells.begin()->second;
+        first.insert(first.end(), world_.unusable.begin(), world_.unusable.end());
         std::sort(first.begin(), first.end());
     }
     return true;
@@ -394,15 +399,8 @@ struct TiledLayout {
     size_t objectCount = 0;
     double tileSize = 0;
     std::string settings;  ///< layoutKey
-    // The layout.
-    std::vector<std::array<double, 6>> boxes;
-    std::vector<char> usable, support;
-    std::vector<uint32_t> unusable, cellOf;
-    std::map<uint32_t, std::vector<uint32_t>> cells;
-    int axes[2] = {0, 1};
-    double origin[2] = {0, 0};
-    double size = 0, tolerance = 0, diagonal = 0;
-    TiledBakeReport report;
+    WorldLayout world;
+    TiledBakeReport report;  ///< as layOut leaves it
 };
 
 std::shared_ptr<TiledLayout> newTiledLayout() { return std::make_shared<TiledLayout>(); }
@@ -414,17 +412,7 @@ bool TiledBaker::reuseLayout(double tileSize) {
     if (!kept || kept->objects != objects_.data() || kept->objectCount != objects_.size() || kept->tileSize != tileSize ||
         kept->settings != layoutKey(settings_))
         return false;
-    boxes_ = kept->boxes;
-    usable_ = kept->usable;
-    support_ = kept->support;
-    unusable_ = kept->unusable;
-    cellOf_ = kept->cellOf;
-    cells_ = kept->cells;
-    std::copy_n(kept->axes, 2, axes_);
-    std::copy_n(kept->origin, 2, origin_);
-    size_ = kept->size;
-    tolerance_ = kept->tolerance;
-    diagonal_ = kept->diagonal;
+    world_ = kept->world;
     report_ = kept->report;
     return true;
 }
@@ -432,22 +420,7 @@ bool TiledBaker::reuseLayout(double tileSize) {
 void TiledBaker::keepLayout(double tileSize) const {
     TiledLayout* kept = options_.layout.get();
     if (!kept) return;
-    kept->objects = objects_.data();
-    kept->objectCount = objects_.size();
-    kept->tileSize = tileSize;
-    kept->settings = layoutKey(settings_);
-    kept->boxes = boxes_;
-    kept->usable = usable_;
-    kept->support = support_;
-    kept->unusable = unusable_;
-    kept->cellOf = cellOf_;
-    kept->cells = cells_;
-    std::copy_n(axes_, 2, kept->axes);
-    std::copy_n(origin_, 2, kept->origin);
-    kept->size = size_;
-    kept->tolerance = tolerance_;
-    kept->diagonal = diagonal_;
-    kept->report = report_;
+    *kept = TiledLayout{objects_.data(), objects_.size(), tileSize, layoutKey(settings_), world_, report_};
 }
 
 bool TiledBaker::run(double tileSize) {
@@ -479,7 +452,7 @@ bool TiledBaker::run(double tileSize) {
     report_.automaticDeltas = settings_.deltas.empty();
     if (isTask(Kind::Plan)) {  // the pieces, for running them apart (aggrelod-farm)
         report_.parents.assign(size_t(report_.quadtreeDepth) + 1, {});
-        for (const auto& [cell, ids] : cells_) report_.cells.push_back(cell);
+        for (const auto& [cell, ids] : world_.cells) report_.cells.push_back(cell);
         for (int j = 1; j <= report_.quadtreeDepth; ++j) {
             if (!report_.automaticDeltas && parentDeltas[size_t(j)].empty()) continue;
             auto& list = report_.parents[size_t(j)];
@@ -506,7 +479,7 @@ bool TiledBaker::run(double tileSize) {
     std::vector<char> leftOut(objects_.size(), 0);
     size_t done = 0;
     bool hasConstant = true;
-    for (const auto& [cell, ids] : cells_) {
+    for (const auto& [cell, ids] : world_.cells) {
         if (!needCell(cell)) continue;
         const Settings3D settings = cellSettings(cellDeltas);
         Hierarchy3D part;
@@ -547,14 +520,14 @@ bool TiledBaker::run(double tileSize) {
         out_.inputTriangleCount += part.inputTriangleCount;
         out_.originals.volume += part.originals.volume;
         out_.originals.area += part.originals.area;
-        if (settings_.progress) settings_.progress("tiles", double(++done) / double(cells_.size()));
+        if (settings_.progress) settings_.progress("tiles", double(++done) / double(world_.cells.size()));
     }
     for (Level& level : levels) level.hasVolumeConstant = hasConstant;
     if (isTask(Kind::Cell)) return true;
 
     // Parent cells, quadtree level by level: the coarsest aggregates so far are their objects.
     const auto anchorColumnRow = [&](const Aggregate& a) {
-        const uint32_t cell = cellOf_[a.sourceObjects.front()];
+        const uint32_t cell = world_.cellOf[a.sourceObjects.front()];
         return std::make_pair(cell % report_.columns, cell / report_.columns);
     };
     for (int j = 1; j <= report_.quadtreeDepth; ++j) {
@@ -622,7 +595,7 @@ bool TiledBaker::run(double tileSize) {
                     wrapInputs();
                     if (buildHierarchy3D(objects, settings, p)) return true;
                     Settings3D closer = settings;
-                    closer.touchTolerance = std::max(tolerance_, 1e-3 * deltas.front());
+                    closer.touchTolerance = std::max(world_.tolerance, 1e-3 * deltas.front());
                     std::vector<Diagnostic> first = p.diagnostics;
                     if (buildHierarchy3D(objects, closer, p)) return true;
                     p = Hierarchy3D{};
@@ -686,9 +659,9 @@ bool TiledBaker::run(double tileSize) {
     std::sort(solids.begin(), solids.end(), [](const SolidReport& a, const SolidReport& b) { return a.objects.front() < b.objects.front(); });
     out_.solids = std::move(solids);
     for (uint32_t i = 0; i < objects_.size(); ++i) {
-        if (support_[i]) {  // counted in the originals as the untiled bake counts them
+        if (world_.support[i]) {  // counted in the originals as the untiled bake counts them
             detail::PreparedObject prepared;
-            detail::prepareObject(objects_[i], 1e-14 * diagonal_ * diagonal_, prepared, out_.diagnostics);
+            detail::prepareObject(objects_[i], 1e-14 * world_.diagonal * world_.diagonal, prepared, out_.diagnostics);
             out_.supportObjects.push_back(i);
             out_.inputTriangleCount += prepared.triangles.size() / 3;
             out_.originals.volume += prepared.volume;
