@@ -61,6 +61,24 @@ struct ViewRecord {
 class JsonWriter {
 public:
     std::string text;
+    /// Where drain() moves the text so far (null: it all stays in `text`).
+    std::FILE* sink = nullptr;
+    uint64_t drained = 0;  ///< bytes moved to `sink`
+    bool sinkFailed = false;
+
+    /// Moves the text to `sink` once it exceeds a block (always with `all`), so that a large
+    /// document never lies in memory whole.
+    void drain(bool all = false) {
+        if (!sink || (!all && text.size() < (size_t(1) << 20))) return;
+        if (std::fwrite(text.data(), 1, text.size(), sink) != text.size()) sinkFailed = true;
+        drained += text.size();
+        text.clear();
+    }
+    /// A complete JSON value written before (another JsonWriter's text).
+    void raw(const std::string& json) {
+        comma();
+        text += json;
+    }
 
     void string(const std::string& s) {
         text += '"';
@@ -225,11 +243,11 @@ const char* accessorTypeName(int type) {
     }
 }
 
-/// The glTF JSON of `model` with one buffer of `binaryBytes` (none when 0).
-std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord>& meshes,
-                      const std::vector<AccessorRecord>& accessors, const std::vector<ViewRecord>& views,
-                      uint64_t binaryBytes) {
-    JsonWriter w;
+/// Writes the glTF JSON of `model` with one buffer of `binaryBytes` (none when 0) through `w`
+/// (drained as it goes). frozenExtras[i], where not empty, is node i's extras as JSON text.
+void modelJson(const tinygltf::Model& model, const std::vector<MeshRecord>& meshes,
+               const std::vector<AccessorRecord>& accessors, const std::vector<ViewRecord>& views,
+               uint64_t binaryBytes, const std::vector<std::string>& frozenExtras, JsonWriter& w) {
     w.open('{');
     w.key("asset");
     w.open('{');
@@ -253,7 +271,8 @@ std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord
     if (!model.nodes.empty()) {
         w.key("nodes");
         w.open('[');
-        for (const tinygltf::Node& node : model.nodes) {
+        for (size_t i = 0; i < model.nodes.size(); ++i) {
+            const tinygltf::Node& node = model.nodes[i];
             w.open('{');
             if (!node.name.empty()) w.member("name", node.name);
             if (node.mesh >= 0) w.member("mesh", int64_t(node.mesh));
@@ -263,8 +282,14 @@ std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord
             if (!node.rotation.empty()) w.numbers("rotation", node.rotation);
             if (!node.scale.empty()) w.numbers("scale", node.scale);
             w.extensions(node.extensions);
-            w.extras(node.extras);
+            if (i < frozenExtras.size() && !frozenExtras[i].empty()) {
+                w.key("extras");
+                w.raw(frozenExtras[i]);
+            } else {
+                w.extras(node.extras);
+            }
             w.close('}');
+            w.drain();
         }
         w.close(']');
     }
@@ -289,6 +314,7 @@ std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord
             w.close('}');
             w.close(']');
             w.close('}');
+            w.drain();
         }
         w.close(']');
     }
@@ -332,6 +358,7 @@ std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord
                 w.numbers("max", std::vector<double>(a.max, a.max + 3));
             }
             w.close('}');
+            w.drain();
         }
         w.close(']');
     }
@@ -345,6 +372,7 @@ std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord
             w.member("byteLength", int64_t(v.byteLength));
             if (v.target > 0) w.member("target", int64_t(v.target));
             w.close('}');
+            w.drain();
         }
         w.close(']');
     }
@@ -357,14 +385,14 @@ std::string modelJson(const tinygltf::Model& model, const std::vector<MeshRecord
         w.close(']');
     }
     w.close('}');
-    return std::move(w.text);
+    w.drain(true);
 }
 
 /// Builds one GLB model; meshes share one buffer, one buffer view per accessor.
 class GlbBuilder {
 public:
     /// `path`: the file write() will make; the binary chunk is gathered beside it meanwhile.
-    explicit GlbBuilder(const std::string& path) : spillPath_(path + ".binary-part") {
+    explicit GlbBuilder(const std::string& path) : spillPath_(path + ".binary-part"), jsonSpillPath_(path + ".json-part") {
         model_.asset.version = "2.0";
         model_.asset.generator = "aggrelod";
     }
@@ -372,6 +400,10 @@ public:
         if (spill_) {
             spill_.reset();
             std::remove(spillPath_.c_str());
+        }
+        if (jsonSpill_) {
+            jsonSpill_.reset();
+            std::remove(jsonSpillPath_.c_str());
         }
     }
     GlbBuilder(const GlbBuilder&) = delete;
@@ -468,6 +500,19 @@ public:
         return int(model_.nodes.size()) - 1;
     }
 
+    /// Node `index`'s extras will not change any more: kept as their JSON text from now on, a
+    /// fraction of tinygltf's value tree (a large hierarchy lists every object of every node).
+    void freezeExtras(int index) {
+        tinygltf::Value& extras = model_.nodes.at(size_t(index)).extras;
+        if (extras.Type() == tinygltf::NULL_TYPE) return;
+        JsonWriter w;
+        w.value(extras);
+        if (frozenExtras_.size() <= size_t(index)) frozenExtras_.resize(size_t(index) + 1);
+        frozenExtras_[size_t(index)] = std::move(w.text);
+        frozenExtras_[size_t(index)].shrink_to_fit();
+        extras = tinygltf::Value();
+    }
+
     tinygltf::Model& model() { return model_; }
 
     bool write(const std::string& path, const std::vector<int>& sceneRoots, std::string& error) {
@@ -492,16 +537,24 @@ public:
         model_.defaultScene = 0;
         // The JSON written here from the model, the binary chunk straight from the views:
         // tinygltf would build a JSON document of the whole model and copy the buffer once
-        // more, several times the file in memory for a large hierarchy.
-        std::string json;
+        // more, several times the file in memory for a large hierarchy. The JSON goes to a
+        // file beside the output as it is written (it has to come first, with its length).
+        JsonWriter json;
+        jsonSpill_.reset(std::fopen(jsonSpillPath_.c_str(), "w+b"));
+        json.sink = jsonSpill_.get();
         try {
-            json = modelJson(model_, meshes_, accessors_, views_, binSize_);
+            modelJson(model_, meshes_, accessors_, views_, binSize_, frozenExtras_, json);
         } catch (const std::exception& e) {
             error = path + ": cannot write glTF: " + e.what();
             return false;
         }
+        const uint64_t jsonSize = json.drained + json.text.size();
+        if (json.sink && (json.sinkFailed || std::fflush(json.sink) != 0 || std::fseek(json.sink, 0, SEEK_SET) != 0)) {
+            error = path + ": cannot write glTF: temporary file: " + std::strerror(errno);
+            return false;
+        }
         const auto padded = [](uint64_t n) { return (n + 3) / 4 * 4; };
-        const uint64_t total = 12 + 8 + padded(json.size()) + (binSize_ ? 8 + padded(binSize_) : 0);
+        const uint64_t total = 12 + 8 + padded(jsonSize) + (binSize_ ? 8 + padded(binSize_) : 0);
         if (total > std::numeric_limits<uint32_t>::max()) {
             error = path + ": " + std::to_string(total) + " bytes: beyond the 4 GiB a GLB file can hold";
             return false;
@@ -520,20 +573,11 @@ public:
             const unsigned char b[4] = {uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16), uint8_t(v >> 24)};
             out.write(reinterpret_cast<const char*>(b), 4);
         };
-        out.write("glTF", 4);
-        word(2);
-        word(uint32_t(total));
-        word(uint32_t(padded(json.size())));
-        word(0x4E4F534Au);  // "JSON"
-        json.resize(padded(json.size()), ' ');
-        out.write(json.data(), std::streamsize(json.size()));
-        if (binSize_) {
-            word(uint32_t(padded(binSize_)));
-            word(0x004E4942u);  // "BIN\0"
-            if (!spill_) out.write(reinterpret_cast<const char*>(inMemory_.data()), std::streamsize(inMemory_.size()));
-            std::vector<char> block(spill_ ? 1 << 20 : 0);
-            for (uint64_t left = spill_ ? binSize_ : 0; left > 0;) {
-                const size_t n = std::fread(block.data(), 1, size_t(std::min<uint64_t>(left, block.size())), spill_.get());
+        // `bytes` from a temporary file to the output; false when it ends early.
+        std::vector<char> block(size_t(1) << 20);
+        const auto copy = [&](std::FILE* from, uint64_t bytes) {
+            for (uint64_t left = bytes; left > 0;) {
+                const size_t n = std::fread(block.data(), 1, size_t(std::min<uint64_t>(left, block.size())), from);
                 if (n == 0) {
                     error = path + ": cannot write glTF: temporary file ended early";
                     return false;
@@ -541,6 +585,21 @@ public:
                 out.write(block.data(), std::streamsize(n));
                 left -= n;
             }
+            return true;
+        };
+        out.write("glTF", 4);
+        word(2);
+        word(uint32_t(total));
+        word(uint32_t(padded(jsonSize)));
+        word(0x4E4F534Au);  // "JSON"
+        if (json.sink && !copy(json.sink, json.drained)) return false;
+        json.text.resize(json.text.size() + size_t(padded(jsonSize) - jsonSize), ' ');
+        out.write(json.text.data(), std::streamsize(json.text.size()));
+        if (binSize_) {
+            word(uint32_t(padded(binSize_)));
+            word(0x004E4942u);  // "BIN\0"
+            if (!spill_) out.write(reinterpret_cast<const char*>(inMemory_.data()), std::streamsize(inMemory_.size()));
+            if (spill_ && !copy(spill_.get(), binSize_)) return false;
             const char zeros[4] = {0, 0, 0, 0};
             out.write(zeros, std::streamsize(padded(binSize_) - binSize_));
         }
@@ -719,8 +778,10 @@ private:
     std::vector<MeshRecord> meshes_;
     std::vector<AccessorRecord> accessors_;
     std::vector<ViewRecord> views_;
-    std::string spillPath_;
+    std::vector<std::string> frozenExtras_;  ///< per node: its extras as JSON text (freezeExtras), or empty
+    std::string spillPath_, jsonSpillPath_;
     std::unique_ptr<std::FILE, CloseFile> spill_;  ///< the binary chunk so far, at spillPath_
+    std::unique_ptr<std::FILE, CloseFile> jsonSpill_;  ///< the JSON chunk while it is written
     std::vector<unsigned char> inMemory_;         ///< the same without a temporary file
     bool spillFailed_ = false;
     uint64_t binSize_ = 0;      ///< bytes of the binary chunk before its final padding
@@ -968,6 +1029,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 }
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
+                glb.freezeExtras(children.back());
             }
             model.nodes[size_t(levelIndex)].children = std::move(children);
         }
@@ -1005,6 +1067,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 if (nodes && s < nodes->objectCount) extras["node"] = intValue(s);
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
+                glb.freezeExtras(children.back());
             }
             model.nodes[size_t(supportIndex)].children = std::move(children);
         }
@@ -1183,12 +1246,14 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
             for (size_t c = chain.size() - (b.leaf ? 1 : 0); c-- > 0;) {
                 const uint32_t i = chain[c];
                 const int standIn = meshNode(i, stem + "_LOD" + std::to_string(lod), lod);
+                glb.freezeExtras(standIn);
                 ++lod;
                 ids.push_back(standIn);
                 errors.push_back(nodes.nodes[i].geometricError);
                 standInRoots.push_back(standIn);
             }
             setMsftLod(model, model.nodes[size_t(lod0)], ids, nodes.nodes[p.top].sphereRadius, errors, true);
+            glb.freezeExtras(lod0);
         }
         // Children were pushed in reverse onto the stack, so they arrive in order; the LOD0
         // nodes of a group's children are appended in that order.

@@ -44,6 +44,9 @@
 #include <cstring>
 #include <dirent.h>
 #include <fcntl.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -60,6 +63,15 @@ enum ExitCode { kOk = 0, kUsage = 1, kFileError = 2, kBakeFailed = 3, kInternal 
 
 void printError(const std::string& message) {
     std::fprintf(stderr, "aggrelod: error: %s\n", message.c_str());
+}
+
+/// Hands the pages of freed memory back to the system between the bake's stages. glibc keeps
+/// them (in every thread's arena), while the next stage's large blocks come from new pages:
+/// without this, the peak is what every stage ever held, not what one holds.
+void releaseFreedMemory() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
 }
 
 // ---------------------------------------------------------------------------
@@ -511,6 +523,7 @@ int runBake(BakeOptions o) {
             Hierarchy3D piece;
             done = buildTiledHierarchy3D(scene.objects, settings, tiling, piece, &tiled);
             if (done && proxies) {
+                releaseFreedMemory();
                 done = buildProxyShare(piece, scene.objects, proxySettings, proxyShare, shareError, &made, &loaded);
             } else {
                 made += tiled.graphsBaked + tiled.cellsBaked + tiled.parentsBaked;
@@ -544,6 +557,7 @@ int runBake(BakeOptions o) {
     HierarchyNodes nodes;
     std::string nodeError;
     bool nodesOk = false;
+    releaseFreedMemory();
     if (ok) {
         const auto start = std::chrono::steady_clock::now();
         nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
@@ -560,6 +574,7 @@ int runBake(BakeOptions o) {
         hierarchy.timings.emplace_back("collision", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
     progress.finish();
+    releaseFreedMemory();
     cli::printDiagnostics(hierarchy.diagnostics, o.quiet);
     if (!ok) {
         printError(o.scene + ": baking failed; nothing was written");
@@ -605,7 +620,9 @@ int runBake(BakeOptions o) {
             std::vector<uint32_t>().swap(a.indices);
             std::vector<float>().swap(a.faceColors);
         }
+    releaseFreedMemory();
     if (!io::writeProxiesGlb(nodes, scene.objects, proxiesTmp.string(), error, o.threads)) return fail(error);
+    releaseFreedMemory();
     if (!io::writeRuntimeScene(nodes, scene.objects, io::settingsHash(settingsText(o)), AGGRELOD_VERSION,
                                runtimeTmp.string(), error, o.threads))
         return fail(error);

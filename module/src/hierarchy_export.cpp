@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numeric>
 
 namespace aggrelod {
@@ -147,40 +148,53 @@ bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>
     params.settingsHash = hash;
     params.toolVersion = toolVersion;
     for (const InputObject& o : objects) params.objectNames.push_back(o.name);
-    size_t totalChildren = 0, totalSources = 0, totalPositions = 0, totalIndices = 0;
-    std::vector<RenderMesh> meshes(nodes.nodes.size());
-    std::vector<char> built(nodes.nodes.size(), 0);
-    detail::parallelFor(nodes.nodes.size(), threadCount, [&](size_t i) {
-        const HierarchyNode& n = nodes.nodes[i];
-        built[i] = buildRenderMesh(n.positions, n.indices, n.faceColors, meshes[i]);
-    });
-    for (size_t i = 0; i < nodes.nodes.size(); ++i) {
-        const HierarchyNode& n = nodes.nodes[i];
-        if (!built[i]) {
-            error = "node " + std::to_string(i) + ": a triangle index is out of range";
-            return false;
-        }
+    size_t totalChildren = 0, totalSources = 0, totalIndices = 0;
+    for (const HierarchyNode& n : nodes.nodes) {
         totalChildren += n.children.size();
         totalSources += n.sources.size();
-        totalPositions += meshes[i].positions.size();
         totalIndices += n.indices.size();
     }
+    // A render mesh has at most one vertex per triangle corner (buildRenderMesh splits, never adds).
     const size_t limit = std::numeric_limits<uint32_t>::max() - 1;
-    if (nodes.nodes.size() > limit || totalChildren > limit || totalSources > limit || totalPositions / 3 > limit ||
-        totalIndices > limit) {
+    if (nodes.nodes.size() > limit || totalChildren > limit || totalSources > limit || totalIndices > limit) {
         error = "the hierarchy is too large for the runtime file (more than 2^32 nodes, vertices or indices)";
         return false;
     }
     params.nodes.reserve(nodes.nodes.size());
     params.childIndices.reserve(totalChildren);
     params.sourceObjects.reserve(totalSources);
-    params.positions.reserve(totalPositions);
-    params.normals.reserve(totalPositions);
-    params.colors.reserve(totalPositions / 3 * 4);
     params.indices.reserve(totalIndices);
+    // The vertex arrays are reserved for that most (address space: only what is filled takes
+    // memory), so they never grow by copying, and the render meshes are made a batch at a
+    // time: the peak stays near one copy of the arrays.
+    try {
+        params.positions.reserve(3 * totalIndices);
+        params.normals.reserve(3 * totalIndices);
+        params.colors.reserve(4 * totalIndices);
+    } catch (const std::bad_alloc&) {  // no such address space: the arrays grow as they fill
+        params.positions.shrink_to_fit();
+        params.normals.shrink_to_fit();
+        params.colors.shrink_to_fit();
+    }
+    std::vector<RenderMesh> meshes;
+    const size_t batch = 1024;
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
         const HierarchyNode& n = nodes.nodes[i];
-        RenderMesh& mesh = meshes[i];
+        if (i % batch == 0) {
+            const size_t count = std::min(batch, nodes.nodes.size() - i);
+            meshes.assign(count, RenderMesh{});
+            std::vector<char> built(count, 0);
+            detail::parallelFor(count, threadCount, [&](size_t k) {
+                const HierarchyNode& m = nodes.nodes[i + k];
+                built[k] = buildRenderMesh(m.positions, m.indices, m.faceColors, meshes[k]);
+            });
+            for (size_t k = 0; k < count; ++k)
+                if (!built[k]) {
+                    error = "node " + std::to_string(i + k) + ": a triangle index is out of range";
+                    return false;
+                }
+        }
+        RenderMesh& mesh = meshes[i % batch];
         runtime::NodeRecord b;
         b.parent = n.parent == kNoNode ? runtime::kNoIndex : n.parent;
         b.firstChild = static_cast<uint32_t>(params.childIndices.size());

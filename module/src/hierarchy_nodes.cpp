@@ -662,6 +662,8 @@ struct WorkItems {
     std::function<void(size_t, std::vector<uint8_t>&)> write;
     std::function<void(size_t, std::vector<char>&)> objects;  ///< marks the objects make(j) measures against
     std::function<void(const std::vector<uint32_t>&)> beforeMaking;  ///< optional, with the items to make
+    /// Optional: drops item j's result once it is in the cache, where nothing after needs it.
+    std::function<void(size_t)> release;
     std::function<std::string(size_t)> name;
 };
 
@@ -1065,6 +1067,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 std::vector<uint8_t> bytes;
                 items.write(j, bytes);
                 memo.store(keys[j], bytes);
+                if (items.release) items.release(j);
             }
         }, [&](size_t done) {
             if (settings.progress)
@@ -1172,6 +1175,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // alone (the object with its concavities filled), up to its first aggregate with other
     // objects; those single-object aggregates stay only where the object has no chain.
     std::vector<std::vector<HierarchyNode>> chains(objectCount);
+    std::vector<char> chained(objectCount, 0);
     std::vector<uint32_t> firstGroup(objectCount, kNoNode);  // first ancestor with several objects
     for (size_t o = 0; o < objectCount; ++o) {
         uint32_t up = nodes[o].parent;
@@ -1181,8 +1185,13 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (ladders[o].versions.empty()) return;
         const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
-        chains[o] = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceiling, settings);
+        std::vector<HierarchyNode> chain = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceiling, settings);
+        // A ladder read without its exact vertices has given all it can: coarser versions to
+        // be made read it again whole (beforeMaking), so it need not be held beside its chain.
+        if (!ladderWhole[o]) ladders[o] = VersionLadder{};
+        chained[o] = !chain.empty();
         if (share) return;  // only whether there is a chain matters to a share
+        chains[o] = std::move(chain);
         const detail::SurfaceColorSource colors({&objects[o]});
         for (HierarchyNode& c : chains[o]) {
             colors.colorsOf(c.positions, c.indices, c.faceColors);
@@ -1192,7 +1201,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     std::vector<char> dropped(nodes.size(), 0);
     std::vector<uint32_t> keptSingles;
     for (uint32_t i : singleNodes) {
-        if (!chains[nodes[i].sources.front()].empty()) dropped[i] = 1;
+        if (chained[nodes[i].sources.front()]) dropped[i] = 1;
         else keptSingles.push_back(i);
     }
     // Coarser versions of every aggregate kept, capped by its parent's error. The parent of
@@ -1238,6 +1247,14 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         items.make = [&](size_t j) {
             const uint32_t i = keptAggregates[j];
             const HierarchyNode& n = nodes[i];
+            if (!exactHeld[i]) {
+                // Read without its exact vertices: read again whole, one item at a time (or,
+                // should the entry have gone meanwhile, made again: the same result).
+                HierarchyNode again = n;
+                std::vector<uint8_t> bytes;
+                if (!(memo.on() && memo.load(nodeKeys[i], bytes) && readAggregateProxy(bytes, again, &exactProxies[i])))
+                    makeAggregateProxy(aggregateOf(n), originalsOf(n), settings, again, exactProxies[i]);
+            }
             std::vector<const VersionLadder*> sourceLadders;
             for (uint32_t o : n.sources) sourceLadders.push_back(ladders[o].versions.empty() ? nullptr : &ladders[o]);
             coarser[i] = coarserChain(n, exactProxies[i], aggregateOf(n).componentCount, originalsOf(n), sourceLadders,
@@ -1250,24 +1267,18 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             }
         };
         items.write = [&](size_t j, std::vector<uint8_t>& bytes) { writeCoarser(coarser[keptAggregates[j]], bytes); };
-        // What was read without its exact vertices and is needed now: read again whole (or,
-        // should the entry have gone meanwhile, made again: the same result).
+        // The ladders read without their exact vertices that are needed now: those of groups
+        // small enough to be united from their objects' versions (coarserChain; several items
+        // share one). Read again whole (or, should the entry have gone meanwhile, made again).
         items.beforeMaking = [&](const std::vector<uint32_t>& toMake) {
-            std::vector<uint32_t> lackingNodes, lackingLadders;
+            std::vector<uint32_t> lackingLadders;
             std::vector<char> lacking(objectCount, 0);
             for (uint32_t j : toMake) {
-                const uint32_t i = keptAggregates[j];
-                if (!exactHeld[i]) lackingNodes.push_back(i);
-                for (uint32_t o : nodes[i].sources)
+                const std::vector<uint32_t>& sources = nodes[keptAggregates[j]].sources;
+                if (sources.size() < 2 || sources.size() > kUnionMaxObjects) continue;
+                for (uint32_t o : sources)
                     if (!ladderWhole[o] && hasLadder(o) && !lacking[o]) lacking[o] = 1, lackingLadders.push_back(o);
             }
-            detail::parallelFor(lackingNodes.size(), settings.threadCount, [&](size_t k) {
-                const uint32_t i = lackingNodes[k];
-                HierarchyNode again = nodes[i];
-                std::vector<uint8_t> bytes;
-                if (!(memo.on() && memo.load(nodeKeys[i], bytes) && readAggregateProxy(bytes, again, &exactProxies[i])))
-                    makeAggregateProxy(aggregateOf(nodes[i]), originalsOf(nodes[i]), settings, again, exactProxies[i]);
-            });
             detail::parallelFor(lackingLadders.size(), settings.threadCount, [&](size_t k) {
                 const uint32_t o = lackingLadders[k];
                 std::vector<uint8_t> bytes;
@@ -1279,6 +1290,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             for (uint32_t o : nodes[keptAggregates[j]].sources) needed[o] = 1;
         };
         items.name = [&](size_t j) { return "the coarser versions of node " + std::to_string(keptAggregates[j]); };
+        if (share) items.release = [&](size_t j) { coarser[keptAggregates[j]] = {}; };  // a share keeps nothing
         if (!runItems(keptAggregates.size(), items, 0.85, 1.0)) return finish(false);
     }
     exactProxies = {};

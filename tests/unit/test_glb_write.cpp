@@ -5,6 +5,7 @@
 #include "scene_io.h"
 #include "test_support.h"
 
+#include <aggrelod/hierarchy_nodes.h>
 #include <aggrelod/samples.h>
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <string>
 
 namespace aggrelod {
 namespace {
@@ -63,6 +65,60 @@ TEST(GlbWrite, AwkwardNamesAreEscapedAndReadBack) {
         ASSERT_EQ(back.objects[i].positions.size(), objects[i].positions.size()) << i;
         for (size_t k = 0; k < objects[i].positions.size(); ++k)
             EXPECT_EQ(back.objects[i].positions[k], double(float(objects[i].positions[k]))) << i << " " << k;
+    }
+}
+
+// levels.glb and proxies.glb list every object of every node by name: on a large world their
+// JSON runs to hundreds of megabytes, which the writer streams through a temporary file in
+// blocks of 1 MiB. A JSON chunk of several blocks must come out whole, valid and in order,
+// and no temporary file may stay behind.
+TEST(GlbWrite, JsonOfSeveralBlocksIsWholeAndLeavesNoTemporaryFile) {
+    const fs::path dir = freshTestDir(currentTestName());
+    std::vector<InputObject> objects;
+    for (int i = 0; i < 40; ++i) {
+        const double x = 1.5 * i;  // unit boxes 0.5 apart
+        objects.push_back(samples::makeBox("box" + std::to_string(100 + i) + "_" + std::string(30000, char('a' + i % 26)),
+                                           {x, 0, 0}, {x + 1, 1, 1}));
+    }
+    Settings3D settings;
+    settings.deltas = {0.25, 1.0};
+    settings.threadCount = 1;
+    Hierarchy3D h;
+    ASSERT_TRUE(buildHierarchy3D(objects, settings, h));
+    ASSERT_EQ(h.levels.size(), 2u);
+    ASSERT_EQ(h.levels[1].aggregates.size(), 1u);
+    HierarchyNodes nodes;
+    ProxySettings proxySettings;
+    proxySettings.threadCount = 1;
+    std::string error;
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, proxySettings, nodes, error)) << error;
+    const fs::path levels = dir / "levels.glb", proxies = dir / "proxies.glb";
+    ASSERT_TRUE(io::writeLevelsGlb(h, objects, levels.string(), error, &nodes, 2)) << error;
+    ASSERT_TRUE(io::writeProxiesGlb(nodes, objects, proxies.string(), error, 2)) << error;
+    for (const fs::path& file : {levels, proxies}) {
+        const std::string json = glbJson(file);
+        EXPECT_GT(json.size(), size_t(2) << 20) << file << ": the JSON must span several blocks";
+        // Every object is named once per level in levels.glb, and at least in its leaf and in
+        // the group of all 40 in proxies.glb; the last one too, at the end of the last block.
+        for (const InputObject& o : {objects.front(), objects.back()}) {
+            size_t count = 0;
+            for (size_t at = json.find(o.name); at != std::string::npos; at = json.find(o.name, at + 1)) ++count;
+            EXPECT_GE(count, 2u) << file << ": " << o.name.substr(0, 8);
+        }
+    }
+    validateGltf({levels, proxies}, dir);
+    std::vector<io::LevelsGlbNode> levelNodes;
+    ASSERT_TRUE(io::readLevelsGlb(levels.string(), levelNodes, error)) << error;
+    ASSERT_EQ(levelNodes.size(), 41u);
+    EXPECT_EQ(levelNodes.back().sourceCount, 40u);
+    std::vector<io::ProxiesGlbNode> proxyNodes;
+    ASSERT_TRUE(io::readProxiesGlb(proxies.string(), proxyNodes, error)) << error;
+    size_t leaves = 0;
+    for (const io::ProxiesGlbNode& n : proxyNodes) leaves += n.leaf;
+    EXPECT_EQ(leaves, 40u);
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        const std::string name = entry.path().filename().string();
+        EXPECT_EQ(name.find("-part"), std::string::npos) << name << ": a temporary file left behind";
     }
 }
 
