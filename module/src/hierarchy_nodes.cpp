@@ -1293,7 +1293,11 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         if (share) items.release = [&](size_t j) { coarser[keptAggregates[j]] = {}; };  // a share keeps nothing
         if (!runItems(keptAggregates.size(), items, 0.85, 1.0)) return finish(false);
     }
-    exactProxies = {};
+    // Nothing after measures against the originals or unites versions: what was held for that
+    // goes before the tree is put together again (on a large world, a good part of the peak).
+    std::vector<ExactProxy>().swap(exactProxies);
+    std::vector<detail::PreparedOriginal>().swap(prepared);
+    std::vector<VersionLadder>().swap(ladders);
     if (share) return finish(true);
     for (size_t i = objectCount; i < nodes.size(); ++i) {
         if (dropped[i]) continue;

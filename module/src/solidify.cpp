@@ -23,10 +23,21 @@
 #include <algorithm>
 #include <memory>
 #include <numeric>
+#include <type_traits>
 
 namespace aggrelod::detail {
 
 namespace {
+
+/// A coordinate as a double; for an exact kernel's lazy number, from its exact value. CGAL's
+/// own to_double returns the middle of the interval the number holds whenever that is narrow
+/// enough, and the interval narrows once anything has asked for the exact value, which is not
+/// the same from one process to the next: the same union came out with other last bits.
+template <class FT>
+double coordinate(const FT& x) {
+    if constexpr (std::is_same_v<FT, double>) return x;
+    else return CGAL::to_double(x.exact());
+}
 
 /// Vertices and triangles of a triangle Surface_mesh without removed elements, in index
 /// order (deterministic: the order the algorithm created them). False on a face that is not
@@ -41,9 +52,9 @@ bool meshToArrays(const Mesh& mesh, std::vector<double>& outPositions, std::vect
     for (typename Mesh::Vertex_index v : mesh.vertices()) {
         const auto& p = mesh.point(v);
         index[v.idx()] = next++;
-        outPositions.push_back(CGAL::to_double(p.x()));
-        outPositions.push_back(CGAL::to_double(p.y()));
-        outPositions.push_back(CGAL::to_double(p.z()));
+        outPositions.push_back(coordinate(p.x()));
+        outPositions.push_back(coordinate(p.y()));
+        outPositions.push_back(coordinate(p.z()));
     }
     outTriangles.reserve(3 * mesh.number_of_faces());
     for (typename Mesh::Face_index f : mesh.faces()) {
