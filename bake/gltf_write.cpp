@@ -392,19 +392,9 @@ void modelJson(const tinygltf::Model& model, const std::vector<MeshRecord>& mesh
 class GlbBuilder {
 public:
     /// `path`: the file write() will make; the binary chunk is gathered beside it meanwhile.
-    explicit GlbBuilder(const std::string& path) : spillPath_(path + ".binary-part"), jsonSpillPath_(path + ".json-part") {
+    explicit GlbBuilder(const std::string& path) : spill_(path + ".binary-part"), jsonSpill_(path + ".json-part") {
         model_.asset.version = "2.0";
         model_.asset.generator = "aggrelod";
-    }
-    ~GlbBuilder() {
-        if (spill_) {
-            spill_.reset();
-            std::remove(spillPath_.c_str());
-        }
-        if (jsonSpill_) {
-            jsonSpill_.reset();
-            std::remove(jsonSpillPath_.c_str());
-        }
     }
     GlbBuilder(const GlbBuilder&) = delete;
     GlbBuilder& operator=(const GlbBuilder&) = delete;
@@ -540,8 +530,7 @@ public:
         // more, several times the file in memory for a large hierarchy. The JSON goes to a
         // file beside the output as it is written (it has to come first, with its length).
         JsonWriter json;
-        jsonSpill_.reset(std::fopen(jsonSpillPath_.c_str(), "w+b"));
-        json.sink = jsonSpill_.get();
+        json.sink = jsonSpill_.open();
         try {
             modelJson(model_, meshes_, accessors_, views_, binSize_, frozenExtras_, json);
         } catch (const std::exception& e) {
@@ -559,8 +548,8 @@ public:
             error = path + ": " + std::to_string(total) + " bytes: beyond the 4 GiB a GLB file can hold";
             return false;
         }
-        if (binSize_ > 0 && spill_ &&
-            (spillFailed_ || std::fflush(spill_.get()) != 0 || std::fseek(spill_.get(), 0, SEEK_SET) != 0)) {
+        if (binSize_ > 0 && spill_.file &&
+            (spillFailed_ || std::fflush(spill_.file) != 0 || std::fseek(spill_.file, 0, SEEK_SET) != 0)) {
             error = path + ": cannot write glTF: temporary file: " + std::strerror(errno);
             return false;
         }
@@ -598,8 +587,8 @@ public:
         if (binSize_) {
             word(uint32_t(padded(binSize_)));
             word(0x004E4942u);  // "BIN\0"
-            if (!spill_) out.write(reinterpret_cast<const char*>(inMemory_.data()), std::streamsize(inMemory_.size()));
-            if (spill_ && !copy(spill_.get(), binSize_)) return false;
+            if (!spill_.file) out.write(reinterpret_cast<const char*>(inMemory_.data()), std::streamsize(inMemory_.size()));
+            if (spill_.file && !copy(spill_.file, binSize_)) return false;
             const char zeros[4] = {0, 0, 0, 0};
             out.write(zeros, std::streamsize(padded(binSize_) - binSize_));
         }
@@ -734,15 +723,15 @@ private:
         // The binary chunk goes to a file beside the output as it grows (written out after the
         // JSON, which has to come first): the builder holds the model's description only.
         // Where that file cannot be made, the chunk stays in memory.
-        if (!spill_ && inMemory_.empty() && binSize_ == 0) spill_.reset(std::fopen(spillPath_.c_str(), "w+b"));
+        if (!spill_.file && inMemory_.empty() && binSize_ == 0) spill_.open();
         const auto* b = static_cast<const unsigned char*>(data);
-        if (!spill_) {
+        if (!spill_.file) {
             inMemory_.resize(size_t(view.byteOffset), 0);
             inMemory_.insert(inMemory_.end(), b, b + bytes);
         } else {
             const char zeros[4] = {0, 0, 0, 0};
-            if (std::fwrite(zeros, 1, size_t(view.byteOffset - binSize_), spill_.get()) != view.byteOffset - binSize_ ||
-                std::fwrite(b, 1, bytes, spill_.get()) != bytes)
+            if (std::fwrite(zeros, 1, size_t(view.byteOffset - binSize_), spill_.file) != view.byteOffset - binSize_ ||
+                std::fwrite(b, 1, bytes, spill_.file) != bytes)
                 spillFailed_ = true;
         }
         binSize_ = view.byteOffset + bytes;
@@ -768,8 +757,24 @@ private:
         return int(accessors_.size()) - 1;
     }
 
-    struct CloseFile {
-        void operator()(std::FILE* f) const { std::fclose(f); }
+    /// A file beside the output for what has to wait until the output's start is known;
+    /// removed with the builder.
+    struct TemporaryFile {
+        std::string path;
+        std::FILE* file = nullptr;
+        explicit TemporaryFile(std::string where) : path(std::move(where)) {}
+        /// Creates it (read and write); null where it cannot be made.
+        std::FILE* open() {
+            file = std::fopen(path.c_str(), "w+b");
+            return file;
+        }
+        TemporaryFile(const TemporaryFile&) = delete;
+        TemporaryFile& operator=(const TemporaryFile&) = delete;
+        ~TemporaryFile() {
+            if (!file) return;
+            std::fclose(file);
+            std::remove(path.c_str());
+        }
     };
 
     // Meshes, accessors and buffer views are only ever made here: kept in records of their own,
@@ -779,9 +784,8 @@ private:
     std::vector<AccessorRecord> accessors_;
     std::vector<ViewRecord> views_;
     std::vector<std::string> frozenExtras_;  ///< per node: its extras as JSON text (freezeExtras), or empty
-    std::string spillPath_, jsonSpillPath_;
-    std::unique_ptr<std::FILE, CloseFile> spill_;  ///< the binary chunk so far, at spillPath_
-    std::unique_ptr<std::FILE, CloseFile> jsonSpill_;  ///< the JSON chunk while it is written
+    TemporaryFile spill_;      ///< the binary chunk so far
+    TemporaryFile jsonSpill_;  ///< the JSON chunk while it is written
     std::vector<unsigned char> inMemory_;         ///< the same without a temporary file
     bool spillFailed_ = false;
     uint64_t binSize_ = 0;      ///< bytes of the binary chunk before its final padding
