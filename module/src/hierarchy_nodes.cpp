@@ -665,6 +665,9 @@ struct WorkItems {
     /// Optional: drops item j's result once it is in the cache, where nothing after needs it.
     std::function<void(size_t)> release;
     std::function<std::string(size_t)> name;
+    /// Optional: a relative estimate of make(j)'s time. The items are made largest first, so
+    /// that the last ones to finish are small ones (the results do not depend on the order).
+    std::function<double(size_t)> cost;
 };
 
 /// Layout of the proxies' cache entries and of their keys: a new layout never reads old ones.
@@ -940,9 +943,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             }
     }
 
-    // Leaves: the original objects.
+    // Leaves: the original objects (a share makes no tree: only whether a leaf has geometry).
     std::vector<HierarchyNode>& nodes = out.nodes;
     nodes.resize(objectCount);
+    std::vector<char> leafHasGeometry(objectCount, 0);
     for (size_t o = 0; o < objectCount; ++o) {
         HierarchyNode& n = nodes[o];
         n.leaf = true;
@@ -952,7 +956,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         const bool inHierarchy = levelCount > 0 && groupOf[0][o] != kNoNode;
         const bool finite = std::all_of(objects[o].positions.begin(), objects[o].positions.end(),
                                         [](double x) { return std::isfinite(x); });
-        if (inHierarchy && finite) {
+        leafHasGeometry[o] = inHierarchy && finite;
+        if (leafHasGeometry[o] && !share) {
             n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
             n.indices = objects[o].indices;
             if (detail::hasTriangleColors(objects[o])) n.faceColors = objects[o].triangleColors;
@@ -1035,6 +1040,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 std::vector<uint8_t> bytes;
                 if (memo.load(keys[j], bytes) && items.read(j, bytes)) {
                     ++memo.loaded;
+                    if (items.release) items.release(j);  // as for one made: nothing after needs it
                     return;
                 }
             }
@@ -1058,6 +1064,11 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             detail::prepareOriginal(objects[unprepared[j]], prepared[unprepared[j]]);
             isPrepared[unprepared[j]] = 1;
         });
+        if (items.cost) {
+            std::vector<double> costs(count, 0.0);
+            for (uint32_t j : toMake) costs[j] = items.cost(j);
+            std::stable_sort(toMake.begin(), toMake.end(), [&](uint32_t a, uint32_t b) { return costs[a] > costs[b]; });
+        }
         if (items.beforeMaking) items.beforeMaking(toMake);
         detail::parallelFor(toMake.size(), settings.threadCount, [&](size_t m) {
             const uint32_t j = toMake[m];
@@ -1083,7 +1094,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         for (uint32_t o : n.sources) t += double(objects[o].indices.size() / 3);
         return t;
     };
-    const auto hasLadder = [&](size_t o) { return nodes[o].parent != kNoNode && !nodes[o].positions.empty(); };
+    const auto hasLadder = [&](size_t o) { return nodes[o].parent != kNoNode && leafHasGeometry[o]; };
     const auto finish = [&](bool ok) {
         if (!ok) error = "the cache holds no result for " + missing + ": run the proxies' phase 1 first";
         // A share whose results are not kept did nothing; a whole bake just makes them again next time.
@@ -1107,7 +1118,16 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             return nodeKeys[i];
         };
         items.read = [&, which](size_t j, const std::vector<uint8_t>& bytes) {
-            return readAggregateProxy(bytes, nodes[which[j]], nullptr);
+            HierarchyNode& n = nodes[which[j]];
+            if (!readAggregateProxy(bytes, n, nullptr)) return false;
+            // A share of phase 2 needs an aggregate's error only (its ceilings); the items it
+            // makes read their aggregate's proxy again whole.
+            if (share && share->phase == 2) {
+                std::vector<float>().swap(n.positions);
+                std::vector<uint32_t>().swap(n.indices);
+                std::vector<float>().swap(n.faceColors);
+            }
+            return true;
         };
         items.make = [&, which](size_t j) {
             HierarchyNode& n = nodes[which[j]];
@@ -1126,6 +1146,19 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             const HierarchyNode& n = nodes[which[j]];
             return "the proxy of level " + std::to_string(n.firstLevel) + " aggregate " + std::to_string(n.aggregateIndex);
         };
+        items.cost = [&, which](size_t j) {
+            return double(nodes[which[j]].exactTriangleCount) + sourceTriangles(nodes[which[j]]);
+        };
+        // A share of phase 1 ends with its results in the cache: it holds none of them.
+        if (share && share->phase == 1)
+            items.release = [&, which](size_t j) {
+                HierarchyNode& n = nodes[which[j]];
+                std::vector<float>().swap(n.positions);
+                std::vector<uint32_t>().swap(n.indices);
+                std::vector<float>().swap(n.faceColors);
+                exactProxies[which[j]] = ExactProxy{};
+                exactHeld[which[j]] = 0;
+            };
         return items;
     };
     std::vector<uint32_t> groupNodes, singleNodes;
@@ -1167,6 +1200,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
         items.objects = [](size_t o, std::vector<char>& needed) { needed[o] = 1; };
         items.name = [&](size_t o) { return "the versions of object '" + objects[o].name + "'"; };
+        items.cost = [&](size_t o) { return double(objects[o].indices.size() / 3); };
+        if (share && share->phase == 1) items.release = [&](size_t o) { ladders[o] = VersionLadder{}; };
         if (!runItems(objectCount, items, 0.5, 0.75)) return finish(false);
     }
     if (share && share->phase == 1) return finish(true);
@@ -1290,6 +1325,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             for (uint32_t o : nodes[keptAggregates[j]].sources) needed[o] = 1;
         };
         items.name = [&](size_t j) { return "the coarser versions of node " + std::to_string(keptAggregates[j]); };
+        items.cost = [&](size_t j) {
+            const HierarchyNode& n = nodes[keptAggregates[j]];
+            return double(n.exactTriangleCount) + sourceTriangles(n);
+        };
         if (share) items.release = [&](size_t j) { coarser[keptAggregates[j]] = {}; };  // a share keeps nothing
         if (!runItems(keptAggregates.size(), items, 0.85, 1.0)) return finish(false);
     }

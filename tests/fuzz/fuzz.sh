@@ -8,7 +8,7 @@
 # A run first executes every mutant of its reader once (a call of its own, -runs=0), then
 # fuzzes a fresh copy of the seeds for SECONDS (AGGRELOD_FUZZ_SECONDS overrides), both with a
 # 2 GB memory limit; its exit status is non-zero on any finding (crash, sanitizer report, an
-# input running over 30 s, an allocation over the limit; ASan is not told to return null for a
+# input running over 30 s, an allocation over the limit, a file left in its temporary folder; ASan is not told to return null for a
 # request it refuses, so that is a finding too). Findings are kept in DIR/findings/TARGET.
 set -euo pipefail
 mode=$1
@@ -64,10 +64,19 @@ GLTF
     export ASAN_OPTIONS=detect_leaks=0
     export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
     cd "$findings"
+    # A private temporary folder: whatever a target leaves behind in it is a finding too.
+    export TMPDIR="$dir/tmp/$target"
+    rm -rf "$TMPDIR"
+    mkdir -p "$TMPDIR"
     limits=(-rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=30 -max_len=1048576 -artifact_prefix="$findings/")
     # Every mutant once, outside the timed run.
     "$dir/build/fuzz_$target" -runs=0 "${limits[@]}" "$dir/mutants/$target"
     "$dir/build/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 "${limits[@]}" "$corpus"
+    if [ -n "$(ls -A "$TMPDIR")" ]; then
+      echo "fuzz: fuzz_$target left files in its temporary folder:" >&2
+      ls -A "$TMPDIR" >&2
+      exit 1
+    fi
     ;;
   *)
     echo "usage: fuzz.sh build|seeds|run ..." >&2

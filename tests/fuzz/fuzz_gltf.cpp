@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // libFuzzer target: the glTF import (GLB or .gltf text) through readGltfScene, as the bake
-// reads a file. The input is written to a private folder; its uris may name files there only.
+// reads a file. The input is written to a private folder (under $TMPDIR, else /tmp, removed at
+// exit); its uris may name files there only.
 #include "scene_io.h"
 
 #include <cstdint>
@@ -11,18 +12,33 @@
 #include <unistd.h>
 
 namespace {
-std::string scratchFolder() {
-    static std::string folder = [] {
-        char pattern[] = "/tmp/aggrelod-fuzz-gltf-XXXXXX";
-        const char* made = ::mkdtemp(pattern);
-        return std::string(made ? made : "/tmp");
+/// The private folder, made on first use; kept in a string that is never destroyed, so the
+/// exit handler that removes the folder can still read it.
+const std::string& scratchFolder();
+
+void removeScratchFolder() {
+    const std::string& folder = scratchFolder();
+    std::remove((folder + "/scene.glb").c_str());
+    std::remove((folder + "/scene.gltf").c_str());
+    ::rmdir(folder.c_str());
+}
+
+const std::string& scratchFolder() {
+    static const std::string* folder = [] {
+        const char* base = std::getenv("TMPDIR");
+        std::string pattern = std::string(base && *base ? base : "/tmp") + "/aggrelod-fuzz-gltf-XXXXXX";
+        if (!::mkdtemp(pattern.data())) return new std::string();
+        // libFuzzer ends through exit(): the folder and the two inputs go with the process.
+        std::atexit(removeScratchFolder);
+        return new std::string(pattern);
     }();
-    return folder;
+    return *folder;
 }
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool glb = size >= 4 && data[0] == 'g' && data[1] == 'l' && data[2] == 'T' && data[3] == 'F';
+    if (scratchFolder().empty()) return 0;
     const std::string path = scratchFolder() + (glb ? "/scene.glb" : "/scene.gltf");
     FILE* f = std::fopen(path.c_str(), "wb");
     if (!f) return 0;
