@@ -848,20 +848,48 @@ bool readCoarser(const std::vector<uint8_t>& bytes, std::vector<HierarchyNode>& 
     return true;
 }
 
-/// The share (ProxyShare::part) of each work item of a phase: heaviest expected work first,
-/// each to the share with the least so far (ties: the lower share), so that no share is left
-/// with a heavy item on top of its part. `costs`: estimated work per item (triangles to
-/// measure). Deterministic: every share computes the same assignment.
-std::vector<uint32_t> assignShares(const std::vector<double>& costs, uint32_t parts) {
+/// Bits of x's low 21 bits spread three apart (for a 63-bit Morton key).
+uint64_t spreadBits(uint64_t x) {
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffULL;
+    x = (x | x << 16) & 0x1f0000ff0000ffULL;
+    x = (x | x << 8) & 0x100f00f00f00f00fULL;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+    x = (x | x << 2) & 0x1249249249249249ULL;
+    return x;
+}
+
+/// The share (ProxyShare::part) of each work item of a phase: the items in Morton order of
+/// their centres (`centres`, inside the box lo..hi), cut into `parts` runs of about equal
+/// estimated work (`costs`: triangles to measure). Items near each other go to one share, so
+/// a share measures against the originals of its part of the world only (it prepares their
+/// search structures) rather than against nearly all of them. Deterministic: every share
+/// computes the same assignment.
+std::vector<uint32_t> assignShares(const std::vector<double>& costs, const std::vector<std::array<double, 3>>& centres,
+                                   const double lo[3], const double hi[3], uint32_t parts) {
+    std::vector<uint64_t> key(costs.size(), 0);
+    for (size_t j = 0; j < costs.size(); ++j) {
+        uint64_t code = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double extent = hi[k] - lo[k];
+            double t = extent > 0 ? (centres[j][k] - lo[k]) / extent : 0.0;
+            t = std::isfinite(t) ? std::clamp(t, 0.0, 1.0) : 0.0;
+            code |= spreadBits(static_cast<uint64_t>(t * double(0x1fffff))) << k;
+        }
+        key[j] = code;
+    }
     std::vector<uint32_t> order(costs.size());
     for (uint32_t j = 0; j < order.size(); ++j) order[j] = j;
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return costs[a] > costs[b]; });
-    std::vector<double> load(parts, 0.0);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key[a] < key[b]; });
+    double total = 0;
+    for (double c : costs) total += c;
     std::vector<uint32_t> shareOf(costs.size(), 0);
+    double before = 0;
     for (uint32_t j : order) {
-        const uint32_t least = static_cast<uint32_t>(std::min_element(load.begin(), load.end()) - load.begin());
-        shareOf[j] = least;
-        load[least] += costs[j];
+        // By the middle of the item's work: a heavy item goes where most of it falls.
+        const double middle = before + 0.5 * costs[j];
+        shareOf[j] = total > 0 ? std::min(parts - 1, static_cast<uint32_t>(double(parts) * middle / total)) : 0;
+        before += costs[j];
     }
     return shareOf;
 }
@@ -1086,6 +1114,24 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         });
         return true;
     };
+    // Where each object is, for a share to take the items of one part of the world.
+    std::vector<std::array<double, 6>> objectBox(share ? objectCount : 0);
+    double worldLo[3] = {INFINITY, INFINITY, INFINITY}, worldHi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t o = 0; o < objectBox.size(); ++o) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        if (leafHasGeometry[o])
+            for (size_t i = 0; i + 2 < objects[o].positions.size(); i += 3) growBox(lo, hi, &objects[o].positions[i]);
+        for (int k = 0; k < 3; ++k) {
+            objectBox[o][k] = lo[k], objectBox[o][3 + k] = hi[k];
+            worldLo[k] = std::min(worldLo[k], lo[k]), worldHi[k] = std::max(worldHi[k], hi[k]);
+        }
+    }
+    const auto centreOf = [&](const HierarchyNode& n) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (uint32_t o : n.sources)
+            for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], objectBox[o][k]), hi[k] = std::max(hi[k], objectBox[o][3 + k]);
+        return std::array<double, 3>{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+    };
     // Which items of a phase are this share's (assignShares); all of them without a share.
     std::vector<uint32_t> shareOf;
     const auto mine = [&](size_t j) { return !share || shareOf[j] == share->part ? Work::Obtain : Work::Skip; };
@@ -1167,10 +1213,16 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     const bool phaseOne = !share || share->phase == 1;
     if (share && phaseOne) {  // the groups' proxies, then the objects' versions
         std::vector<double> costs;
-        for (uint32_t i : groupNodes) costs.push_back(double(nodes[i].exactTriangleCount) + sourceTriangles(nodes[i]));
-        for (size_t o = 0; o < objectCount; ++o)
+        std::vector<std::array<double, 3>> centres;
+        for (uint32_t i : groupNodes) {
+            costs.push_back(double(nodes[i].exactTriangleCount) + sourceTriangles(nodes[i]));
+            centres.push_back(centreOf(nodes[i]));
+        }
+        for (size_t o = 0; o < objectCount; ++o) {
             costs.push_back(hasLadder(o) ? kLadderCostPerTriangle * double(objects[o].indices.size() / 3) : 0.0);
-        shareOf = assignShares(costs, share->parts);
+            centres.push_back(centreOf(nodes[o]));
+        }
+        shareOf = assignShares(costs, centres, worldLo, worldHi, share->parts);
     }
     if (!runItems(groupNodes.size(), aggregateItems(groupNodes, phaseOne ? std::function<Work(size_t)>(mine) : [](size_t) { return Work::LoadOnly; }),
                   0.0, 0.5))
@@ -1250,16 +1302,17 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     std::vector<uint32_t> shareOfNode(share ? nodes.size() : 0, 0);
     if (share) {
         std::vector<double> costs;
+        std::vector<std::array<double, 3>> centres;
         std::vector<uint32_t> unitOf(keptAggregates.size()), unitOfObject(objectCount, kNoNode);
         for (size_t j = 0; j < keptAggregates.size(); ++j) {
             const HierarchyNode& n = nodes[keptAggregates[j]];
             uint32_t& single = unitOfObject[n.sources.front()];
-            if (n.sources.size() > 1 || single == kNoNode) costs.push_back(0.0);
+            if (n.sources.size() > 1 || single == kNoNode) costs.push_back(0.0), centres.push_back(centreOf(n));
             if (n.sources.size() == 1 && single == kNoNode) single = static_cast<uint32_t>(costs.size() - 1);
             unitOf[j] = n.sources.size() == 1 ? single : static_cast<uint32_t>(costs.size() - 1);
             costs[unitOf[j]] += double(n.exactTriangleCount) + sourceTriangles(n);
         }
-        const std::vector<uint32_t> unitShare = assignShares(costs, share->parts);
+        const std::vector<uint32_t> unitShare = assignShares(costs, centres, worldLo, worldHi, share->parts);
         for (size_t j = 0; j < keptAggregates.size(); ++j) shareOfNode[keptAggregates[j]] = unitShare[unitOf[j]];
     }
     const auto mineInPhaseTwo = [&](uint32_t node) {
