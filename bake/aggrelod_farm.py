@@ -82,7 +82,8 @@ def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, thr
     plan = json.loads(run_piece(base + ["--tile-task", "plan", "--quiet"]))
     if plan["tiled"]:
         # Shares of the proxies: one per worker thread (each share reads the whole hierarchy;
-        # the bake balances their estimated work). The result does not depend on their number.
+        # the bake gives each a part of the world of about equal estimated work). The result
+        # does not depend on their number.
         slots = max(1, sum(client.nthreads().values()))
         for wave in piece_commands(plan, slots):
             started = time.monotonic()

@@ -661,7 +661,6 @@ struct WorkItems {
     std::function<void(size_t)> make;
     std::function<void(size_t, std::vector<uint8_t>&)> write;
     std::function<void(size_t, std::vector<char>&)> objects;  ///< marks the objects make(j) measures against
-    std::function<void(const std::vector<uint32_t>&)> beforeMaking;  ///< optional, with the items to make
     /// Optional: drops item j's result once it is in the cache, where nothing after needs it.
     std::function<void(size_t)> release;
     std::function<std::string(size_t)> name;
@@ -1097,7 +1096,6 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             for (uint32_t j : toMake) costs[j] = items.cost(j);
             std::stable_sort(toMake.begin(), toMake.end(), [&](uint32_t a, uint32_t b) { return costs[a] > costs[b]; });
         }
-        if (items.beforeMaking) items.beforeMaking(toMake);
         detail::parallelFor(toMake.size(), settings.threadCount, [&](size_t m) {
             const uint32_t j = toMake[m];
             items.make(j);
@@ -1236,6 +1234,16 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         if (r.objects.size() == 1 && r.objects.front() < objectCount) standInOf[r.objects.front()] = &r;
     std::vector<VersionLadder> ladders(objectCount);
     std::vector<char> ladderWhole(objectCount, 0);  // with the versions' exact vertices (made, not read lean)
+    std::vector<char> chained(objectCount, 0);  // the object has a per-object LOD chain
+    std::vector<uint32_t> firstGroup(objectCount, kNoNode);  // first ancestor with several objects
+    for (size_t o = 0; o < objectCount; ++o) {
+        uint32_t up = nodes[o].parent;
+        while (up != kNoNode && nodes[up].sources.size() == 1) up = nodes[up].parent;
+        firstGroup[o] = up;
+    }
+    const auto ceilingOfChain = [&](size_t o) {
+        return firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
+    };
     std::vector<std::string> ladderKeys(memo.on() ? objectCount : 0, std::string("-"));
     {
         WorkItems items;
@@ -1244,7 +1252,16 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
         };
         items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
-        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) { return readLadder(bytes, ladders[o], false); };
+        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) {
+            if (!readLadder(bytes, ladders[o], false)) return false;
+            // A share of phase 2 needs only whether the object has a chain (the groups' errors
+            // are read by now): known at once, the ladder need not wait for all the others.
+            if (share && share->phase == 2) {
+                chained[o] = !chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceilingOfChain(o), settings).empty();
+                ladders[o] = VersionLadder{};
+            }
+            return true;
+        };
         items.make = [&](size_t o) {
             ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
             ladderWhole[o] = 1;
@@ -1262,19 +1279,11 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // alone (the object with its concavities filled), up to its first aggregate with other
     // objects; those single-object aggregates stay only where the object has no chain.
     std::vector<std::vector<HierarchyNode>> chains(objectCount);
-    std::vector<char> chained(objectCount, 0);
-    std::vector<uint32_t> firstGroup(objectCount, kNoNode);  // first ancestor with several objects
-    for (size_t o = 0; o < objectCount; ++o) {
-        uint32_t up = nodes[o].parent;
-        while (up != kNoNode && nodes[up].sources.size() == 1) up = nodes[up].parent;
-        firstGroup[o] = up;
-    }
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (ladders[o].versions.empty()) return;
-        const double ceiling = firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
-        std::vector<HierarchyNode> chain = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceiling, settings);
+        std::vector<HierarchyNode> chain = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceilingOfChain(o), settings);
         // A ladder read without its exact vertices has given all it can: coarser versions to
-        // be made read it again whole (beforeMaking), so it need not be held beside its chain.
+        // be made read it again whole, each for itself, so it need not be held beside its chain.
         if (!ladderWhole[o]) ladders[o] = VersionLadder{};
         chained[o] = !chain.empty();
         if (share) return;  // only whether there is a chain matters to a share
@@ -1343,8 +1352,24 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 if (!(memo.on() && memo.load(nodeKeys[i], bytes) && readAggregateProxy(bytes, again, &exactProxies[i])))
                     makeAggregateProxy(aggregateOf(n), originalsOf(n), settings, again, exactProxies[i]);
             }
+            // The versions of its objects, for a group small enough to be united from them
+            // (coarserChain): a ladder read without its exact vertices is read again whole for
+            // this item alone (or, should the entry have gone meanwhile, made again: the same).
+            const bool unitable = n.sources.size() >= 2 && n.sources.size() <= kUnionMaxObjects;
+            std::vector<VersionLadder> reread;
+            reread.reserve(unitable ? n.sources.size() : 0);  // no reallocation: pointers into it are kept
             std::vector<const VersionLadder*> sourceLadders;
-            for (uint32_t o : n.sources) sourceLadders.push_back(ladders[o].versions.empty() ? nullptr : &ladders[o]);
+            for (uint32_t o : n.sources) {
+                const VersionLadder* ladder = &ladders[o];
+                if (unitable && !ladderWhole[o] && hasLadder(o)) {
+                    VersionLadder& whole = reread.emplace_back();
+                    std::vector<uint8_t> bytes;
+                    if (!(memo.on() && memo.load(ladderKeys[o], bytes) && readLadder(bytes, whole, true)))
+                        whole = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+                    ladder = &whole;
+                }
+                sourceLadders.push_back(ladder->versions.empty() ? nullptr : ladder);
+            }
             coarser[i] = coarserChain(n, exactProxies[i], aggregateOf(n).componentCount, originalsOf(n), sourceLadders,
                                       ceilingOf(n), settings);
             exactProxies[i] = ExactProxy{};
@@ -1355,25 +1380,6 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             }
         };
         items.write = [&](size_t j, std::vector<uint8_t>& bytes) { writeCoarser(coarser[keptAggregates[j]], bytes); };
-        // The ladders read without their exact vertices that are needed now: those of groups
-        // small enough to be united from their objects' versions (coarserChain; several items
-        // share one). Read again whole (or, should the entry have gone meanwhile, made again).
-        items.beforeMaking = [&](const std::vector<uint32_t>& toMake) {
-            std::vector<uint32_t> lackingLadders;
-            std::vector<char> lacking(objectCount, 0);
-            for (uint32_t j : toMake) {
-                const std::vector<uint32_t>& sources = nodes[keptAggregates[j]].sources;
-                if (sources.size() < 2 || sources.size() > kUnionMaxObjects) continue;
-                for (uint32_t o : sources)
-                    if (!ladderWhole[o] && hasLadder(o) && !lacking[o]) lacking[o] = 1, lackingLadders.push_back(o);
-            }
-            detail::parallelFor(lackingLadders.size(), settings.threadCount, [&](size_t k) {
-                const uint32_t o = lackingLadders[k];
-                std::vector<uint8_t> bytes;
-                if (!(memo.on() && memo.load(ladderKeys[o], bytes) && readLadder(bytes, ladders[o], true)))
-                    ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
-            });
-        };
         items.objects = [&](size_t j, std::vector<char>& needed) {
             for (uint32_t o : nodes[keptAggregates[j]].sources) needed[o] = 1;
         };
