@@ -1091,6 +1091,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             detail::prepareOriginal(objects[unprepared[j]], prepared[unprepared[j]]);
             isPrepared[unprepared[j]] = 1;
         });
+        out.originalsPrepared += unprepared.size();
         if (items.cost) {
             std::vector<double> costs(count, 0.0);
             for (uint32_t j : toMake) costs[j] = items.cost(j);
@@ -1492,7 +1493,7 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
 
 bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                      const ProxySettings& settings, const ProxyShare& share, std::string& error, size_t* made,
-                     size_t* loaded) {
+                     size_t* loaded, size_t* prepared) {
     if (!(share.phase == 1 || share.phase == 2) || share.parts == 0 || share.part >= share.parts) {
         error = "proxy share " + std::to_string(share.phase) + ":" + std::to_string(share.part) + ":" +
                 std::to_string(share.parts) + " is out of range (phase 1 or 2, part below parts)";
@@ -1506,6 +1507,7 @@ bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject
     const bool ok = buildNodes(hierarchy, objects, settings, &share, nodes, error);
     if (made) *made = nodes.proxyItemsMade;
     if (loaded) *loaded = nodes.proxyItemsLoaded;
+    if (prepared) *prepared = nodes.originalsPrepared;
     return ok;
 }
 

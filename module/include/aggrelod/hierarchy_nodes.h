@@ -130,6 +130,8 @@ struct HierarchyNodes {
     std::vector<std::vector<uint32_t>> nodeOfAggregate;
     /// Work items of the proxies made in this run and read from ProxySettings::cache.
     size_t proxyItemsMade = 0, proxyItemsLoaded = 0;
+    /// Originals whose search structures this run built (for the items it made).
+    size_t originalsPrepared = 0;
 };
 
 /// One share of buildHierarchyNodes's work, for processes that share ProxySettings::cache
@@ -155,13 +157,15 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
 
 /// Makes one share of the proxies of `hierarchy` into settings.cache (required) and nothing
 /// else; buildHierarchyNodes with the same cache afterwards makes only what no share made.
-/// `made` and `loaded` (optional) count the share's work items. Returns false with a message
+/// `made` and `loaded` (optional) count the share's work items, `prepared` (optional) the
+/// originals it built search structures for (a share takes the items of one part of the
+/// world, so about its part of them). Returns false with a message
 /// in `error` for what buildHierarchyNodes refuses, a share out of range, no cache, or (phase
 /// 2) a phase-1 item missing from the cache, named. The cache's entries do not depend on how
 /// the work was shared.
 bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                      const ProxySettings& settings, const ProxyShare& share, std::string& error,
-                     size_t* made = nullptr, size_t* loaded = nullptr);
+                     size_t* made = nullptr, size_t* loaded = nullptr, size_t* prepared = nullptr);
 
 /// The aggregate node that coarser version `node` simplifies (the end of its chain of single
 /// children); `node` itself when it is not a coarser version. `node` < nodes.nodes.size().
