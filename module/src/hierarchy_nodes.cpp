@@ -118,6 +118,14 @@ bool sameSolid(const Aggregate& a, const Aggregate& b) {
 }
 
 
+/// Frees a node's proxy mesh (keeps its error and the rest): for a share, whose results are
+/// in the cache.
+void dropMesh(HierarchyNode& n) {
+    std::vector<float>().swap(n.positions);
+    std::vector<uint32_t>().swap(n.indices);
+    std::vector<float>().swap(n.faceColors);
+}
+
 std::vector<float> toFloats(const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); }
 
 /// Largest distance a vertex moved when rounded to float (world units). Every point of the
@@ -1134,8 +1142,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // Which items of a phase are this share's (assignShares); all of them without a share.
     std::vector<uint32_t> shareOf;
     const auto mine = [&](size_t j) { return !share || shareOf[j] == share->part ? Work::Obtain : Work::Skip; };
-    const auto sourceTriangles = [&](const HierarchyNode& n) {
-        double t = 0;
+    // Estimated work of an aggregate's items: the triangles its proxies are measured over
+    // (its own and its originals').
+    const auto aggregateWork = [&](const HierarchyNode& n) {
+        double t = double(n.exactTriangleCount);
         for (uint32_t o : n.sources) t += double(objects[o].indices.size() / 3);
         return t;
     };
@@ -1167,11 +1177,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             if (!readAggregateProxy(bytes, n, nullptr)) return false;
             // A share of phase 2 needs an aggregate's error only (its ceilings); the items it
             // makes read their aggregate's proxy again whole.
-            if (share && share->phase == 2) {
-                std::vector<float>().swap(n.positions);
-                std::vector<uint32_t>().swap(n.indices);
-                std::vector<float>().swap(n.faceColors);
-            }
+            if (share && share->phase == 2) dropMesh(n);
             return true;
         };
         items.make = [&, which](size_t j) {
@@ -1191,16 +1197,11 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             const HierarchyNode& n = nodes[which[j]];
             return "the proxy of level " + std::to_string(n.firstLevel) + " aggregate " + std::to_string(n.aggregateIndex);
         };
-        items.cost = [&, which](size_t j) {
-            return double(nodes[which[j]].exactTriangleCount) + sourceTriangles(nodes[which[j]]);
-        };
+        items.cost = [&, which](size_t j) { return aggregateWork(nodes[which[j]]); };
         // A share of phase 1 ends with its results in the cache: it holds none of them.
         if (share && share->phase == 1)
             items.release = [&, which](size_t j) {
-                HierarchyNode& n = nodes[which[j]];
-                std::vector<float>().swap(n.positions);
-                std::vector<uint32_t>().swap(n.indices);
-                std::vector<float>().swap(n.faceColors);
+                dropMesh(nodes[which[j]]);
                 exactProxies[which[j]] = ExactProxy{};
                 exactHeld[which[j]] = 0;
             };
@@ -1214,7 +1215,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         std::vector<double> costs;
         std::vector<std::array<double, 3>> centres;
         for (uint32_t i : groupNodes) {
-            costs.push_back(double(nodes[i].exactTriangleCount) + sourceTriangles(nodes[i]));
+            costs.push_back(aggregateWork(nodes[i]));
             centres.push_back(centreOf(nodes[i]));
         }
         for (size_t o = 0; o < objectCount; ++o) {
@@ -1320,7 +1321,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             if (n.sources.size() > 1 || single == kNoNode) costs.push_back(0.0), centres.push_back(centreOf(n));
             if (n.sources.size() == 1 && single == kNoNode) single = static_cast<uint32_t>(costs.size() - 1);
             unitOf[j] = n.sources.size() == 1 ? single : static_cast<uint32_t>(costs.size() - 1);
-            costs[unitOf[j]] += double(n.exactTriangleCount) + sourceTriangles(n);
+            costs[unitOf[j]] += aggregateWork(n);
         }
         const std::vector<uint32_t> unitShare = assignShares(costs, centres, worldLo, worldHi, share->parts);
         for (size_t j = 0; j < keptAggregates.size(); ++j) shareOfNode[keptAggregates[j]] = unitShare[unitOf[j]];
@@ -1385,10 +1386,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             for (uint32_t o : nodes[keptAggregates[j]].sources) needed[o] = 1;
         };
         items.name = [&](size_t j) { return "the coarser versions of node " + std::to_string(keptAggregates[j]); };
-        items.cost = [&](size_t j) {
-            const HierarchyNode& n = nodes[keptAggregates[j]];
-            return double(n.exactTriangleCount) + sourceTriangles(n);
-        };
+        items.cost = [&](size_t j) { return aggregateWork(nodes[keptAggregates[j]]); };
         if (share) items.release = [&](size_t j) { coarser[keptAggregates[j]] = {}; };  // a share keeps nothing
         if (!runItems(keptAggregates.size(), items, 0.85, 1.0)) return finish(false);
     }
