@@ -75,7 +75,9 @@ bool meshToArrays(const Mesh& mesh, std::vector<double>& outPositions, std::vect
 /// always of a ball far from it) and "does this tetrahedron meet the input?" (mostly not).
 /// A query is answered here only when a double-precision test decides it with a margin far
 /// above its rounding error; every other one goes to CGAL's exact one. The answers are
-/// therefore CGAL's, and so is the wrap, bit for bit; only faster.
+/// therefore CGAL's. With `constructions`, the closest points and the offset surface's
+/// crossings (the Steiner points) are computed on this oracle's BVH too: the same points up to
+/// rounding, so the wrap is no longer CGAL's bit for bit (see WrapOracle).
 template <class Kernel>
 class QuickOracle : public CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<Kernel> {
     using Base = CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<Kernel>;
@@ -83,9 +85,10 @@ class QuickOracle : public CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<K
 
 public:
     /// points: the input's corners; faces: its triangles, as given to add_triangle_soup.
+    /// constructions: closest points and offset crossings on this oracle's BVH (else CGAL's).
     QuickOracle(double alpha, const std::vector<double>& positions, const std::vector<typename Kernel::Point_3>& points,
-                const std::vector<std::array<size_t, 3>>& faces)
-        : Base(alpha, Kernel()) {
+                const std::vector<std::array<size_t, 3>>& faces, bool constructions)
+        : Base(alpha, Kernel()), constructions_(constructions) {
         // The same triangles as CGAL's soup: it leaves out the exactly degenerate ones (CGAL
         // tests each original triangle; its splitting only makes tighter boxes).
         std::vector<uint32_t> kept, forBalls;
@@ -139,6 +142,47 @@ public:
         return Base::do_intersect(query);
     }
 
+    using Point = typename Kernel::Point_3;
+    using FT = typename Kernel::FT;
+
+    // CGAL's own tree is slow on closest points (most of a wrap's time on inputs of many
+    // triangles: the Steiner points need them). Distances are taken on the BVH with slivers
+    // as their edges, whose distances are exact (a sliver's computed normal is mostly
+    // rounding).
+
+    /// The input's closest point to p.
+    Point closest_point(const Point& p) const {
+        if (!constructions_) return Base::closest_point(p);
+        const double c[3] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+        const ClosestPoint nearest = closestPoint(distanceBvh(), c);
+        return Point(nearest.point[0], nearest.point[1], nearest.point[2]);
+    }
+
+    /// The squared distance from p to the input.
+    FT squared_distance(const Point& p) const {
+        if (!constructions_) return Base::squared_distance(p);
+        const double c[3] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+        const double d = closestPoint(distanceBvh(), c).distance;
+        return d * d;
+    }
+
+    /// The first point of segment pq at distance `offset` from the input: CGAL's own search
+    /// (Offset_intersection, to within 1 % of the offset as CGAL's oracle asks it), with the
+    /// distances from this oracle's BVH.
+    bool first_intersection(const Point& p, const Point& q, Point& o, const FT offset) const {
+        if (!constructions_) return Base::first_intersection(p, q, o, offset);
+        struct Distance {
+            const TriangleBvh* bvh;
+            FT operator()(const Point& x) const {
+                const double c[3] = {CGAL::to_double(x.x()), CGAL::to_double(x.y()), CGAL::to_double(x.z())};
+                return closestPoint(*bvh, c).distance;
+            }
+        };
+        CGAL::Alpha_wraps_3::internal::Offset_intersection<Kernel, Distance> search(Distance{&distanceBvh()}, offset,
+                                                                                   1e-2 * offset, 1);
+        return search.first_intersection(p, q, o);
+    }
+
     bool do_intersect(const Ball& ball) const {
         const auto& sphere = ball.boundary();
         const double c[3] = {CGAL::to_double(sphere.center().x()), CGAL::to_double(sphere.center().y()),
@@ -157,7 +201,8 @@ public:
     bool do_intersect(const CGAL::Alpha_wraps_3::internal::Tetrahedron_with_outside_info<K2>& tet) const {
         // False when every input triangle near the tetrahedron is apart from the solid
         // tetrahedron by a separating axis with room to spare (then none meets a face of it or
-        // lies inside it: CGAL's answer is false too); else CGAL's test.
+        // lies inside it: CGAL's answer is false too); true when one surely meets it as CGAL
+        // counts it (surelyMeets); else CGAL's test.
         double v[4][3];
         for (int i = 0; i < 4; ++i)
             for (int k = 0; k < 3; ++k) v[i][k] = CGAL::to_double(tet.m_tet[i][k]);
@@ -178,6 +223,7 @@ public:
         thread_local std::vector<uint32_t> stack;
         stack.clear();
         stack.push_back(0);
+        bool undecided = false;
         while (!stack.empty()) {
             const TriangleBvh::Node& node = nodes[stack.back()];
             stack.pop_back();
@@ -189,13 +235,79 @@ public:
                 stack.push_back(node.first + 1);
                 continue;
             }
-            for (uint32_t i = 0; i < node.count; ++i)
-                if (!separated(v, bvh_.slotCorners(node.first + i), m)) return Base::do_intersect(tet);
+            for (uint32_t i = 0; i < node.count; ++i) {
+                const double* t = bvh_.slotCorners(node.first + i);
+                if (separated(v, t, m)) continue;
+                if (surelyMeets(v, tet.m_b, t)) return true;
+                undecided = true;
+            }
+        }
+        return undecided ? Base::do_intersect(tet) : false;
+    }
+
+private:
+    /// The orientation of d against plane abc (the signed volume det(b - a, c - a, d - a)),
+    /// or 0 when rounding could change its sign: the determinant errs by a few ulps of the
+    /// product of its vectors' lengths (each difference of two doubles is rounded once).
+    static double orientation(const double* a, const double* b, const double* c, const double* d) {
+        double u[3], w[3], x[3];
+        for (int k = 0; k < 3; ++k) {
+            u[k] = b[k] - a[k];
+            w[k] = c[k] - a[k];
+            x[k] = d[k] - a[k];
+        }
+        const double det = u[0] * (w[1] * x[2] - w[2] * x[1]) - u[1] * (w[0] * x[2] - w[2] * x[0]) +
+                           u[2] * (w[0] * x[1] - w[1] * x[0]);
+        const double bound = 1e-10 * std::sqrt((u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) *
+                                               (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) *
+                                               (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]));
+        return std::fabs(det) > bound ? det : 0.0;
+    }
+
+    /// Whether segment pq crosses triangle abc through their interiors, decided with room to
+    /// spare (false when rounding could matter).
+    static bool surelyCrosses(const double* p, const double* q, const double* a, const double* b, const double* c) {
+        const double sp = orientation(a, b, c, p), sq = orientation(a, b, c, q);
+        if (sp == 0 || sq == 0 || (sp > 0) == (sq > 0)) return false;
+        const double s1 = orientation(p, q, a, b), s2 = orientation(p, q, b, c), s3 = orientation(p, q, c, a);
+        if (s1 == 0 || s2 == 0 || s3 == 0) return false;
+        return (s1 > 0) == (s2 > 0) && (s2 > 0) == (s3 > 0);
+    }
+
+    /// Whether input triangle t (9 doubles) meets tetrahedron v as CGAL's query counts it, with
+    /// room to spare: t crosses a face not shared with an outside cell (`outside` bit i: face i,
+    /// opposite vertex i), or t lies inside. CGAL splits input triangles into smaller pieces
+    /// and asks each piece whether it meets such a face or has its first corner inside: a
+    /// crossing with room to spare lies in some piece, and a triangle inside has every piece
+    /// inside, so CGAL's answer is true too.
+    template <class Bits>
+    static bool surelyMeets(const double v[4][3], const Bits& outside, const double* t) {
+        bool inside = true;
+        for (int i = 0; i < 4 && inside; ++i) {
+            const double* a = v[(i + 1) & 3];
+            const double* b = v[(i + 2) & 3];
+            const double* c = v[(i + 3) & 3];
+            const double own = orientation(a, b, c, v[i]);
+            for (int corner = 0; corner < 3 && inside; ++corner) {
+                const double o = orientation(a, b, c, t + 3 * corner);
+                inside = own != 0 && o != 0 && (o > 0) == (own > 0);
+            }
+        }
+        if (inside) return true;
+        for (int i = 0; i < 4; ++i) {
+            if (outside.test(i)) continue;
+            const double* a = v[(i + 1) & 3];
+            const double* b = v[(i + 2) & 3];
+            const double* c = v[(i + 3) & 3];
+            for (int e = 0; e < 3; ++e) {
+                if (surelyCrosses(t + 3 * e, t + 3 * ((e + 1) % 3), a, b, c)) return true;
+                const double* face[3] = {a, b, c};
+                if (surelyCrosses(face[e], face[(e + 1) % 3], t, t + 3, t + 6)) return true;
+            }
         }
         return false;
     }
 
-private:
     /// A separating axis between tetrahedron v and triangle t (9 doubles) with a gap wider
     /// than `margin` (a length): the face normals of both and the cross products of their
     /// edges (Gottschalk et al. 1996; Ericson, Real-Time Collision Detection, 5.2.1).
@@ -250,6 +362,9 @@ private:
         return false;
     }
 
+    const TriangleBvh& distanceBvh() const { return ballBvh_ ? *ballBvh_ : bvh_; }
+
+    bool constructions_ = false;           ///< closest points and crossings on the BVH
     TriangleBvh bvh_;                      ///< the input's triangles (tetrahedron queries)
     std::unique_ptr<TriangleBvh> ballBvh_;  ///< the same with slivers as their edges, if any
     double sliverWidth_ = 0;                ///< the widest sliver's width (world units)
@@ -295,9 +410,9 @@ bool alphaWrap(const std::vector<double>& positions, const std::vector<uint32_t>
     }
     Mesh wrap;
     try {
-        if (oracle == WrapOracle::Quick) {
+        if (oracle != WrapOracle::Cgal) {
             // As CGAL::alpha_wrap_3 does it, with the quicker oracle.
-            QuickOracle<Kernel> quick(alpha, positions, points, faces);
+            QuickOracle<Kernel> quick(alpha, positions, points, faces, oracle == WrapOracle::Quick);
             quick.add_triangle_soup(points, faces, CGAL::parameters::default_values());
             CGAL::Alpha_wraps_3::internal::Alpha_wrap_3<QuickOracle<Kernel>> wrapper(quick);
             wrapper(alpha, offset, wrap, CGAL::parameters::default_values());

@@ -7,8 +7,9 @@
 // bake's peak (getrusage; each scene runs in its own process), and per scene the solids' added volume and sampled Hausdorff
 // distance (worst solid, in % of its own bounding-box diagonal). With --solids, one line per
 // solid with its own time, and for each wrap the time of the same wrap (one thread) with the
-// quick oracle the bake uses and with CGAL's own exact queries, and whether both give the same
-// wrap. A benchmark: nothing is asserted.
+// quick oracle the bake uses and with CGAL's own queries, and the triangles of both wraps
+// (the quick oracle's Steiner points differ from CGAL's by rounding). A benchmark: nothing is
+// asserted.
 //
 // Usage: bench_solidify [--threads 2] [--data DIR] [--solids] [SCENE.glb|gltf ...]
 //   (default scenes: every real scene under DIR/3d)
@@ -138,7 +139,7 @@ int main(int argc, char** argv) {
                             r.seconds, r.alpha, r.offset, r.triangles.size() / 3,
                             100 * std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid) / r.bboxDiagonal);
                 if (r.method == SolidifyMethod::Wrap) {
-                    // The same wrap of the objects as read, with either oracle.
+                    // The wrap of the objects as read, with either oracle.
                     std::vector<double> positions;
                     std::vector<uint32_t> triangles;
                     for (uint32_t o : r.objects) {
@@ -156,9 +157,8 @@ int main(int argc, char** argv) {
                                           k == 0 ? detail::WrapOracle::Quick : detail::WrapOracle::Cgal);
                         seconds[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
                     }
-                    const bool same = outPositions[0] == outPositions[1] && outTriangles[0] == outTriangles[1];
-                    std::printf("  wrap %.2f s, with CGAL's queries %.2f s (%.1fx), %s", seconds[0], seconds[1],
-                                seconds[1] / seconds[0], same ? "same wrap" : "DIFFERENT WRAP");
+                    std::printf("  wrap %.2f s, with CGAL's queries %.2f s (%.1fx), %zu / %zu tris", seconds[0], seconds[1],
+                                seconds[1] / seconds[0], outTriangles[0].size() / 3, outTriangles[1].size() / 3);
                 }
                 std::printf("\n");
             }
