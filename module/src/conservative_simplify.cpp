@@ -794,10 +794,13 @@ bool meshSelfIntersects(const std::vector<double>& positions, const std::vector<
 }
 
 bool simplifyConservativeClean(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
-                               double maxError, std::vector<char>& pinned, int maxRounds, ConservativeSnapshot& out) {
+                               double maxError, std::vector<char>& pinned, int maxRounds, ConservativeSnapshot& out,
+                               int* rounds) {
     pinned.resize(positions.size() / 3, 0);
     std::vector<uint32_t> source;
+    if (rounds) *rounds = 0;
     for (int round = 0; round < maxRounds; ++round) {
+        if (rounds) *rounds = round + 1;
         Simplifier simplifier(positions, indices, &pinned);
         ConservativeSimplifyResult result;
         simplifier.run(maxError, 0, result);

@@ -51,12 +51,14 @@ ConservativeSimplifyResult simplifyConservativeSeries(const std::vector<double>&
                                                       std::vector<ConservativeSnapshot>& out);
 
 /// simplifyConservative to maxError, made again with the corners of crossing faces pinned
-/// (never moved) until the output does not intersect itself, at most maxRounds times.
-/// pinned: per input vertex, 1 = never moves; grown by the rounds (pass it on to a finer
-/// maxError of the same mesh). Returns false when the last round still intersects itself
-/// (out holds it). positions, indices as simplifyConservative.
+/// (never moved) until the output does not intersect itself, at most maxRounds times (each
+/// round is a whole simplification). pinned: per input vertex, 1 = never moves; grown by the
+/// rounds (pass it on to a finer maxError of the same mesh). rounds (optional): set to the
+/// rounds made. Returns false when the last round still intersects itself (out holds it),
+/// or maxRounds <= 0. positions, indices as simplifyConservative.
 bool simplifyConservativeClean(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
-                               double maxError, std::vector<char>& pinned, int maxRounds, ConservativeSnapshot& out);
+                               double maxError, std::vector<char>& pinned, int maxRounds, ConservativeSnapshot& out,
+                               int* rounds = nullptr);
 
 /// Pairs (lower, higher triangle index) of triangles that share no vertex position and
 /// intersect or touch, at most maxPairs of them, in traversal order. Deterministic.

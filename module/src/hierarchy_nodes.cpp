@@ -160,7 +160,11 @@ ProxyError measureEnclosure(const std::vector<double>& exact, const std::vector<
 
 /// Enclosing simplifications of one closed mesh at ascending push-out targets (world units):
 /// one pass of the simplifier for the whole series; a snapshot that intersects itself is
-/// made again on demand with the corners of the crossing faces pinned.
+/// made again on demand with the corners of the crossing faces pinned. Each repair round is a
+/// whole simplification, and where the simplifier keeps crossing itself (a dense wrap of flat
+/// faces) more rounds on other targets rarely help: a series makes at most kCleanRounds of
+/// them in all, then gives up its intersecting snapshots (the callers fall back to finer
+/// versions, the exact aggregate or the object itself). Benchmark scenes need none.
 class EnclosureSeries {
 public:
     EnclosureSeries(const std::vector<double>& positions, const std::vector<uint32_t>& indices,
@@ -177,9 +181,15 @@ public:
         if (!checked_[i]) {
             checked_[i] = 1;
             if (detail::meshSelfIntersects(snapshots_[i].positions, snapshots_[i].indices)) {
+                if (roundsLeft_ <= 0) {
+                    checked_[i] = 2;
+                    return nullptr;
+                }
                 detail::ConservativeSnapshot redone;
+                int rounds = 0;
                 checked_[i] = detail::simplifyConservativeClean(positions_, indices_, targets_[i], pinned_,
-                                                                kCleanRounds, redone) ? 1 : 2;
+                                                                roundsLeft_, redone, &rounds) ? 1 : 2;
+                roundsLeft_ -= rounds;
                 snapshots_[i] = std::move(redone);
             }
         }
@@ -187,8 +197,9 @@ public:
     }
 
 private:
-    /// Rounds of pinning crossing faces before a snapshot is given up for a finer one.
+    /// Rounds of pinning crossing faces a series may make in all.
     static constexpr int kCleanRounds = 6;
+    int roundsLeft_ = kCleanRounds;
     const std::vector<double>& positions_;
     const std::vector<uint32_t>& indices_;
     std::vector<double> targets_;
