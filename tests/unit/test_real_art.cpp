@@ -307,6 +307,23 @@ TEST(RealArt, QuickWrapOraclesKeepCgalsWrapAndGuarantees) {
             if (o.name == "House04Mesh" || o.name == "Ramp2Mesh") inputs.emplace_back(o.name, o);
         ASSERT_EQ(inputs.size(), 2u);
     }
+    // Three open walls of a few large faces that touch (collision-world's largest model):
+    // tetrahedra cross them through their faces far from any edge.
+    const std::string walls = "3d/collision-world/collision-world.glb";
+    if (std::filesystem::exists(sharedData(walls))) {
+        io::SceneReadResult scene;
+        std::string error;
+        ASSERT_TRUE(io::readGltfScene(sharedData(walls).string(), {}, scene, error)) << error;
+        InputObject together;
+        for (const InputObject& o : scene.objects)
+            if (o.name == "Cube.001" || o.name == "Cube.002" || o.name == "Cube.003") {
+                const uint32_t base = uint32_t(together.positions.size() / 3);
+                together.positions.insert(together.positions.end(), o.positions.begin(), o.positions.end());
+                for (uint32_t i : o.indices) together.indices.push_back(base + i);
+            }
+        ASSERT_EQ(together.indices.size(), 3u * 22);
+        inputs.emplace_back("walls", together);
+    }
     InputObject soup;
     uint64_t state = 12345;
     auto next = [&state] {
