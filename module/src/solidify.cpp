@@ -152,7 +152,7 @@ public:
 
     /// The input's closest point to p.
     Point closest_point(const Point& p) const {
-        if (!constructions_) return Base::closest_point(p);
+        if (!constructions_ || distanceBvh().triangleCount() == 0) return Base::closest_point(p);
         const double c[3] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
         const ClosestPoint nearest = closestPoint(distanceBvh(), c);
         return Point(nearest.point[0], nearest.point[1], nearest.point[2]);
@@ -160,7 +160,7 @@ public:
 
     /// The squared distance from p to the input.
     FT squared_distance(const Point& p) const {
-        if (!constructions_) return Base::squared_distance(p);
+        if (!constructions_ || distanceBvh().triangleCount() == 0) return Base::squared_distance(p);
         const double c[3] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
         const double d = closestPoint(distanceBvh(), c).distance;
         return d * d;
@@ -170,7 +170,7 @@ public:
     /// (Offset_intersection, to within 1 % of the offset as CGAL's oracle asks it), with the
     /// distances from this oracle's BVH.
     bool first_intersection(const Point& p, const Point& q, Point& o, const FT offset) const {
-        if (!constructions_) return Base::first_intersection(p, q, o, offset);
+        if (!constructions_ || distanceBvh().triangleCount() == 0) return Base::first_intersection(p, q, o, offset);
         struct Distance {
             const TriangleBvh* bvh;
             FT operator()(const Point& x) const {
