@@ -150,19 +150,24 @@ public:
     // as their edges, whose distances are exact (a sliver's computed normal is mostly
     // rounding).
 
+    /// p's coordinates as doubles.
+    static std::array<double, 3> coordinates(const Point& p) {
+        return {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+    }
+
     /// The input's closest point to p.
     Point closest_point(const Point& p) const {
         if (!constructions_ || distanceBvh().triangleCount() == 0) return Base::closest_point(p);
-        const double c[3] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
-        const ClosestPoint nearest = closestPoint(distanceBvh(), c);
+        const std::array<double, 3> c = coordinates(p);
+        const ClosestPoint nearest = closestPoint(distanceBvh(), c.data());
         return Point(nearest.point[0], nearest.point[1], nearest.point[2]);
     }
 
     /// The squared distance from p to the input.
     FT squared_distance(const Point& p) const {
         if (!constructions_ || distanceBvh().triangleCount() == 0) return Base::squared_distance(p);
-        const double c[3] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
-        const double d = closestPoint(distanceBvh(), c).distance;
+        const std::array<double, 3> c = coordinates(p);
+        const double d = closestPoint(distanceBvh(), c.data()).distance;
         return d * d;
     }
 
@@ -173,10 +178,7 @@ public:
         if (!constructions_ || distanceBvh().triangleCount() == 0) return Base::first_intersection(p, q, o, offset);
         struct Distance {
             const TriangleBvh* bvh;
-            FT operator()(const Point& x) const {
-                const double c[3] = {CGAL::to_double(x.x()), CGAL::to_double(x.y()), CGAL::to_double(x.z())};
-                return closestPoint(*bvh, c).distance;
-            }
+            FT operator()(const Point& x) const { return closestPoint(*bvh, coordinates(x).data()).distance; }
         };
         CGAL::Alpha_wraps_3::internal::Offset_intersection<Kernel, Distance> search(Distance{&distanceBvh()}, offset,
                                                                                    1e-2 * offset, 1);
@@ -185,13 +187,12 @@ public:
 
     bool do_intersect(const Ball& ball) const {
         const auto& sphere = ball.boundary();
-        const double c[3] = {CGAL::to_double(sphere.center().x()), CGAL::to_double(sphere.center().y()),
-                             CGAL::to_double(sphere.center().z())};
+        const std::array<double, 3> c = coordinates(sphere.center());
         const double r = std::sqrt(CGAL::to_double(sphere.squared_radius()));
         const double m = margin_ + 1e-9 * (r + std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
         // Slivers' edges stand in for them: nothing within r + margin + their width means
         // nothing within r; an edge point within r - margin is a point of the input.
-        const ClosestPoint nearest = closestPoint(ballBvh_ ? *ballBvh_ : bvh_, c, r + m + sliverWidth_);
+        const ClosestPoint nearest = closestPoint(distanceBvh(), c.data(), r + m + sliverWidth_);
         if (nearest.triangle == ~0u) return false;
         if (nearest.distance < r - m) return true;
         return Base::do_intersect(ball);
@@ -299,9 +300,9 @@ private:
             const double* a = v[(i + 1) & 3];
             const double* b = v[(i + 2) & 3];
             const double* c = v[(i + 3) & 3];
+            const double* face[3] = {a, b, c};
             for (int e = 0; e < 3; ++e) {
                 if (surelyCrosses(t + 3 * e, t + 3 * ((e + 1) % 3), a, b, c)) return true;
-                const double* face[3] = {a, b, c};
                 if (surelyCrosses(face[e], face[(e + 1) % 3], t, t + 3, t + 6)) return true;
             }
         }
