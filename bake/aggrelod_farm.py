@@ -27,6 +27,20 @@ import sys
 import time
 
 RETRIES = 3  # a task whose worker died is run again (Dask counts it); beyond, the bake fails
+# Input triangles per proxies share: a share holds the whole scene, the hierarchy without its
+# meshes, and the originals and exact aggregates of its part of the world (a share of
+# 2.2 million triangles of the 65,536-object world peaks at 1.5 GiB).
+SHARE_TRIANGLES = 2_500_000
+
+
+def proxy_share_count(plan, slots, asked=0):
+    """Shares of the proxies: `asked` when given, else a multiple of the worker threads with at
+    most SHARE_TRIANGLES input triangles each. The result does not depend on it."""
+    if asked > 0:
+        return asked
+    triangles = int(plan.get("triangles", 0))
+    rounds = max(1, -(-triangles // (slots * SHARE_TRIANGLES)))
+    return slots * rounds
 
 
 def _die_with_parent():
@@ -69,9 +83,10 @@ def batches(wave, count):
     return [",".join(wave[k::count]) for k in range(count)]
 
 
-def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, threads="0", log=print):
+def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, threads="0", log=print, proxy_shares=0):
     """The whole farm bake on a connected dask.distributed Client; returns the final bake's output.
-    bake_options: further `aggrelod bake` options (not --threads, --tile-*)."""
+    bake_options: further `aggrelod bake` options (not --threads, --tile-*); proxy_shares: see
+    proxy_share_count."""
     if __name__ != "__main__":  # workers on other machines need not have this file: ship it with the tasks
         try:
             import cloudpickle
@@ -81,11 +96,10 @@ def bake_on(client, aggrelod, scene, outdir, tile_size, cache, bake_options, thr
     base = [aggrelod, "bake", scene, "-o", outdir, "--tile-size", tile_size] + bake_options
     plan = json.loads(run_piece(base + ["--tile-task", "plan", "--quiet"]))
     if plan["tiled"]:
-        # Shares of the proxies: one per worker thread (each share reads the whole hierarchy;
-        # the bake gives each a part of the world of about equal estimated work). The result
-        # does not depend on their number.
+        # Shares of the proxies: a part of the world of about equal estimated work each, as many
+        # as keep each share's memory bounded, at least one per worker thread.
         slots = max(1, sum(client.nthreads().values()))
-        for wave in piece_commands(plan, slots):
+        for wave in piece_commands(plan, proxy_share_count(plan, slots, proxy_shares)):
             started = time.monotonic()
             commands = [base + ["--tile-cache", cache, "--tile-task", task, "--quiet", "--threads", "1"]
                         for task in batches(wave, 4 * slots)]
@@ -110,6 +124,9 @@ def main(argv=None):
     parser.add_argument("--tile-size", default="auto", help="tile side in scene units, or auto (default)")
     parser.add_argument("--tile-cache", help="folder of the pieces (default: OUTDIR.tile-cache)")
     parser.add_argument("--threads", default="0", help="threads of the final bake (pieces run on one each)")
+    parser.add_argument("--proxy-shares", type=int, default=0,
+                        help="shares of the proxies' work (default: one per worker thread, more for a world "
+                             f"over {SHARE_TRIANGLES:,} triangles per worker thread, to bound each one's memory)")
     args, bake_options = parser.parse_known_args(argv)
     for option in ("--tile-task",):
         if option in bake_options:
@@ -133,7 +150,7 @@ def main(argv=None):
         client = Client(cluster)
     try:
         sys.stdout.write(bake_on(client, aggrelod, scene, outdir, args.tile_size, cache, bake_options, args.threads,
-                                 log=lambda line: print(line, file=sys.stderr)))
+                                 log=lambda line: print(line, file=sys.stderr), proxy_shares=args.proxy_shares))
     except Exception as error:  # the failing piece's own message
         sys.exit(f"aggrelod-farm: {error}")
     finally:

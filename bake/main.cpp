@@ -444,6 +444,7 @@ int runBake(BakeOptions o) {
             } else if (std::sscanf(text.c_str(), "proxies:%lu:%lu:%lu%c", &a, &b, &c, &tail) == 3 && (a == 1 || a == 2) &&
                        c >= 1 && c <= UINT32_MAX && b < c) {
                 t.kind = TileTask::Kind::Assemble;  // the whole hierarchy from the cache, then the share
+                tiling.leanMeshes = true;           // which reads again the meshes of its own items only
                 proxyShare.phase = static_cast<int>(a);
                 proxyShare.part = static_cast<uint32_t>(b);
                 proxyShare.parts = static_cast<uint32_t>(c);

@@ -63,6 +63,7 @@ std::string tilePlanJson(const TiledBakeReport& plan) {
     j["graphs"] = plan.automaticDeltas;
     j["cells"] = plan.cells;
     j["parents"] = std::move(parents);
+    j["triangles"] = plan.cellTriangleCount;
     return j.dump();
 }
 

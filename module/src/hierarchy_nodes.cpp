@@ -111,6 +111,16 @@ bool nearlyEqual(double x, double y) { return std::fabs(x - y) <= 1e-9 * std::ma
 /// changes of the fill and ignores a flat face (e.g. a planar quad of an object, filled by a
 /// zero-volume sliver) split along its other diagonal at another level.
 bool sameSolid(const Aggregate& a, const Aggregate& b) {
+    if (a.meshInCache || b.meshInCache) {  // a lean hierarchy: by the hashes kept of the meshes
+        const auto vertices = [](const Aggregate& x) { return x.meshInCache ? x.meshInCache->vertexCount : x.positions.size() / 3; };
+        if (a.sourceObjects != b.sourceObjects || vertices(a) != vertices(b)) return false;
+        if (aggregateMeshHash(a) == aggregateMeshHash(b)) return true;
+        uint64_t ha[2], hb[2];
+        aggregateVertexSetHash(a, ha);
+        aggregateVertexSetHash(b, hb);
+        return nearlyEqual(a.measures.volume, b.measures.volume) && nearlyEqual(a.measures.area, b.measures.area) &&
+               ha[0] == hb[0] && ha[1] == hb[1];
+    }
     if (a.sourceObjects != b.sourceObjects || a.positions.size() != b.positions.size()) return false;
     if (a.indices == b.indices && a.positions == b.positions) return true;
     return nearlyEqual(a.measures.volume, b.measures.volume) && nearlyEqual(a.measures.area, b.measures.area) &&
@@ -680,6 +690,9 @@ struct WorkItems {
     std::function<void(size_t)> make;
     std::function<void(size_t, std::vector<uint8_t>&)> write;
     std::function<void(size_t, std::vector<char>&)> objects;  ///< marks the objects make(j) measures against
+    /// Optional: the nodes whose aggregate's mesh make(j) reads (read again from the cache
+    /// first when the hierarchy is lean, Aggregate::meshInCache).
+    std::function<void(size_t, std::vector<uint32_t>&)> meshes;
     /// Optional: drops item j's result once it is in the cache, where nothing after needs it.
     std::function<void(size_t)> release;
     std::function<std::string(size_t)> name;
@@ -691,7 +704,7 @@ struct WorkItems {
 /// Layout of the proxies' cache entries and of their keys: a new layout never reads old ones.
 /// Change it too whenever what an item makes changes (any constant or step of this file or
 /// of the simplifier, the error measure or the colours), so that no stale entry is read.
-constexpr char kProxyItemTag[] = "aggrelod proxy item 1";
+constexpr char kProxyItemTag[] = "aggrelod proxy item 2";
 
 /// ProxySettings::cache: the keys of the proxies' work items (each a hash of everything the
 /// item's result depends on) and what was made and read.
@@ -723,8 +736,7 @@ public:
     std::string aggregateKey(const Aggregate& a, const HierarchyNode& n, const std::vector<std::string>& objectKeys) const {
         detail::ContentHash h = start('a');
         h.f64(n.delta);
-        h.values(a.positions);
-        h.values(a.indices);
+        h.text(aggregateMeshHash(a));  // a lean hierarchy keeps it without the mesh
         h.u64(n.sources.size());
         for (uint32_t o : n.sources) h.text(objectKeys[o]);
         return h.hex();
@@ -916,6 +928,22 @@ std::vector<uint32_t> assignShares(const std::vector<double>& costs, const std::
 /// per triangle measured (a ladder simplifies and certifies at some twenty targets).
 constexpr double kLadderCostPerTriangle = 8.0;
 
+/// An aggregate's mesh is well formed (sizes, indices in range); true for a lean one (checked
+/// when read again).
+bool checkMesh(const Aggregate& agg, const std::string& where, std::string& error) {
+    if (agg.meshInCache && agg.positions.empty() && agg.indices.empty()) return true;
+    if (agg.positions.size() % 3 || agg.indices.size() % 3) {
+        error = where + ": positions or indices size is not a multiple of 3";
+        return false;
+    }
+    for (uint32_t i : agg.indices)
+        if (i >= agg.positions.size() / 3) {
+            error = where + ": vertex index " + std::to_string(i) + " out of range";
+            return false;
+        }
+    return true;
+}
+
 /// buildHierarchyNodes, or one share of its work (buildProxyShare) when `share` is given.
 bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects, const ProxySettings& settings,
                 const ProxyShare* share, HierarchyNodes& out, std::string& error) {
@@ -935,15 +963,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 error = where + " stands for no object";
                 return false;
             }
-            if (agg.positions.size() % 3 || agg.indices.size() % 3) {
-                error = where + ": positions or indices size is not a multiple of 3";
-                return false;
-            }
-            for (uint32_t i : agg.indices)
-                if (i >= agg.positions.size() / 3) {
-                    error = where + ": vertex index " + std::to_string(i) + " out of range";
-                    return false;
-                }
+            if (!checkMesh(agg, where, error)) return false;
             for (uint32_t o : agg.sourceObjects) {
                 if (o >= objectCount) {
                     error = where + " refers to object " + std::to_string(o) + " but there are " +
@@ -1031,7 +1051,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             n.aggregateIndex = static_cast<uint32_t>(g);
             n.delta = level.delta;
             n.sources = agg.sourceObjects;
-            n.exactTriangleCount = agg.indices.size() / 3;
+            n.exactTriangleCount = agg.meshInCache ? agg.meshInCache->triangleCount : agg.indices.size() / 3;
             out.nodeOfAggregate[k][g] = static_cast<uint32_t>(nodes.size());
             nodes.push_back(std::move(n));
         }
@@ -1053,6 +1073,34 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     ProxyMemo memo(settings);
     auto aggregateOf = [&](const HierarchyNode& n) -> const Aggregate& {
         return hierarchy.levels[size_t(n.firstLevel)].aggregates[n.aggregateIndex];
+    };
+    // A lean hierarchy's meshes, read again from the cache for the items that need them
+    // (WorkItems::meshes), each dropped once its item is made.
+    std::vector<std::unique_ptr<Aggregate>> reloaded(nodes.size());
+    std::string reloadError;
+    const auto needsReload = [&](uint32_t i) {
+        const Aggregate& a = aggregateOf(nodes[i]);
+        return a.meshInCache && a.positions.empty() && a.indices.empty();
+    };
+    const auto reload = [&](const std::vector<uint32_t>& which) {
+        std::vector<const Aggregate*> lean;
+        std::vector<Aggregate*> into;
+        for (uint32_t i : which) {
+            reloaded[i] = std::make_unique<Aggregate>();
+            lean.push_back(&aggregateOf(nodes[i]));
+            into.push_back(reloaded[i].get());
+        }
+        if (!settings.cache || !detail::reloadMeshes(*settings.cache, lean, into, settings.threadCount, reloadError))
+            return false;
+        for (uint32_t i : which)
+            if (!checkMesh(*reloaded[i], "the aggregate of node " + std::to_string(i) + " read again", reloadError)) return false;
+        return true;
+    };
+    // The aggregate of node i with its mesh (read again alone if it was not read for its item).
+    const auto meshOf = [&](uint32_t i) -> const Aggregate& {
+        if (!needsReload(i)) return aggregateOf(nodes[i]);
+        if (!reloaded[i] && !reload({i})) throw std::runtime_error(reloadError);
+        return *reloaded[i];
     };
     // One BVH per original object, shared by every node holding it at every level (an
     // object recurs at each level; merging the originals into one BVH per node would
@@ -1111,6 +1159,15 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             isPrepared[unprepared[j]] = 1;
         });
         out.originalsPrepared += unprepared.size();
+        if (items.meshes) {
+            std::vector<uint32_t> meshNodes, lean;
+            for (uint32_t j : toMake) items.meshes(j, meshNodes);
+            std::sort(meshNodes.begin(), meshNodes.end());
+            meshNodes.erase(std::unique(meshNodes.begin(), meshNodes.end()), meshNodes.end());
+            for (uint32_t i : meshNodes)
+                if (needsReload(i) && !reloaded[i]) lean.push_back(i);
+            if (!lean.empty() && !reload(lean)) return false;
+        }
         if (items.cost) {
             std::vector<double> costs(count, 0.0);
             for (uint32_t j : toMake) costs[j] = items.cost(j);
@@ -1162,7 +1219,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     };
     const auto hasLadder = [&](size_t o) { return nodes[o].parent != kNoNode && leafHasGeometry[o]; };
     const auto finish = [&](bool ok) {
-        if (!ok) error = "the cache holds no result for " + missing + ": run the proxies' phase 1 first";
+        if (!ok) error = !reloadError.empty() ? reloadError
+                         : "the cache holds no result for " + missing + ": run the proxies' phase 1 first";
         // A share whose results are not kept did nothing; a whole bake just makes them again next time.
         else if (share && memo.storeFailed) error = "could not store a result in the cache";
         out.proxyItemsMade = memo.made;
@@ -1193,7 +1251,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         };
         items.make = [&, which](size_t j) {
             HierarchyNode& n = nodes[which[j]];
-            makeAggregateProxy(aggregateOf(n), originalsOf(n), settings, n, exactProxies[which[j]]);
+            makeAggregateProxy(meshOf(which[j]), originalsOf(n), settings, n, exactProxies[which[j]]);
+            reloaded[which[j]].reset();
             exactHeld[which[j]] = 1;
             detail::nearestSurfaceColors(n.positions, n.indices, objectsOf(n), n.faceColors);
             detail::optimizeVertexCache(n.positions, n.indices, n.faceColors);
@@ -1204,6 +1263,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         items.objects = [&, which](size_t j, std::vector<char>& needed) {
             for (uint32_t o : nodes[which[j]].sources) needed[o] = 1;
         };
+        items.meshes = [&, which](size_t j, std::vector<uint32_t>& needed) { needed.push_back(which[j]); };
         items.name = [&, which](size_t j) {
             const HierarchyNode& n = nodes[which[j]];
             return "the proxy of level " + std::to_string(n.firstLevel) + " aggregate " + std::to_string(n.aggregateIndex);
@@ -1362,8 +1422,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 // should the entry have gone meanwhile, made again: the same result).
                 HierarchyNode again = n;
                 std::vector<uint8_t> bytes;
-                if (!(memo.on() && memo.load(nodeKeys[i], bytes) && readAggregateProxy(bytes, again, &exactProxies[i])))
-                    makeAggregateProxy(aggregateOf(n), originalsOf(n), settings, again, exactProxies[i]);
+                if (!(memo.on() && memo.load(nodeKeys[i], bytes) && readAggregateProxy(bytes, again, &exactProxies[i]))) {
+                    makeAggregateProxy(meshOf(i), originalsOf(n), settings, again, exactProxies[i]);
+                    reloaded[i].reset();
+                }
             }
             // The versions of its objects, for a group small enough to be united from them
             // (coarserChain): a ladder read without its exact vertices is read again whole for
@@ -1513,7 +1575,12 @@ bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject
         return false;
     }
     HierarchyNodes nodes;
-    const bool ok = buildNodes(hierarchy, objects, settings, &share, nodes, error);
+    bool ok = false;
+    try {
+        ok = buildNodes(hierarchy, objects, settings, &share, nodes, error);
+    } catch (const std::runtime_error& e) {  // a lean hierarchy's mesh that did not read back
+        error = e.what();
+    }
     if (made) *made = nodes.proxyItemsMade;
     if (loaded) *loaded = nodes.proxyItemsLoaded;
     if (prepared) *prepared = nodes.originalsPrepared;

@@ -2,7 +2,12 @@
 // Hierarchy3D to bytes and back for the tiled bake's cache (docs/design.md §2.8).
 #include "hierarchy_serialize.h"
 
+#include "parallel_for.h"
+
+#include <algorithm>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <type_traits>
 
 namespace aggrelod::detail {
@@ -171,4 +176,121 @@ std::string ContentHash::hex() const {
     return s;
 }
 
+void leaveMeshInCache(Aggregate& a, const std::string& piece, uint32_t level, uint32_t index, bool keepForNow) {
+    if (!a.meshInCache) {
+        auto ref = std::make_shared<AggregateMeshRef>();
+        ref->piece = piece;
+        ref->level = level;
+        ref->index = index;
+        ref->vertexCount = a.positions.size() / 3;
+        ref->triangleCount = a.indices.size() / 3;
+        ref->meshHash = aggregateMeshHash(a);
+        aggregateVertexSetHash(a, ref->vertexSetHash);
+        a.meshInCache = std::move(ref);
+    }
+    if (!keepForNow) dropMeshInCache(a);
+}
+
+void dropMeshInCache(Aggregate& a) {
+    if (!a.meshInCache) return;
+    std::vector<double>().swap(a.positions);
+    std::vector<uint32_t>().swap(a.indices);
+    std::vector<float>().swap(a.faceColors);
+}
+
+bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& lean, const std::vector<Aggregate*>& into,
+                  int threads, std::string& error) {
+    std::map<std::string, std::vector<size_t>> byPiece;  // piece -> the j it holds, in key order
+    for (size_t j = 0; j < lean.size(); ++j) {
+        if (!lean[j]->meshInCache) {
+            error = "an aggregate to read again was not left in the cache";
+            return false;
+        }
+        byPiece[lean[j]->meshInCache->piece].push_back(j);
+    }
+    std::vector<const std::vector<size_t>*> pieces;
+    for (const auto& [key, js] : byPiece) pieces.push_back(&js);
+    std::vector<char> failed(pieces.size(), 0);
+    parallelFor(pieces.size(), threads, [&](size_t p) {
+        const std::string& key = lean[pieces[p]->front()]->meshInCache->piece;
+        std::vector<uint8_t> bytes;
+        Hierarchy3D piece;
+        if (!cache.load || !cache.load(key, bytes) || !deserializeHierarchy(bytes, piece)) {
+            failed[p] = 1;
+            return;
+        }
+        std::vector<uint8_t>().swap(bytes);
+        for (size_t j : *pieces[p]) {
+            const AggregateMeshRef& ref = *lean[j]->meshInCache;
+            if (ref.level >= piece.levels.size() || ref.index >= piece.levels[ref.level].aggregates.size()) {
+                failed[p] = 1;
+                return;
+            }
+            Aggregate& from = piece.levels[ref.level].aggregates[ref.index];
+            if (from.positions.size() / 3 != ref.vertexCount || from.indices.size() / 3 != ref.triangleCount ||
+                aggregateMeshHash(from) != ref.meshHash) {
+                failed[p] = 1;
+                return;
+            }
+            Aggregate& a = *into[j];
+            a = *lean[j];
+            a.positions = from.positions;  // copies: a piece's aggregate may be asked for twice
+            a.indices = from.indices;
+            a.faceColors = from.faceColors;
+        }
+    });
+    for (size_t p = 0; p < pieces.size(); ++p)
+        if (failed[p]) {
+            error = "the tile cache entry " + lean[pieces[p]->front()]->meshInCache->piece +
+                    " is missing or no longer holds the aggregates assembled from it";
+            return false;
+        }
+    return true;
+}
+
 }  // namespace aggrelod::detail
+
+namespace aggrelod {
+
+std::string aggregateMeshHash(const Aggregate& a) {
+    if (a.meshInCache && a.positions.empty() && a.indices.empty()) return a.meshInCache->meshHash;
+    detail::ContentHash h;
+    h.text("aggregate mesh");
+    h.values(a.positions);
+    h.values(a.indices);
+    return h.hex();
+}
+
+void aggregateVertexSetHash(const Aggregate& a, uint64_t hash[2]) {
+    if (a.meshInCache && a.positions.empty() && a.indices.empty()) {
+        hash[0] = a.meshInCache->vertexSetHash[0];
+        hash[1] = a.meshInCache->vertexSetHash[1];
+        return;
+    }
+    // Sums of a strong mix of each vertex (order-free): two independent 64-bit lanes.
+    const auto mix = [](uint64_t x) {
+        x ^= x >> 30;
+        x *= 0xbf58476d1ce4e5b9ull;
+        x ^= x >> 27;
+        x *= 0x94d049bb133111ebull;
+        x ^= x >> 31;
+        return x;
+    };
+    uint64_t s0 = 0, s1 = 0;
+    for (size_t i = 0; i + 2 < a.positions.size(); i += 3) {
+        uint64_t h0 = 0x9e3779b97f4a7c15ull, h1 = 0xc2b2ae3d27d4eb4full;
+        for (int k = 0; k < 3; ++k) {
+            const double x = a.positions[i + k] + 0.0;  // -0 as +0
+            uint64_t bits;
+            std::memcpy(&bits, &x, sizeof bits);
+            h0 = mix(h0 ^ bits);
+            h1 = mix(h1 + bits * 0x2545f4914f6cdd1dull);
+        }
+        s0 += h0;
+        s1 += mix(h1 ^ 0x5851f42d4c957f2dull);
+    }
+    hash[0] = s0;
+    hash[1] = s1;
+}
+
+}  // namespace aggrelod

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <aggrelod/aggregate3d.h>
+#include <aggrelod/tile_cache.h>
 
 #include <cstdint>
 #include <cstring>
@@ -95,6 +96,21 @@ void serializeHierarchy(const Hierarchy3D& h, std::vector<uint8_t>& bytes);
 
 /// Reads what serializeHierarchy wrote; false (and `h` reset) for anything else.
 bool deserializeHierarchy(const std::vector<uint8_t>& bytes, Hierarchy3D& h);
+
+/// Leaves `a`'s mesh in the tile cache entry `piece` (where it is aggregate `index` of level
+/// `level`): sets a.meshInCache (hashes and counts of the mesh) unless set, then frees the
+/// mesh unless `keepForNow` (dropMeshInCache frees it later).
+void leaveMeshInCache(Aggregate& a, const std::string& piece, uint32_t level, uint32_t index, bool keepForNow = false);
+
+/// Frees the mesh of an aggregate whose mesh is in the cache (meshInCache set); else nothing.
+void dropMeshInCache(Aggregate& a);
+
+/// Reads the meshes of lean aggregates (Aggregate::meshInCache) back from `cache`, each piece
+/// once: for every j, the mesh of *lean[j] into *into[j] (positions, indices, faceColors; the
+/// rest copied from *lean[j]). Runs on up to `threads` threads. False naming the first piece
+/// that is missing, does not read back, or no longer holds a mesh with the hashes kept.
+bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& lean, const std::vector<Aggregate*>& into,
+                  int threads, std::string& error);
 
 /// 128-bit content hash (two independent 64-bit FNV-1a lanes), fed piece by piece; hex() is
 /// 32 lowercase hex digits. Equal feeds give equal hashes on every platform.

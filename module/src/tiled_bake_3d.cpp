@@ -58,7 +58,7 @@ void totalLevel(Level& level) {
         area += a.measures.area;
         level.volumeOriginal += a.volumeOriginal;
         level.volumeHull += a.volumeHull;
-        level.triangleCount += a.indices.size() / 3;
+        level.triangleCount += a.meshInCache ? a.meshInCache->triangleCount : a.indices.size() / 3;
     }
     level.measures = detail::measuresOf(volume, area);
 }
@@ -118,6 +118,8 @@ private:
     using Kind = TileTask::Kind;
     bool caching() const { return options_.cache && options_.cache->load && options_.cache->store && !settings_.customFunction; }
     bool isTask(Kind k) const { return options_.task.kind == k; }
+    /// Aggregates' meshes are left in the cache (TiledBakeOptions::leanMeshes).
+    bool lean() const { return options_.leanMeshes && isTask(Kind::Assemble) && caching(); }
     /// Whether this run needs cell `cell` (its graph, its levels).
     bool needCell(uint32_t cell) const;
     std::string cellKey(char kind, const std::vector<uint32_t>& ids, const Settings3D& settings) const;
@@ -249,7 +251,10 @@ void TiledBaker::assignCells() {
         const uint32_t cell = cellAt(world_.boxes[ids[root]].data());
         for (uint32_t k : members) world_.cellOf[ids[k]] = split ? cellAt(world_.boxes[ids[k]].data()) : cell;
     }
-    for (uint32_t i : ids) world_.cells[world_.cellOf[i]].push_back(i);
+    for (uint32_t i : ids) {
+        world_.cells[world_.cellOf[i]].push_back(i);
+        report_.cellTriangleCount += objects_[i].indices.size() / 3;
+    }
     for (auto& [cell, members] : world_.cells) {
         std::sort(members.begin(), members.end());
         report_.largestCellObjects = std::max(report_.largestCellObjects, members.size());
@@ -485,8 +490,8 @@ bool TiledBaker::run(double tileSize) {
         Hierarchy3D part;
         const auto bake = [&](Hierarchy3D& p) { return buildHierarchy3D(cellObjects(ids), settings, p); };
         const bool mayBake = isTask(Kind::Everything) || isTask(Kind::Cell);
-        if (!obtain(cellKey('c', ids, settings), "tile " + std::to_string(cell), mayBake, bake, part, report_.cellsBaked,
-                    report_.cellsLoaded))
+        const std::string key = cellKey('c', ids, settings);
+        if (!obtain(key, "tile " + std::to_string(cell), mayBake, bake, part, report_.cellsBaked, report_.cellsLoaded))
             return false;
         if (part.levels.size() != levels.size()) {
             diag(out_, Diagnostic::Severity::Error, "", "tile " + std::to_string(cell) + ": the bake made " +
@@ -496,7 +501,10 @@ bool TiledBaker::run(double tileSize) {
         for (size_t k = 0; k < levels.size(); ++k) {
             hasConstant = hasConstant && part.levels[k].hasVolumeConstant;
             levels[k].volumeConstant += part.levels[k].volumeConstant;
-            for (Aggregate& a : part.levels[k].aggregates) {
+            for (size_t g = 0; g < part.levels[k].aggregates.size(); ++g) {
+                Aggregate& a = part.levels[k].aggregates[g];
+                // The top level's meshes name the parent pieces: they go once those are read.
+                if (lean()) detail::leaveMeshInCache(a, key, uint32_t(k), uint32_t(g), k + 1 == levels.size());
                 for (uint32_t& o : a.sourceObjects) o = ids[o];
                 levels[k].aggregates.push_back(std::move(a));
             }
@@ -616,7 +624,9 @@ bool TiledBaker::run(double tileSize) {
                 if (target) return true;
                 for (uint32_t o : part.leftOutObjects) passed[o] = 1;
                 for (size_t k = 0; k < added.size() && k < part.levels.size(); ++k)
-                    for (Aggregate& a : part.levels[k].aggregates) {
+                    for (size_t g = 0; g < part.levels[k].aggregates.size(); ++g) {
+                        Aggregate& a = part.levels[k].aggregates[g];
+                        if (lean()) detail::leaveMeshInCache(a, key.hex(), uint32_t(k), uint32_t(g), true);
                         std::vector<uint32_t> sources;
                         double volumeOriginal = 0;
                         for (uint32_t i : a.sourceObjects) {
@@ -644,10 +654,15 @@ bool TiledBaker::run(double tileSize) {
             level.hasVolumeConstant = false;
             levels.push_back(std::move(level));
         }
+        if (lean())  // all but the new top level, whose meshes name the next quadtree level's pieces
+            for (size_t k = 0; k + 1 < levels.size(); ++k)
+                for (Aggregate& a : levels[k].aggregates) detail::dropMeshInCache(a);
         if (isTask(Kind::Parent) && j == options_.task.level) return true;  // its target had one input: nothing to bake
     }
 
     for (Level& level : levels) {
+        if (lean())
+            for (Aggregate& a : level.aggregates) detail::dropMeshInCache(a);
         std::sort(level.aggregates.begin(), level.aggregates.end(),
                   [](const Aggregate& a, const Aggregate& b) { return a.sourceObjects.front() < b.sourceObjects.front(); });
         const double constant = level.volumeConstant;

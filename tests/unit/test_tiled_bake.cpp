@@ -590,3 +590,72 @@ TEST(ProxyCache, SharesRebakesAndDamagedEntriesGiveTheSameNodes) {
     EXPECT_EQ(repaired.proxyItemsLoaded, 0u);
     expectSameNodes(repaired, fresh);
 }
+
+// A share of the proxies holds the hierarchy without its meshes (TiledBakeOptions::leanMeshes:
+// a 65,536-object world's exact aggregates are 1.4 GiB) and reads again from the tile cache
+// only the meshes of the items it makes: the same nodes as the proxies made whole; a piece gone
+// from the cache fails the share, naming it.
+TEST(ProxyCache, LeanSharesReadTheirOwnMeshesAndGiveTheSameNodes) {
+    const std::vector<InputObject> objects = world(200, 3);
+    const Settings3D settings = worldSettings(objects, {1, 4, 12, 24});
+    MemoryCache memory;
+    const TileCache cache = memory.cache();
+    TiledBakeOptions options;
+    options.tileSize = 48;
+    options.cache = &cache;
+    Hierarchy3D h;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, h)) << errors(h);
+    const std::map<std::string, std::vector<uint8_t>> pieces = memory.entries;  // the tile pieces alone
+    ProxySettings proxies;
+    proxies.threadCount = 2;
+    HierarchyNodes plain;
+    std::string error;
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, proxies, plain, error)) << error;
+
+    options.task.kind = TileTask::Kind::Assemble;
+    options.leanMeshes = true;
+    Hierarchy3D lean;
+    ASSERT_TRUE(buildTiledHierarchy3D(objects, settings, options, lean)) << errors(lean);
+    ASSERT_EQ(lean.levels.size(), h.levels.size());
+    size_t aggregates = 0;
+    for (size_t k = 0; k < h.levels.size(); ++k) {
+        ASSERT_EQ(lean.levels[k].aggregates.size(), h.levels[k].aggregates.size());
+        EXPECT_EQ(lean.levels[k].triangleCount, h.levels[k].triangleCount);
+        for (size_t g = 0; g < h.levels[k].aggregates.size(); ++g) {
+            const Aggregate& a = lean.levels[k].aggregates[g];
+            const Aggregate& full = h.levels[k].aggregates[g];
+            ASSERT_TRUE(a.meshInCache) << "level " << k << " aggregate " << g;
+            EXPECT_TRUE(a.positions.empty() && a.indices.empty() && a.faceColors.empty());
+            EXPECT_EQ(a.sourceObjects, full.sourceObjects);
+            EXPECT_EQ(a.meshInCache->triangleCount, full.indices.size() / 3);
+            EXPECT_EQ(aggregateMeshHash(a), aggregateMeshHash(full));
+            uint64_t x[2], y[2];
+            aggregateVertexSetHash(a, x);
+            aggregateVertexSetHash(full, y);
+            EXPECT_TRUE(x[0] == y[0] && x[1] == y[1]);
+            ++aggregates;
+        }
+    }
+    EXPECT_GT(aggregates, 100u);
+
+    ProxySettings cached = proxies;
+    cached.cache = &cache;
+    {  // a piece gone: the share says which entry
+        MemoryCache damaged;
+        damaged.entries = pieces;
+        const std::string gone = lean.levels[0].aggregates[0].meshInCache->piece;
+        ASSERT_EQ(damaged.entries.erase(gone), 1u);
+        const TileCache damagedCache = damaged.cache();
+        ProxySettings withDamaged = proxies;
+        withDamaged.cache = &damagedCache;
+        EXPECT_FALSE(buildProxyShare(lean, objects, withDamaged, ProxyShare{1, 0, 1}, error));
+        EXPECT_NE(error.find(gone), std::string::npos) << error;
+    }
+    for (int phase : {1, 2})
+        for (uint32_t part = 0; part < 3; ++part)
+            ASSERT_TRUE(buildProxyShare(lean, objects, cached, ProxyShare{phase, part, 3}, error)) << error;
+    HierarchyNodes whole;
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, cached, whole, error)) << error;
+    EXPECT_EQ(whole.proxyItemsMade, 0u) << "the lean shares made every item";
+    expectSameNodes(whole, plain);
+}

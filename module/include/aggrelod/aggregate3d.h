@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,17 @@ struct SolidMeasures {
 /// (units^2); 0 when A == 0. The 3D counterpart of circularity().
 double sphericity(double volume, double area);
 
+/// Where a lean assembly of a tiled bake (TiledBakeOptions::leanMeshes) left an aggregate's
+/// mesh: in a tile cache entry, to be read again by the work that needs it (the proxies of a
+/// share of the world), with what stands in for the mesh meanwhile.
+struct AggregateMeshRef {
+    std::string piece;                   ///< the tile cache key of the piece holding the aggregate
+    uint32_t level = 0, index = 0;       ///< its level and place in that piece's Hierarchy3D
+    size_t vertexCount = 0, triangleCount = 0;
+    std::string meshHash;                ///< aggregateMeshHash() of the mesh
+    uint64_t vertexSetHash[2] = {0, 0};  ///< aggregateVertexSetHash() of the mesh
+};
+
 /// One aggregate: the watertight proxy of one group of models at one level.
 struct Aggregate {
     std::vector<double> positions;       ///< 3 * vertexCount
@@ -129,7 +141,19 @@ struct Aggregate {
     /// source model solidified), or both.
     enum class Surface { Original, Solidified, Mixed };
     Surface surface = Surface::Original;
+    /// Set only by a lean assembly: positions, indices and faceColors are then empty and stay
+    /// in the tile cache (AggregateMeshRef); everything else is here.
+    std::shared_ptr<const AggregateMeshRef> meshInCache;
 };
+
+/// A content hash (32 hex digits) of an aggregate's positions and indices; the one kept in
+/// meshInCache when the mesh was left there.
+std::string aggregateMeshHash(const Aggregate& a);
+
+/// A hash of an aggregate's vertices as a set with repeats (their order and the triangles do
+/// not count; -0 and +0 are the same): equal for aggregates whose sorted vertex lists are equal.
+/// The one kept in meshInCache when the mesh was left there.
+void aggregateVertexSetHash(const Aggregate& a, uint64_t hash[2]);
 
 /// One solidified model (docs/design.md §2.0): what stood in for its objects in the triangulation.
 struct SolidReport {

@@ -41,6 +41,7 @@ struct TiledBakeReport {
     size_t columns = 0, rows = 0;   ///< cells along the scene's longest and second axis
     size_t cellCount = 0;           ///< cells baked (those holding objects)
     size_t largestCellObjects = 0;  ///< objects in the fullest cell
+    size_t cellTriangleCount = 0;   ///< triangles of the objects in cells (those aggregated)
     int quadtreeDepth = 0;          ///< parent levels of cells above the cells
     size_t parentBakeCount = 0;     ///< parent cells baked (those with two inputs or more)
     size_t clusterCount = 0;
@@ -91,6 +92,11 @@ struct TiledBakeOptions {
     /// run on other objects (another address or count), settings or tile size works it out anew
     /// and keeps that; objects changed in place need a fresh layout (newTiledLayout).
     std::shared_ptr<TiledLayout> layout;
+    /// TileTask::Kind::Assemble only: leave every aggregate's mesh in the cache
+    /// (Aggregate::meshInCache), so that the whole hierarchy is held without its meshes; for
+    /// buildProxyShare, which reads again the meshes of its own work only. Such a hierarchy is
+    /// for buildProxyShare alone.
+    bool leanMeshes = false;
 };
 
 /// Objects per cell the automatic tile size aims at (tileSize == 0).
