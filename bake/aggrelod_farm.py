@@ -30,7 +30,7 @@ RETRIES = 3  # a task whose worker died is run again (Dask counts it); beyond, t
 # Input triangles per proxies share: a share holds the whole scene, the hierarchy without its
 # meshes, and the originals and exact aggregates of its part of the world (a share of
 # 2.2 million triangles of the 65,536-object world peaks at 1.5 GiB).
-SHARE_TRIANGLES = 2_500_000
+SHARE_TRIANGLES = 1_500_000
 
 
 def proxy_share_count(plan, slots, asked=0):
