@@ -28,8 +28,8 @@ import time
 
 RETRIES = 3  # a task whose worker died is run again (Dask counts it); beyond, the bake fails
 # Input triangles per proxies share: a share holds the whole scene, the hierarchy without its
-# meshes, and the originals and exact aggregates of its part of the world (a share of
-# 2.2 million triangles of the 65,536-object world peaks at 1.5 GiB).
+# meshes, and the originals and exact aggregates of its part of the world (the 65,536-object
+# world's six shares of 1.3 million triangles each peak at 1.2-1.6 GiB).
 SHARE_TRIANGLES = 1_500_000
 
 

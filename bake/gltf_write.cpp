@@ -5,6 +5,8 @@
 #include "runtime_export.h"
 #include "scene_io.h"
 
+#include <aggrelod/tiled_bake_3d.h>
+
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -931,7 +933,8 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 }
 
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
-                    const std::string& path, std::string& error, const HierarchyNodes* nodes, int threadCount) {
+                    const std::string& path, std::string& error, const HierarchyNodes* nodes, int threadCount,
+                    const TileCache* meshCache) {
     if (nodes && (nodes->nodeOfAggregate.size() != hierarchy.levels.size() || nodes->objectCount != objects.size())) {
         error = path + ": the hierarchy nodes do not belong to this hierarchy";
         return false;
@@ -944,7 +947,13 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
         const size_t levelCount = hierarchy.levels.size();
         bool anyColours = false;
         for (const Level& level : hierarchy.levels)
-            for (const Aggregate& agg : level.aggregates) anyColours = anyColours || !agg.faceColors.empty();
+            for (const Aggregate& agg : level.aggregates)
+                anyColours = anyColours || !agg.faceColors.empty() || (agg.meshInCache && agg.meshInCache->hasFaceColors);
+        // Meshes left in the tile cache, read back a run of aggregates at a time (the meshes
+        // added from a run are made before the next run replaces it).
+        constexpr size_t kMeshRun = 4096;
+        std::vector<Aggregate> meshRun;
+        std::vector<uint32_t> meshAt;  // g - run start -> index in meshRun (UINT32_MAX: in memory)
         for (size_t k = 0; k < levelCount; ++k) {
             const Level& level = hierarchy.levels[k];
             const std::string levelName = "level" + std::to_string(k);
@@ -972,7 +981,26 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
 
             std::vector<int> children;
             for (size_t g = 0; g < level.aggregates.size(); ++g) {
-                const Aggregate& agg = level.aggregates[g];
+                if (g % kMeshRun == 0) {
+                    glb.flushDeferred();
+                    std::vector<const Aggregate*> lean;
+                    meshAt.assign(std::min(kMeshRun, level.aggregates.size() - g), UINT32_MAX);
+                    for (size_t j = g; j < g + meshAt.size(); ++j) {
+                        const Aggregate& a = level.aggregates[j];
+                        if (!a.meshInCache || !a.positions.empty()) continue;
+                        meshAt[j - g] = static_cast<uint32_t>(lean.size());
+                        lean.push_back(&a);
+                    }
+                    if (!lean.empty()) {
+                        std::string why;
+                        if (!meshCache || !readAggregateMeshes(*meshCache, lean, meshRun, threadCount, why)) {
+                            error = path + ": " + (meshCache ? why : "aggregate meshes left in a tile cache but no cache given");
+                            return false;
+                        }
+                    }
+                }
+                const uint32_t at = meshAt[g % kMeshRun];
+                const Aggregate& agg = at == UINT32_MAX ? level.aggregates[g] : meshRun[at];
                 const std::string name = levelName + "_group" + std::to_string(g);
                 if (agg.positions.size() % 3 != 0 || agg.indices.size() % 3 != 0) {
                     error = path + ": " + name + ": positions or indices size is not a multiple of 3";

@@ -553,8 +553,20 @@ int runBake(BakeOptions o) {
         std::fflush(stdout);
         return kOk;
     }
-    const bool ok = o.tileSize.empty() ? buildHierarchy3D(scene.objects, settings, hierarchy)
-                                       : buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled);
+    // A tiled bake whose pieces are all in the cache holds the hierarchy without its exact
+    // meshes (they stay in the cache; the bounds and levels.glb read them back a run at a
+    // time); otherwise it bakes what is missing and holds everything.
+    bool lean = false;
+    if (!o.tileSize.empty() && tiling.cache && !settings.customFunction) {
+        TiledBakeOptions assemble = tiling;
+        assemble.task.kind = TileTask::Kind::Assemble;
+        assemble.leanMeshes = true;
+        TiledBakeReport report;
+        lean = buildTiledHierarchy3D(scene.objects, settings, assemble, hierarchy, &report);
+        if (lean) tiled = report;
+    }
+    const bool ok = lean || (o.tileSize.empty() ? buildHierarchy3D(scene.objects, settings, hierarchy)
+                                                : buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled));
     HierarchyNodes nodes;
     std::string nodeError;
     bool nodesOk = false;
@@ -612,7 +624,8 @@ int runBake(BakeOptions o) {
         !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)) ||
         (o.collision && !set.addFile(collisionPath, collisionTmp, error)))
         return fail(error);
-    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes, o.threads)) return fail(error);
+    if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes, o.threads, tiling.cache))
+        return fail(error);
     // The exact aggregates' meshes are in levels.glb now and nothing after needs them (the
     // statistics keep counts): on a large world they are the largest part of what is held.
     for (Level& level : hierarchy.levels)

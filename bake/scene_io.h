@@ -6,6 +6,7 @@
 #include <aggrelod/aggregate3d.h>
 #include <aggrelod/collision_shapes.h>
 #include <aggrelod/hierarchy_nodes.h>
+#include <aggrelod/tile_cache.h>
 
 #include <string>
 #include <vector>
@@ -107,9 +108,11 @@ bool writeObjectsGlb(const std::vector<InputObject>& objects, const std::string&
 /// COLOR_0 (linear RGBA) and the level materials are white; without colours each level's
 /// material has its own tint.
 /// Meshes are made on up to `threadCount` threads (0: all cores); the file is the same for any.
+/// The meshes of aggregates a lean assembly left in the tile cache (Aggregate::meshInCache)
+/// are read back from `meshCache`, a run of aggregates at a time.
 bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                     const std::string& path, std::string& error,
-                    const HierarchyNodes* nodes = nullptr, int threadCount = 1);
+                    const HierarchyNodes* nodes = nullptr, int threadCount = 1, const TileCache* meshCache = nullptr);
 
 /// Writes OUTDIR/proxies.glb: glTF node i = hierarchy node i, nested as the hierarchy (scene
 /// roots = its roots). Aggregate nodes carry their simplified proxy as a mesh (one material

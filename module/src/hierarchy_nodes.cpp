@@ -20,6 +20,7 @@
 
 #include <aggrelod/disjoint_sets.h>
 #include <aggrelod/hierarchy_nodes.h>
+#include <aggrelod/tiled_bake_3d.h>
 
 #include <algorithm>
 #include <array>
@@ -1541,15 +1542,37 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     }
 
     // Errors and bounds, children first (children have smaller indices than their parent).
+    // The exact aggregates of a lean hierarchy are read again a run of nodes at a time.
     const std::vector<double> none;
+    constexpr size_t kBoundsRun = 16384;
+    std::vector<Aggregate> exactRun;
+    std::vector<uint32_t> exactAt;  // node - run start -> index in exactRun (kNoNode: in memory)
     for (size_t i = 0; i < nodes.size(); ++i) {
         HierarchyNode& n = nodes[i];
+        const bool exactAggregate = !n.leaf && n.objectLod == 0 && n.coarserStep == 0;
+        if (i % kBoundsRun == 0) {
+            std::vector<const Aggregate*> lean;
+            exactAt.assign(std::min(kBoundsRun, nodes.size() - i), kNoNode);
+            for (size_t j = i; j < i + exactAt.size(); ++j) {
+                const HierarchyNode& m = nodes[j];
+                if (m.leaf || m.objectLod > 0 || m.coarserStep > 0) continue;
+                const Aggregate& a = aggregateOf(m);
+                if (!a.meshInCache || !a.positions.empty()) continue;
+                exactAt[j - i] = static_cast<uint32_t>(lean.size());
+                lean.push_back(&a);
+            }
+            if (!lean.empty() && !(settings.cache && readAggregateMeshes(*settings.cache, lean, exactRun, settings.threadCount,
+                                                                        reloadError)))
+                return finish(false);
+        }
         double e = n.leaf ? 0.0 : n.error.bound();
         for (uint32_t c : n.children) e = std::max(e, nodes[c].geometricError);
         n.geometricError = floatUp(e);
+        const uint32_t at = exactAt[i % kBoundsRun];
         const std::vector<double>& exact = n.leaf ? (n.positions.empty() ? none : objects[i].positions)
-                                           : n.objectLod > 0 || n.coarserStep > 0 ? none
-                                                                         : aggregateOf(n).positions;
+                                           : !exactAggregate ? none
+                                           : at != kNoNode  ? exactRun[at].positions
+                                                            : aggregateOf(n).positions;
         computeBounds(n, exact, nodes);
     }
     return finish(true);

@@ -86,6 +86,43 @@ void serializeHierarchy(const Hierarchy3D& h, std::vector<uint8_t>& bytes) {
     w.array(h.leftOutObjects);
 }
 
+bool deserializeLevel(const std::vector<uint8_t>& bytes, uint32_t wanted, std::vector<Aggregate>& aggregates) {
+    aggregates.clear();
+    ByteReader r(bytes);
+    for (char c : kMagic)
+        if (r.pod<char>() != c) return false;
+    const size_t levels = r.count(73);
+    if (wanted >= levels) return false;
+    for (size_t k = 0; k <= wanted && r.ok(); ++k) {
+        r.pod<double>();  // delta
+        const size_t count = r.count(4 * 8 + 8 + 3 * 8 + 2 * 8 + 1);
+        if (k == wanted) aggregates.resize(count);
+        for (size_t g = 0; g < count && r.ok(); ++g) {
+            if (k == wanted) {
+                Aggregate& a = aggregates[g];
+                r.array(a.positions);
+                r.array(a.indices);
+                r.array(a.sourceObjects);
+                r.array(a.faceColors);
+            } else {
+                r.skipArray(sizeof(double));
+                r.skipArray(sizeof(uint32_t));
+                r.skipArray(sizeof(uint32_t));
+                r.skipArray(sizeof(float));
+            }
+            r.pod<int64_t>();  // componentCount, measures, volumes, surface: kept in memory
+            for (int i = 0; i < 5; ++i) r.pod<double>();
+            r.pod<uint8_t>();
+        }
+        if (k == wanted) break;
+        for (int i = 0; i < 6; ++i) r.pod<double>();  // measures, volumes
+        r.pod<uint8_t>();
+        r.pod<uint64_t>();
+    }
+    if (!r.ok()) aggregates.clear();
+    return r.ok();
+}
+
 bool deserializeHierarchy(const std::vector<uint8_t>& bytes, Hierarchy3D& h) {
     h = Hierarchy3D{};
     ByteReader r(bytes);
@@ -184,6 +221,7 @@ void leaveMeshInCache(Aggregate& a, const std::string& piece, uint32_t level, ui
         ref->index = index;
         ref->vertexCount = a.positions.size() / 3;
         ref->triangleCount = a.indices.size() / 3;
+        ref->hasFaceColors = !a.faceColors.empty();
         ref->meshHash = aggregateMeshHash(a);
         aggregateVertexSetHash(a, ref->vertexSetHash);
         a.meshInCache = std::move(ref);
@@ -200,33 +238,34 @@ void dropMeshInCache(Aggregate& a) {
 
 bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& lean, const std::vector<Aggregate*>& into,
                   int threads, std::string& error) {
-    std::map<std::string, std::vector<size_t>> byPiece;  // piece -> the j it holds, in key order
+    // (piece, level) -> the j it holds: each piece read once per level asked, that level only.
+    std::map<std::pair<std::string, uint32_t>, std::vector<size_t>> byPiece;
     for (size_t j = 0; j < lean.size(); ++j) {
         if (!lean[j]->meshInCache) {
             error = "an aggregate to read again was not left in the cache";
             return false;
         }
-        byPiece[lean[j]->meshInCache->piece].push_back(j);
+        byPiece[{lean[j]->meshInCache->piece, lean[j]->meshInCache->level}].push_back(j);
     }
     std::vector<const std::vector<size_t>*> pieces;
     for (const auto& [key, js] : byPiece) pieces.push_back(&js);
     std::vector<char> failed(pieces.size(), 0);
     parallelFor(pieces.size(), threads, [&](size_t p) {
-        const std::string& key = lean[pieces[p]->front()]->meshInCache->piece;
+        const AggregateMeshRef& first = *lean[pieces[p]->front()]->meshInCache;
         std::vector<uint8_t> bytes;
-        Hierarchy3D piece;
-        if (!cache.load || !cache.load(key, bytes) || !deserializeHierarchy(bytes, piece)) {
+        std::vector<Aggregate> level;
+        if (!cache.load || !cache.load(first.piece, bytes) || !deserializeLevel(bytes, first.level, level)) {
             failed[p] = 1;
             return;
         }
         std::vector<uint8_t>().swap(bytes);
         for (size_t j : *pieces[p]) {
             const AggregateMeshRef& ref = *lean[j]->meshInCache;
-            if (ref.level >= piece.levels.size() || ref.index >= piece.levels[ref.level].aggregates.size()) {
+            if (ref.index >= level.size()) {
                 failed[p] = 1;
                 return;
             }
-            Aggregate& from = piece.levels[ref.level].aggregates[ref.index];
+            Aggregate& from = level[ref.index];
             if (from.positions.size() / 3 != ref.vertexCount || from.indices.size() / 3 != ref.triangleCount ||
                 aggregateMeshHash(from) != ref.meshHash) {
                 failed[p] = 1;
@@ -234,7 +273,7 @@ bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& l
             }
             Aggregate& a = *into[j];
             a = *lean[j];
-            a.positions = from.positions;  // copies: a piece's aggregate may be asked for twice
+            a.positions = from.positions;  // copies: an aggregate may be asked for twice
             a.indices = from.indices;
             a.faceColors = from.faceColors;
         }

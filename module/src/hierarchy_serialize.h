@@ -70,6 +70,11 @@ public:
         v.resize(n);
         if (n && take(n * sizeof(T))) std::memcpy(v.data(), in_.data() + at_ - n * sizeof(T), n * sizeof(T));
     }
+    /// Skips an array that ByteWriter::array wrote of items of `itemBytes` each.
+    void skipArray(size_t itemBytes) {
+        const size_t n = count(itemBytes);
+        take(n * itemBytes);
+    }
     std::string text() {
         const size_t n = count(1);
         if (!take(n)) return {};
@@ -96,6 +101,12 @@ void serializeHierarchy(const Hierarchy3D& h, std::vector<uint8_t>& bytes);
 
 /// Reads what serializeHierarchy wrote; false (and `h` reset) for anything else.
 bool deserializeHierarchy(const std::vector<uint8_t>& bytes, Hierarchy3D& h);
+
+/// The meshes, sources and colours of the aggregates of level `level` only of what
+/// serializeHierarchy wrote (the rest of each aggregate left at its defaults); the levels
+/// before it are skipped, those after it not read. False (and `aggregates` empty) when the
+/// bytes end early or there is no such level.
+bool deserializeLevel(const std::vector<uint8_t>& bytes, uint32_t level, std::vector<Aggregate>& aggregates);
 
 /// Leaves `a`'s mesh in the tile cache entry `piece` (where it is aggregate `index` of level
 /// `level`): sets a.meshInCache (hashes and counts of the mesh) unless set, then frees the

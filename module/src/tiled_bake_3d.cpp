@@ -430,7 +430,13 @@ void TiledBaker::keepLayout(double tileSize) const {
 
 bool TiledBaker::run(double tileSize) {
     if (!reuseLayout(tileSize)) {
-        if (!layOut(tileSize)) return buildHierarchy3D(objects_, settings_, out_);
+        if (!layOut(tileSize)) {
+            if (lean()) {  // nothing in the cache to assemble: the caller bakes the world whole
+                diag(out_, Diagnostic::Severity::Error, "", "the world fits one tile: there are no pieces to assemble");
+                return false;
+            }
+            return buildHierarchy3D(objects_, settings_, out_);
+        }
         keepLayout(tileSize);
     }
 
@@ -710,6 +716,14 @@ bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settin
     TiledBakeOptions options;
     options.tileSize = tileSize;
     return buildTiledHierarchy3D(objects, settings, options, out, report);
+}
+
+bool readAggregateMeshes(const TileCache& cache, const std::vector<const Aggregate*>& lean, std::vector<Aggregate>& out,
+                         int threads, std::string& error) {
+    out.assign(lean.size(), Aggregate{});
+    std::vector<Aggregate*> into(lean.size());
+    for (size_t j = 0; j < lean.size(); ++j) into[j] = &out[j];
+    return detail::reloadMeshes(cache, lean, into, threads, error);
 }
 
 bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings,

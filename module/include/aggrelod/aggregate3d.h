@@ -119,6 +119,7 @@ struct AggregateMeshRef {
     std::string piece;                   ///< the tile cache key of the piece holding the aggregate
     uint32_t level = 0, index = 0;       ///< its level and place in that piece's Hierarchy3D
     size_t vertexCount = 0, triangleCount = 0;
+    bool hasFaceColors = false;          ///< faceColors was not empty
     std::string meshHash;                ///< aggregateMeshHash() of the mesh
     uint64_t vertexSetHash[2] = {0, 0};  ///< aggregateVertexSetHash() of the mesh
 };

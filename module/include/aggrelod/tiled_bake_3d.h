@@ -117,4 +117,11 @@ bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settin
 bool buildTiledHierarchy3D(const std::vector<InputObject>& objects, const Settings3D& settings,
                            const TiledBakeOptions& options, Hierarchy3D& out, TiledBakeReport* report = nullptr);
 
+/// Reads back from `cache` the meshes a lean assembly left there (TiledBakeOptions::leanMeshes):
+/// out[j] is *lean[j] with its positions, indices and faceColors (out resized to lean.size()).
+/// Each piece is read once per level asked; runs on up to `threads` threads (0: all cores).
+/// False with `error` naming a piece that is missing or no longer holds a mesh with the hash kept.
+bool readAggregateMeshes(const TileCache& cache, const std::vector<const Aggregate*>& lean, std::vector<Aggregate>& out,
+                         int threads, std::string& error);
+
 }  // namespace aggrelod
