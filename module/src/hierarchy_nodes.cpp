@@ -1091,11 +1091,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             lean.push_back(&aggregateOf(nodes[i]));
             into.push_back(reloaded[i].get());
         }
-        if (!settings.cache || !detail::reloadMeshes(*settings.cache, lean, into, settings.threadCount, reloadError))
-            return false;
-        for (uint32_t i : which)
-            if (!checkMesh(*reloaded[i], "the aggregate of node " + std::to_string(i) + " read again", reloadError)) return false;
-        return true;
+        if (!settings.cache) reloadError = "the hierarchy's meshes are in a tile cache, but no cache was given";
+        return settings.cache && detail::reloadMeshes(*settings.cache, lean, into, settings.threadCount, reloadError);
     };
     // The aggregate of node i with its mesh (read again alone if it was not read for its item).
     const auto meshOf = [&](uint32_t i) -> const Aggregate& {
@@ -1561,6 +1558,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 exactAt[j - i] = static_cast<uint32_t>(lean.size());
                 lean.push_back(&a);
             }
+            if (!lean.empty() && !settings.cache)
+                reloadError = "the hierarchy's meshes are in a tile cache, but no cache was given";
             if (!lean.empty() && !(settings.cache && readAggregateMeshes(*settings.cache, lean, exactRun, settings.threadCount,
                                                                         reloadError)))
                 return finish(false);
@@ -1582,7 +1581,12 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
 
 bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                          const ProxySettings& settings, HierarchyNodes& out, std::string& error) {
-    return buildNodes(hierarchy, objects, settings, nullptr, out, error);
+    try {
+        return buildNodes(hierarchy, objects, settings, nullptr, out, error);
+    } catch (const std::runtime_error& e) {  // a lean hierarchy's mesh that did not read back
+        error = e.what();
+        return false;
+    }
 }
 
 bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,

@@ -266,7 +266,11 @@ bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& l
                 return;
             }
             Aggregate& from = level[ref.index];
-            if (from.positions.size() / 3 != ref.vertexCount || from.indices.size() / 3 != ref.triangleCount ||
+            const bool wellFormed =
+                from.positions.size() % 3 == 0 && from.indices.size() % 3 == 0 &&
+                (from.faceColors.empty() || from.faceColors.size() == 4 * (from.indices.size() / 3)) &&
+                std::all_of(from.indices.begin(), from.indices.end(), [&](uint32_t v) { return v < from.positions.size() / 3; });
+            if (!wellFormed || from.positions.size() / 3 != ref.vertexCount || from.indices.size() / 3 != ref.triangleCount ||
                 aggregateMeshHash(from) != ref.meshHash) {
                 failed[p] = 1;
                 return;

@@ -119,7 +119,8 @@ void dropMeshInCache(Aggregate& a);
 /// Reads the meshes of lean aggregates (Aggregate::meshInCache) back from `cache`, each piece
 /// once: for every j, the mesh of *lean[j] into *into[j] (positions, indices, faceColors; the
 /// rest copied from *lean[j]). Runs on up to `threads` threads. False naming the first piece
-/// that is missing, does not read back, or no longer holds a mesh with the hashes kept.
+/// that is missing, does not read back, or no longer holds a well-formed mesh (sizes, indices
+/// in range) with the hash kept.
 bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& lean, const std::vector<Aggregate*>& into,
                   int threads, std::string& error);
 

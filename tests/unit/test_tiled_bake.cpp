@@ -428,11 +428,15 @@ TEST(TiledBakeCli, OptionsErrorsPlanAndCachedRebake) {
     ASSERT_EQ(first.exitCode, 0) << first.describe();
     EXPECT_NE(first.out.find(" read from "), std::string::npos) << first.out;
     const std::string aglod = aggrelod::testing::readFile(dir / "out" / "scene.aglod");
+    const std::string levels = aggrelod::testing::readFile(dir / "out" / "levels.glb");
+    // Every piece in the cache: the hierarchy is held without its exact meshes, which the
+    // bounds and levels.glb read back from the cache. The same files.
     const auto second = bake(cached);
     ASSERT_EQ(second.exitCode, 0) << second.describe();
     EXPECT_NE(second.out.find("tiles: 0 cells and 0 parent cells baked"), std::string::npos) << second.out;
     EXPECT_NE(second.out.find("proxies: 0 items made"), std::string::npos) << second.out;
     EXPECT_EQ(aggrelod::testing::readFile(dir / "out" / "scene.aglod"), aglod) << "a cached rebake gives the same file";
+    EXPECT_EQ(aggrelod::testing::readFile(dir / "out" / "levels.glb"), levels) << "a cached rebake gives the same file";
 #ifdef AGGRELOD_CLI_ASAN
     // Damaged cache files through the AddressSanitizer build of the CLI: refused, baked again,
     // same outputs, no sanitizer report (which would end the process with an error).
@@ -658,4 +662,25 @@ TEST(ProxyCache, LeanSharesReadTheirOwnMeshesAndGiveTheSameNodes) {
     ASSERT_TRUE(buildHierarchyNodes(h, objects, cached, whole, error)) << error;
     EXPECT_EQ(whole.proxyItemsMade, 0u) << "the lean shares made every item";
     expectSameNodes(whole, plain);
+    // The whole stage on the lean hierarchy, as the bake's last step runs it when every piece
+    // is in the cache: the nodes' bounds read the exact meshes back. The same nodes.
+    HierarchyNodes fromLean;
+    ASSERT_TRUE(buildHierarchyNodes(lean, objects, cached, fromLean, error)) << error;
+    expectSameNodes(fromLean, plain);
+    // A piece whose aggregate changed after the assembly (an index far out of range): refused,
+    // naming the piece, never read out of bounds.
+    const Aggregate* group = nullptr;  // the finest aggregate of several objects: a node of its own
+    for (const Level& level : lean.levels)
+        for (const Aggregate& a : level.aggregates)
+            if (!group && a.sourceObjects.size() > 1) group = &a;
+    ASSERT_NE(group, nullptr);
+    const std::string changed = group->meshInCache->piece;
+    Hierarchy3D piece;
+    ASSERT_TRUE(detail::deserializeHierarchy(memory.entries.at(changed), piece));
+    piece.levels[group->meshInCache->level].aggregates[group->meshInCache->index].indices.front() = 1000000000u;
+    memory.entries[changed].clear();
+    detail::serializeHierarchy(piece, memory.entries[changed]);
+    HierarchyNodes refused;
+    EXPECT_FALSE(buildHierarchyNodes(lean, objects, cached, refused, error));
+    EXPECT_NE(error.find(changed), std::string::npos) << error;
 }
