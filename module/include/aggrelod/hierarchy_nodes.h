@@ -61,6 +61,8 @@ struct ProxySettings {
     /// back instead of making it again, so a rebake after a local change redoes only the items
     /// it touched, and separate processes can share the work (buildProxyShare). The nodes are
     /// bit-identical with or without. Called from several threads at once (tile_cache.h).
+    /// Required for a hierarchy whose meshes a lean assembly left in the tile cache
+    /// (TiledBakeOptions::leanMeshes): they are read back from it where needed.
     const TileCache* cache = nullptr;
 };
 

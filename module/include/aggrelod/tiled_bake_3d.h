@@ -93,9 +93,10 @@ struct TiledBakeOptions {
     /// and keeps that; objects changed in place need a fresh layout (newTiledLayout).
     std::shared_ptr<TiledLayout> layout;
     /// TileTask::Kind::Assemble only: leave every aggregate's mesh in the cache
-    /// (Aggregate::meshInCache), so that the whole hierarchy is held without its meshes; for
-    /// buildProxyShare, which reads again the meshes of its own work only. Such a hierarchy is
-    /// for buildProxyShare alone.
+    /// (Aggregate::meshInCache), so that the whole hierarchy is held without its meshes. Such
+    /// a hierarchy goes only where that cache is given too: buildProxyShare and
+    /// buildHierarchyNodes (ProxySettings::cache) read back the meshes they need, as does
+    /// readAggregateMeshes. A world that fits one tile has no pieces: refused with an Error.
     bool leanMeshes = false;
 };
 
