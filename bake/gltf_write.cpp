@@ -987,7 +987,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                     meshAt.assign(std::min(kMeshRun, level.aggregates.size() - g), UINT32_MAX);
                     for (size_t j = g; j < g + meshAt.size(); ++j) {
                         const Aggregate& a = level.aggregates[j];
-                        if (!a.meshInCache || !a.positions.empty()) continue;
+                        if (!meshLeftInCache(a)) continue;
                         meshAt[j - g] = static_cast<uint32_t>(lean.size());
                         lean.push_back(&a);
                     }

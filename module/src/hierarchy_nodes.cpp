@@ -932,7 +932,7 @@ constexpr double kLadderCostPerTriangle = 8.0;
 /// An aggregate's mesh is well formed (sizes, indices in range); true for a lean one (checked
 /// when read again).
 bool checkMesh(const Aggregate& agg, const std::string& where, std::string& error) {
-    if (agg.meshInCache && agg.positions.empty() && agg.indices.empty()) return true;
+    if (meshLeftInCache(agg)) return true;
     if (agg.positions.size() % 3 || agg.indices.size() % 3) {
         error = where + ": positions or indices size is not a multiple of 3";
         return false;
@@ -1080,8 +1080,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     std::vector<std::unique_ptr<Aggregate>> reloaded(nodes.size());
     std::string reloadError;
     const auto needsReload = [&](uint32_t i) {
-        const Aggregate& a = aggregateOf(nodes[i]);
-        return a.meshInCache && a.positions.empty() && a.indices.empty();
+        return meshLeftInCache(aggregateOf(nodes[i]));
     };
     const auto reload = [&](const std::vector<uint32_t>& which) {
         std::vector<const Aggregate*> lean;
@@ -1554,7 +1553,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 const HierarchyNode& m = nodes[j];
                 if (m.leaf || m.objectLod > 0 || m.coarserStep > 0) continue;
                 const Aggregate& a = aggregateOf(m);
-                if (!a.meshInCache || !a.positions.empty()) continue;
+                if (!meshLeftInCache(a)) continue;
                 exactAt[j - i] = static_cast<uint32_t>(lean.size());
                 lean.push_back(&a);
             }

@@ -296,7 +296,7 @@ bool reloadMeshes(const TileCache& cache, const std::vector<const Aggregate*>& l
 namespace aggrelod {
 
 std::string aggregateMeshHash(const Aggregate& a) {
-    if (a.meshInCache && a.positions.empty() && a.indices.empty()) return a.meshInCache->meshHash;
+    if (meshLeftInCache(a)) return a.meshInCache->meshHash;
     detail::ContentHash h;
     h.text("aggregate mesh");
     h.values(a.positions);
@@ -305,7 +305,7 @@ std::string aggregateMeshHash(const Aggregate& a) {
 }
 
 void aggregateVertexSetHash(const Aggregate& a, uint64_t hash[2]) {
-    if (a.meshInCache && a.positions.empty() && a.indices.empty()) {
+    if (meshLeftInCache(a)) {
         hash[0] = a.meshInCache->vertexSetHash[0];
         hash[1] = a.meshInCache->vertexSetHash[1];
         return;

@@ -147,6 +147,10 @@ struct Aggregate {
     std::shared_ptr<const AggregateMeshRef> meshInCache;
 };
 
+/// The aggregate's mesh is in the tile cache and not here (meshInCache set, no positions or
+/// indices held): what needs it reads it back (readAggregateMeshes).
+inline bool meshLeftInCache(const Aggregate& a) { return a.meshInCache && a.positions.empty() && a.indices.empty(); }
+
 /// A content hash (32 hex digits) of an aggregate's positions and indices; the one kept in
 /// meshInCache when the mesh was left there.
 std::string aggregateMeshHash(const Aggregate& a);
