@@ -22,18 +22,24 @@ uint64_t settingsHash(const std::string& text) {
 bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                        uint64_t hash, const std::string& toolVersion, const std::string& path,
                        std::string& error, int threadCount) {
-    runtime::BuildArrays arrays;
-    if (!exportHierarchy(nodes, objects, hash, toolVersion, arrays, error, threadCount)) {
-        error = path + ": " + error;
-        return false;
-    }
-    // Straight to the file: the arrays and a whole image of the file would be twice the
-    // hierarchy in memory.
-    if (!runtime::writeRuntimeFile(std::move(arrays), path, error)) {
-        if (error.rfind(path, 0) != 0) error = path + ": " + error;
-        return false;
-    }
-    return true;
+    // A node at a time: the vertex arrays of a large hierarchy wait in spill files, not beside
+    // the nodes in memory.
+    std::vector<std::string> names;
+    names.reserve(objects.size());
+    for (const InputObject& o : objects) names.push_back(o.name);
+    runtime::RuntimeFileStreamWriter writer;
+    const bool written =
+        writer.open(path, std::move(names), hash, toolVersion, error) &&
+        exportHierarchyNodes(nodes, threadCount, [&](size_t i, const runtime::NodeRecord& record, const RenderMesh& mesh,
+                                                     std::string& message) {
+            const HierarchyNode& n = nodes.nodes[i];
+            return writer.addNode(record, n.children.data(), n.children.size(), n.sources.data(), n.sources.size(),
+                                  mesh.positions.data(), mesh.normals.data(), mesh.colors.data(),
+                                  mesh.positions.size() / 3, mesh.indices.data(), mesh.indices.size(), message);
+        }, error) &&
+        writer.finish(error);
+    if (!written && error.rfind(path, 0) != 0) error = path + ": " + error;
+    return written;
 }
 
 }  // namespace aggrelod::io

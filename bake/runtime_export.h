@@ -14,9 +14,10 @@ namespace aggrelod::io {
 /// 64-bit FNV-1a of `text` (the canonical text of the bake settings).
 uint64_t settingsHash(const std::string& text);
 
-/// exportHierarchy + runtime::writeRuntimeFile + writing `path` (the caller renames it into
-/// place). Meshes built on up to `threadCount` threads (0: all cores). Deterministic: the
-/// same nodes give the same bytes, for any thread count.
+/// exportHierarchyNodes into a runtime::RuntimeFileStreamWriter: writes `path` (the caller
+/// renames it into place) a node at a time, its vertex arrays never all in memory. Meshes
+/// built on up to `threadCount` threads (0: all cores). Deterministic: the same nodes give the
+/// same bytes as runtime::writeRuntimeFile of exportHierarchy's arrays, for any thread count.
 bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
                        uint64_t settingsHash, const std::string& toolVersion, const std::string& path,
                        std::string& error, int threadCount = 1);

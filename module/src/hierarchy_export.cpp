@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <new>
 #include <numeric>
@@ -141,13 +142,8 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
     return true;
 }
 
-bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
-                     uint64_t hash, const std::string& toolVersion, runtime::BuildArrays& params,
-                     std::string& error, int threadCount) {
-    params = runtime::BuildArrays{};
-    params.settingsHash = hash;
-    params.toolVersion = toolVersion;
-    for (const InputObject& o : objects) params.objectNames.push_back(o.name);
+bool exportHierarchyNodes(const HierarchyNodes& nodes, int threadCount, const NodeExportSink& emit,
+                          std::string& error) {
     size_t totalChildren = 0, totalSources = 0, totalIndices = 0;
     for (const HierarchyNode& n : nodes.nodes) {
         totalChildren += n.children.size();
@@ -160,22 +156,7 @@ bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>
         error = "the hierarchy is too large for the runtime file (more than 2^32 nodes, vertices or indices)";
         return false;
     }
-    params.nodes.reserve(nodes.nodes.size());
-    params.childIndices.reserve(totalChildren);
-    params.sourceObjects.reserve(totalSources);
-    params.indices.reserve(totalIndices);
-    // The vertex arrays are reserved for that most (address space: only what is filled takes
-    // memory), so they never grow by copying, and the render meshes are made a batch at a
-    // time: the peak stays near one copy of the arrays.
-    try {
-        params.positions.reserve(3 * totalIndices);
-        params.normals.reserve(3 * totalIndices);
-        params.colors.reserve(4 * totalIndices);
-    } catch (const std::bad_alloc&) {  // no such address space: the arrays grow as they fill
-        params.positions.shrink_to_fit();
-        params.normals.shrink_to_fit();
-        params.colors.shrink_to_fit();
-    }
+    // The render meshes are made a batch at a time: only one batch of them is held.
     std::vector<RenderMesh> meshes;
     const size_t batch = 1024;
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
@@ -197,6 +178,58 @@ bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>
         RenderMesh& mesh = meshes[i % batch];
         runtime::NodeRecord b;
         b.parent = n.parent == kNoNode ? runtime::kNoIndex : n.parent;
+        b.level = n.leaf ? runtime::kLeafLevel
+                  : n.objectLod >= 1 ? runtime::kObjectLodLevel
+                  : n.coarserStep >= 1 ? runtime::kCoarserLevel
+                                     : static_cast<uint32_t>(n.firstLevel);
+        b.delta = static_cast<float>(n.delta);
+        // Float-representable by construction (hierarchy_nodes.h): the casts are exact.
+        b.geometricError = static_cast<float>(n.geometricError);
+        for (int k = 0; k < 3; ++k) {
+            b.boundsMin[k] = static_cast<float>(n.boundsMin[k]);
+            b.boundsMax[k] = static_cast<float>(n.boundsMax[k]);
+            b.sphereCenter[k] = static_cast<float>(n.sphereCenter[k]);
+        }
+        b.sphereRadius = static_cast<float>(n.sphereRadius);
+        if (!emit(i, b, mesh, error)) return false;
+        mesh = RenderMesh{};  // keep the peak memory near one batch of meshes
+    }
+    return true;
+}
+
+bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>& objects,
+                     uint64_t hash, const std::string& toolVersion, runtime::BuildArrays& params,
+                     std::string& error, int threadCount) {
+    params = runtime::BuildArrays{};
+    params.settingsHash = hash;
+    params.toolVersion = toolVersion;
+    for (const InputObject& o : objects) params.objectNames.push_back(o.name);
+    size_t totalChildren = 0, totalSources = 0, totalIndices = 0;
+    for (const HierarchyNode& n : nodes.nodes) {
+        totalChildren += n.children.size();
+        totalSources += n.sources.size();
+        totalIndices += n.indices.size();
+    }
+    if (std::max({nodes.nodes.size(), totalChildren, totalSources, totalIndices}) < std::numeric_limits<uint32_t>::max()) {
+        params.nodes.reserve(nodes.nodes.size());
+        params.childIndices.reserve(totalChildren);
+        params.sourceObjects.reserve(totalSources);
+        params.indices.reserve(totalIndices);
+        // The vertex arrays are reserved for that most (address space: only what is filled
+        // takes memory), so they never grow by copying.
+        try {
+            params.positions.reserve(3 * totalIndices);
+            params.normals.reserve(3 * totalIndices);
+            params.colors.reserve(4 * totalIndices);
+        } catch (const std::bad_alloc&) {  // no such address space: the arrays grow as they fill
+            params.positions.shrink_to_fit();
+            params.normals.shrink_to_fit();
+            params.colors.shrink_to_fit();
+        }
+    }
+    return exportHierarchyNodes(nodes, threadCount, [&](size_t i, runtime::NodeRecord b, const RenderMesh& mesh,
+                                                        std::string&) {
+        const HierarchyNode& n = nodes.nodes[i];
         b.firstChild = static_cast<uint32_t>(params.childIndices.size());
         b.childCount = static_cast<uint32_t>(n.children.size());
         params.childIndices.insert(params.childIndices.end(), n.children.begin(), n.children.end());
@@ -211,23 +244,9 @@ bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>
         b.firstIndex = static_cast<uint32_t>(params.indices.size());
         b.indexCount = static_cast<uint32_t>(mesh.indices.size());
         params.indices.insert(params.indices.end(), mesh.indices.begin(), mesh.indices.end());
-        mesh = RenderMesh{};  // keep the peak memory near one copy of the arrays
-        b.level = n.leaf ? runtime::kLeafLevel
-                  : n.objectLod >= 1 ? runtime::kObjectLodLevel
-                  : n.coarserStep >= 1 ? runtime::kCoarserLevel
-                                     : static_cast<uint32_t>(n.firstLevel);
-        b.delta = static_cast<float>(n.delta);
-        // Float-representable by construction (hierarchy_nodes.h): the casts are exact.
-        b.geometricError = static_cast<float>(n.geometricError);
-        for (int k = 0; k < 3; ++k) {
-            b.boundsMin[k] = static_cast<float>(n.boundsMin[k]);
-            b.boundsMax[k] = static_cast<float>(n.boundsMax[k]);
-            b.sphereCenter[k] = static_cast<float>(n.sphereCenter[k]);
-        }
-        b.sphereRadius = static_cast<float>(n.sphereRadius);
         params.nodes.push_back(b);
-    }
-    return true;
+        return true;
+    }, error);
 }
 
 }  // namespace aggrelod

@@ -64,21 +64,37 @@ inline uint16_t loadU16(const uint8_t* p) { uint16_t v; std::memcpy(&v, p, 2); r
 /// lanes, then the lanes folded by the same step. Each step is a bijection of the state, so
 /// any change confined to one word (in particular any single-byte change) changes the result;
 /// four lanes keep the multiplications independent (several GB/s, for a fast open).
-/// The 8 bytes at `skipOffset` are read as zero (the checksum field itself).
-inline uint64_t fileChecksum(const uint8_t* data, size_t size, size_t skipOffset) {
-    constexpr uint64_t kPrime = 0x100000001b3ull;
-    uint64_t lane[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull,
-                        0x2325cbf29ce48422ull};
-    for (size_t i = 0; i + 32 <= size; i += 32) {
-        for (int k = 0; k < 4; ++k) {
-            const size_t at = i + 8 * static_cast<size_t>(k);
-            const uint64_t word = at == skipOffset ? 0 : loadU64(data + at);
-            lane[k] = (lane[k] ^ word) * kPrime;
+/// The 8 bytes at `skipOffset` are read as zero (the checksum field itself). Resumable: add()
+/// whole 32-byte blocks in file order, in as many calls as wanted.
+class FileChecksum {
+public:
+    /// Bytes [at, at + size) of the file, at `data` (at and size multiples of 32).
+    void add(const uint8_t* data, size_t at, size_t size, size_t skipOffset) {
+        for (size_t i = 0; i + 32 <= size; i += 32) {
+            for (int k = 0; k < 4; ++k) {
+                const size_t offset = i + 8 * static_cast<size_t>(k);
+                const uint64_t word = at + offset == skipOffset ? 0 : loadU64(data + offset);
+                lane_[k] = (lane_[k] ^ word) * kPrime;
+            }
         }
     }
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (uint64_t l : lane) h = (h ^ l) * kPrime;
-    return h ^ static_cast<uint64_t>(size);
+    /// The checksum of a file of `size` bytes once all of them were added.
+    uint64_t value(size_t size) const {
+        uint64_t h = 0xcbf29ce484222325ull;
+        for (uint64_t l : lane_) h = (h ^ l) * kPrime;
+        return h ^ static_cast<uint64_t>(size);
+    }
+
+private:
+    static constexpr uint64_t kPrime = 0x100000001b3ull;
+    uint64_t lane_[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull,
+                         0x2325cbf29ce48422ull};
+};
+
+inline uint64_t fileChecksum(const uint8_t* data, size_t size, size_t skipOffset) {
+    FileChecksum sum;
+    sum.add(data, 0, size, skipOffset);
+    return sum.value(size);
 }
 
 }  // namespace aggrelod::runtime::layout

@@ -112,7 +112,23 @@ bool MappedFile::open(const std::string& path, std::string& message) {
     return true;
 }
 
+void MappedFile::release(const void* begin, size_t bytes) const {
+    // Unlocking pages that are not locked removes them from the working set.
+    if (address_ != nullptr && bytes > 0) VirtualUnlock(const_cast<void*>(begin), bytes);
+}
+
 #else
+
+void MappedFile::release(const void* begin, size_t bytes) const {
+    if (address_ == nullptr || bytes == 0) return;
+    const long pageSize = sysconf(_SC_PAGESIZE);
+    if (pageSize <= 0) return;
+    const uintptr_t page = static_cast<uintptr_t>(pageSize);
+    const uintptr_t from = (reinterpret_cast<uintptr_t>(begin) + page - 1) / page * page;
+    const uintptr_t to = (reinterpret_cast<uintptr_t>(begin) + bytes) / page * page;
+    // A private read-only mapping never written to: dropped pages come back from the file.
+    if (to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_DONTNEED);
+}
 
 MappedFile::~MappedFile() {
     if (address_ != nullptr) munmap(address_, size_);

@@ -21,6 +21,10 @@ public:
     bool open(const std::string& path, std::string& message);
     const uint8_t* data() const { return static_cast<const uint8_t*>(address_); }
     size_t size() const { return size_; }
+    /// Lets the system drop the resident pages wholly inside [begin, begin + bytes) of the
+    /// mapping (they are read from the file again if used): a large file validated once does
+    /// not stay resident as a whole. A hint; does nothing where not supported.
+    void release(const void* begin, size_t bytes) const;
 
 private:
     void* address_ = nullptr;

@@ -73,6 +73,25 @@ struct FileValidator {
     size_t size;
     RuntimeFile& out;
     std::string& message;
+    /// The file's mapping (openFile), whose pages the linear passes release behind them.
+    const MappedFile* mapping = nullptr;
+
+    /// Releases what a linear pass over [begin, end) has read, every kReleaseStep bytes.
+    class ReleaseBehind {
+    public:
+        static constexpr size_t kReleaseStep = size_t(64) << 20;
+        ReleaseBehind(const MappedFile* mapping, const void* begin) : mapping_(mapping), from_(static_cast<const uint8_t*>(begin)) {}
+        void reached(const void* at) {
+            const auto* p = static_cast<const uint8_t*>(at);
+            if (mapping_ == nullptr || p < from_ || size_t(p - from_) < kReleaseStep) return;
+            mapping_->release(from_, size_t(p - from_));
+            from_ = p;
+        }
+
+    private:
+        const MappedFile* mapping_;
+        const uint8_t* from_;
+    };
 
     FileStatus fail(FileStatus status, std::string text) {
         message = std::move(text);
@@ -106,7 +125,17 @@ struct FileValidator {
             return fail(FileStatus::BadSection, "total size " + std::to_string(total) +
                                                     " is not a multiple of 32 of at least 64");
         const uint64_t stored = loadU64(base + kChecksumOffset);
-        const uint64_t actual = fileChecksum(base, static_cast<size_t>(total), kChecksumOffset);
+        uint64_t actual = 0;
+        {
+            FileChecksum sum;
+            ReleaseBehind read(mapping, base);
+            for (size_t at = 0; at < total; at += ReleaseBehind::kReleaseStep) {
+                const size_t bytes = std::min<size_t>(ReleaseBehind::kReleaseStep, size_t(total) - at);
+                sum.add(base + at, at, bytes, kChecksumOffset);
+                read.reached(base + at + bytes);
+            }
+            actual = sum.value(static_cast<size_t>(total));
+        }
         if (stored != actual)
             return fail(FileStatus::ChecksumMismatch, "stored checksum does not match the content");
         // Past the checksum only a writer bug (or a deliberate forgery) can fail; keep checking.
@@ -265,8 +294,10 @@ struct FileValidator {
             s != FileStatus::Ok)
             return s;
         // Disjoint ranges: this pass reads each index at most once.
+        ReleaseBehind indicesRead(mapping, out.indices_.data);
         for (uint64_t i = 0; i < n; ++i) {
             const NodeRecord& r = nodes[i];
+            indicesRead.reached(out.indices_.data + r.firstIndex);
             for (uint32_t k = 0; k < r.indexCount; ++k)
                 if (out.indices_[r.firstIndex + k] >= r.vertexCount)
                     return fail(FileStatus::IndexOutOfRange,
@@ -274,12 +305,17 @@ struct FileValidator {
                                     std::to_string(out.indices_[r.firstIndex + k]) + " >= its vertex count " +
                                     std::to_string(r.vertexCount));
         }
-        for (size_t i = 0; i < out.positions_.size; ++i)
+        ReleaseBehind positionsRead(mapping, out.positions_.data);
+        for (size_t i = 0; i < out.positions_.size; ++i) {
+            if (i % 4096 == 0) positionsRead.reached(out.positions_.data + i);
             if (!(std::fabs(out.positions_[i]) <= kMaxMagnitude))
                 return fail(FileStatus::BadValue, "vertex " + std::to_string(i / 3) +
                                                       ": NaN, infinite or beyond 1e18 coordinate");
+        }
+        ReleaseBehind normalsRead(mapping, out.normals_.data);
         for (size_t v = 0; v < out.normals_.size / 3; ++v) {
             const float* nv = out.normals_.data + 3 * v;
+            if (v % 4096 == 0) normalsRead.reached(nv);
             const float length2 = nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2];
             // NaN fails the comparison too.
             if (!(std::fabs(length2 - 1.0f) <= 2.0f * layout::kNormalLengthTolerance))
@@ -499,11 +535,14 @@ FileStatus RuntimeFile::openFile(const std::string& path, RuntimeFile& out, std:
         message = path + ": empty file";
         return FileStatus::Truncated;
     }
-    const FileStatus status = openMemory(mapping->data(), mapping->size(), out, message);
+    RuntimeFile candidate;
+    FileValidator validator{mapping->data(), mapping->size(), candidate, message, mapping.get()};
+    const FileStatus status = validator.run();
     if (status != FileStatus::Ok) {
         message = path + ": " + message;
         return status;
     }
+    out = std::move(candidate);
     out.mapping_ = std::move(mapping);
     return status;
 }

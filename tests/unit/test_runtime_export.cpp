@@ -13,6 +13,9 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 
@@ -275,4 +278,33 @@ TEST(RuntimeExport, FileCarriesNormalsColoursAndPerObjectLodLevels) {
     std::vector<uint8_t> bytesAgain;
     ASSERT_TRUE(runtime::writeRuntimeFile(again, bytesAgain, error));
     EXPECT_EQ(bytes, bytesAgain);
+
+    // Written a node at a time (the bake's way, vertex arrays in spill files): the same bytes,
+    // and nothing else left in the folder.
+    const std::filesystem::path folder = std::filesystem::temp_directory_path() /
+                                         ("aggrelod_stream_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                          "_" + std::to_string(reinterpret_cast<uintptr_t>(&nodes)));
+    std::filesystem::remove_all(folder);
+    std::filesystem::create_directories(folder);
+    const std::string path = (folder / "scene.aglod").string();
+    ASSERT_TRUE(io::writeRuntimeScene(nodes, objects, 7, "test", path, error, 2)) << error;
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<uint8_t> streamed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    EXPECT_EQ(streamed, bytes);
+    auto entries = [&] {
+        std::vector<std::string> names;
+        for (const auto& e : std::filesystem::directory_iterator(folder)) names.push_back(e.path().filename().string());
+        return names;
+    };
+    EXPECT_EQ(entries(), (std::vector<std::string>{"scene.aglod"}));
+    // A hierarchy the reader refuses (a child whose parent is another node): an error naming
+    // the file and the node, and neither the file nor a spill file left behind.
+    nodes.nodes[plain].parent = root;
+    std::filesystem::remove(path);
+    EXPECT_FALSE(io::writeRuntimeScene(nodes, objects, 7, "test", path, error, 2));
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+    EXPECT_NE(error.find("has parent"), std::string::npos) << error;
+    EXPECT_TRUE(entries().empty());
+    std::filesystem::remove_all(folder);
 }

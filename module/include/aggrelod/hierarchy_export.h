@@ -9,6 +9,7 @@
 #include <aggrelod/runtime_build.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,19 @@ struct RenderMesh {
 /// of range or indices.size() is not a multiple of 3.
 bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
                      const std::vector<float>& faceColors, RenderMesh& out);
+
+/// Receives node i's record (its ranges left 0: the receiver places the arrays) and render mesh.
+/// Returns false with `error` filled to stop the export.
+using NodeExportSink =
+    std::function<bool(size_t node, runtime::NodeRecord record, const RenderMesh& mesh, std::string& error)>;
+
+/// The runtime contract of `nodes` a node at a time, in node order (what exportHierarchy
+/// stores, for writers that do not hold it all: runtime::RuntimeFileStreamWriter). Records as
+/// exportHierarchy describes; the render meshes are built a batch of 1,024 nodes at a time on
+/// up to `threadCount` threads (0: all cores), `emit` is called from the calling thread. False
+/// with a message when a count does not fit 32 bits, an index is out of range or emit fails.
+bool exportHierarchyNodes(const HierarchyNodes& nodes, int threadCount, const NodeExportSink& emit,
+                          std::string& error);
 
 /// Fills `out` from `nodes` (node i of the file = nodes.nodes[i]; leaves carry the original
 /// object's triangles, aggregates and per-object LODs their simplified proxy, as float world

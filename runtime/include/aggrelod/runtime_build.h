@@ -164,6 +164,38 @@ inline bool writeRuntimeFile(const BuildArrays& arrays, std::vector<uint8_t>& by
 /// nothing is left at `path`.
 bool writeRuntimeFile(BuildArrays&& arrays, const std::string& path, std::string& error);
 
+/// Writes a `.aglod` file a node at a time: the bytes writeRuntimeFile gives for the same
+/// arrays, without the vertex and index arrays in memory (they wait in spill files beside
+/// `path`, removed when done), for hierarchies too large to hold twice. Call open, then addNode
+/// once per node in node order, then finish, which lays the file out, writes it and checks it
+/// with RuntimeFile::openFile (refusing what the reader would refuse). On any failure, or when
+/// the writer is destroyed before finish succeeds, nothing is left at `path`.
+class RuntimeFileStreamWriter {
+public:
+    RuntimeFileStreamWriter();
+    ~RuntimeFileStreamWriter();
+    RuntimeFileStreamWriter(const RuntimeFileStreamWriter&) = delete;
+    RuntimeFileStreamWriter& operator=(const RuntimeFileStreamWriter&) = delete;
+
+    /// objectNames: one per original object (UTF-8); toolVersion: shorter than 24 bytes.
+    bool open(const std::string& path, std::vector<std::string> objectNames, uint64_t settingsHash,
+              std::string toolVersion, std::string& error);
+    /// The next node. record's ranges (firstChild/childCount, firstSource/sourceCount,
+    /// firstVertex/vertexCount, firstIndex/indexCount) are set here from the arrays given; its
+    /// other fields are written as they are. children: childCount node indices; sources:
+    /// sourceCount object indices; positions and normals: 3 * vertexCount floats (world units,
+    /// unit normals); colors: 4 * vertexCount bytes (encodeColorSrgb8); indices: indexCount,
+    /// relative to this node's first vertex. Null pointers only with a count of 0.
+    bool addNode(NodeRecord record, const uint32_t* children, size_t childCount, const uint32_t* sources,
+                 size_t sourceCount, const float* positions, const float* normals, const uint8_t* colors,
+                 size_t vertexCount, const uint32_t* indices, size_t indexCount, std::string& error);
+    bool finish(std::string& error);
+
+private:
+    struct State;
+    State* state_;
+};
+
 /// Linear RGBA in [0, 1] (glTF baseColorFactor / COLOR_0 meaning; clamped, NaN -> 0) to the
 /// file's colour bytes: RGB through the sRGB transfer function, alpha linear, rounded to
 /// nearest. decodeColorSrgb8 is its inverse up to that rounding (exact for the 256 codes).
