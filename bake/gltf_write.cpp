@@ -424,9 +424,19 @@ public:
     int addMeshDeferred(const std::string& name, std::vector<double>&& positionsIn, const std::vector<uint32_t>& indicesIn,
                         int material, const std::vector<float>* faceColors = nullptr) {
         if (positionsIn.empty() || indicesIn.empty()) return -1;
-        deferred_.push_back({name, std::move(positionsIn), &indicesIn, material, faceColors});
+        deferred_.push_back({name, std::move(positionsIn), &indicesIn, material, faceColors, {}, {}});
         const int index = int(meshes_.size() + deferred_.size()) - 1;
         // A bounded batch: the prepared meshes of one batch are all that is held at once.
+        if (deferred_.size() >= 64 * threadCount()) flushDeferred();
+        return index;
+    }
+    /// The same, taking the indices and face colours too (a mesh read back for this call).
+    int addMeshDeferred(const std::string& name, std::vector<double>&& positionsIn, std::vector<uint32_t>&& indicesIn,
+                        int material, std::vector<float>&& faceColors) {
+        if (positionsIn.empty() || indicesIn.empty()) return -1;
+        deferred_.push_back({name, std::move(positionsIn), nullptr, material, nullptr, std::move(indicesIn),
+                             std::move(faceColors)});
+        const int index = int(meshes_.size() + deferred_.size()) - 1;
         if (deferred_.size() >= 64 * threadCount()) flushDeferred();
         return index;
     }
@@ -444,7 +454,8 @@ public:
             for (size_t k = next++; k < deferred_.size(); k = next++) {
                 const DeferredMesh& d = deferred_[k];
                 try {
-                    prepared[k] = prepareMesh(d.name, d.positions, *d.indices, d.material, d.faceColors, true);
+                    prepared[k] = prepareMesh(d.name, d.positions, d.indices ? *d.indices : d.ownedIndices, d.material,
+                                              d.faceColors ? d.faceColors : &d.ownedFaceColors, true);
                 } catch (...) {
                     failed[k] = std::current_exception();
                 }
@@ -615,9 +626,11 @@ private:
     struct DeferredMesh {
         std::string name;
         std::vector<double> positions;
-        const std::vector<uint32_t>* indices;
+        const std::vector<uint32_t>* indices;  ///< null: ownedIndices
         int material;
-        const std::vector<float>* faceColors;
+        const std::vector<float>* faceColors;  ///< null: ownedFaceColors (empty: white)
+        std::vector<uint32_t> ownedIndices;
+        std::vector<float> ownedFaceColors;
     };
 
     size_t threadCount() const {
@@ -1057,7 +1070,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                     proxyError["tolerance"] = tinygltf::Value(hn.error.tolerance);
                     proxyError["bound"] = tinygltf::Value(hn.error.bound());
                     extras["proxy_error"] = tinygltf::Value(std::move(proxyError));
-                    extras["proxy_triangles"] = intValue(hn.indices.size() / 3);
+                    extras["proxy_triangles"] = intValue(nodeTriangleCount(hn));
                 }
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
@@ -1148,7 +1161,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
         bool anyColours = false;
         for (const HierarchyNode& n : nodes.nodes) {
             levelCount = std::max(levelCount, n.lastLevel + 1);
-            anyColours = anyColours || !n.faceColors.empty();
+            anyColours = anyColours || !n.faceColors.empty() || n.meshPlace.hasFaceColors;
         }
         for (int k = 0; k < levelCount; ++k) {
             tinygltf::Material material;
@@ -1224,8 +1237,16 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
             const int material = n.leaf || n.objectLod >= 1
                                      ? (n.leaf ? originalMaterial : 0)
                                      : std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0);
-            node.mesh = glb.addMeshDeferred(name, std::vector<double>(n.positions.begin(), n.positions.end()), n.indices,
-                                            material, &n.faceColors);
+            if (n.meshPlace.kind == NodeMeshPlace::Kind::InNode) {
+                node.mesh = glb.addMeshDeferred(name, std::vector<double>(n.positions.begin(), n.positions.end()),
+                                                n.indices, material, &n.faceColors);
+            } else {  // spilled out of memory (spillNodeMeshes): read back for this mesh alone
+                NodeMesh mesh;
+                std::string readError;
+                if (!readNodeMesh(nodes, objects, uint32_t(i), mesh, readError)) throw std::runtime_error(readError);
+                node.mesh = glb.addMeshDeferred(name, std::vector<double>(mesh.positions.begin(), mesh.positions.end()),
+                                                std::move(mesh.indices), material, std::move(mesh.faceColors));
+            }
             node.extras = tinygltf::Value(extrasOf(i, lod));
             return glb.addNode(std::move(node));
         };
@@ -1359,9 +1380,11 @@ bool writeCollisionGlb(const HierarchyNodes& nodes, const std::vector<InputObjec
         std::vector<int> trimeshOf(nodes.nodes.size(), -1), convexOf(nodes.nodes.size(), -1);
         for (size_t i = 0; i < nodes.nodes.size(); ++i) {
             const HierarchyNode& n = nodes.nodes[i];
-            if (n.indices.empty()) continue;
+            if (nodeTriangleCount(n) == 0) continue;
             const std::string stem = n.leaf ? objects[i].name : "node" + std::to_string(i);
-            trimeshOf[i] = colliderNode(stem + "_collider", n.positions, n.indices, false, commonExtras(i));
+            NodeMesh storage;  // a mesh out of memory (spillNodeMeshes) comes back here
+            const NodeMeshView mesh = viewNodeMesh(nodes, objects, uint32_t(i), storage);
+            trimeshOf[i] = colliderNode(stem + "_collider", mesh.positions, mesh.indices, false, commonExtras(i));
             const NodeCollisionShapes& c = shapes[i];
             if (c.convexParts.empty()) continue;
             tinygltf::Node group;

@@ -290,7 +290,7 @@ bool writeCollisionInto(const HierarchyNodes& nodes, const std::vector<InputObje
     if (!io::writeCollisionGlb(nodes, objects, shapes, cuts, path.string(), error)) return false;
     summary.scenes = 2 * cuts.size() + 1;
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
-        if (nodes.nodes[i].indices.empty()) continue;
+        if (nodeTriangleCount(nodes.nodes[i]) == 0) continue;
         ++summary.colliders;
         if (shapes[i].convexParts.empty()) continue;
         ++summary.convexNodes;
@@ -624,6 +624,10 @@ int runBake(BakeOptions o) {
         !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)) ||
         (o.collision && !set.addFile(collisionPath, collisionTmp, error)))
         return fail(error);
+    // The nodes' meshes wait on disk while the files are written, each read back when written
+    // (a leaf's is its object's): on a large world they are most of what the bake holds.
+    if (!spillNodeMeshes(nodes, scene.objects, set.scratchFile("node-meshes.spill").string(), error)) return fail(error);
+    releaseFreedMemory();
     if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes, o.threads, tiling.cache))
         return fail(error);
     // The exact aggregates' meshes are in levels.glb now and nothing after needs them (the
@@ -665,7 +669,7 @@ int runBake(BakeOptions o) {
                         nodes.proxyItemsLoaded);
         size_t proxyTriangles = 0, exactTriangles = 0;
         for (size_t i = nodes.objectCount; i < nodes.nodes.size(); ++i) {
-            proxyTriangles += nodes.nodes[i].indices.size() / 3;
+            proxyTriangles += nodeTriangleCount(nodes.nodes[i]);
             exactTriangles += nodes.nodes[i].exactTriangleCount;
         }
         std::printf("runtime hierarchy: %zu nodes (%zu aggregates, %zu roots); proxies %zu triangles "

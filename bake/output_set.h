@@ -77,6 +77,10 @@ public:
     /// A folder (the 3D Tiles tileset), written whole into the returned path by the caller.
     std::filesystem::path folderTemporary(const std::filesystem::path& final);
 
+    /// A file of the bake's own in the private folder (scratch: never committed, removed with
+    /// the folder). begin() first.
+    std::filesystem::path scratchFile(const std::string& name) const { return tempDir_ / name; }
+
     /// Syncs every temporary, writes the new manifest, keeps the old files reachable and points
     /// the manifest at them, moves the new files into place, then switches the manifest to the
     /// new set with one rename. On a failure the set as it was is put back.

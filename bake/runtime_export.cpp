@@ -30,7 +30,7 @@ bool writeRuntimeScene(const HierarchyNodes& nodes, const std::vector<InputObjec
     runtime::RuntimeFileStreamWriter writer;
     const bool written =
         writer.open(path, std::move(names), hash, toolVersion, error) &&
-        exportHierarchyNodes(nodes, threadCount, [&](size_t i, const runtime::NodeRecord& record, const RenderMesh& mesh,
+        exportHierarchyNodes(nodes, objects, threadCount, [&](size_t i, const runtime::NodeRecord& record, const RenderMesh& mesh,
                                                      std::string& message) {
             const HierarchyNode& n = nodes.nodes[i];
             return writer.addNode(record, n.children.data(), n.children.size(), n.sources.data(), n.sources.size(),

@@ -66,7 +66,7 @@ Json proxyFiguresJson(const HierarchyNodes& nodes, int level) {
         ++count;
         budgets.push_back(n.budget);
         errors.push_back(n.error.bound());
-        triangles += n.indices.size() / 3;
+        triangles += nodeTriangleCount(n);
     }
     const auto [budgetMax, budgetMedian] = maxAndMedian(budgets);
     const auto [errorMax, errorMedian] = maxAndMedian(errors);

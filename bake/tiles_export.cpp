@@ -110,7 +110,7 @@ public:
 private:
     bool hasGeometry(uint32_t n) const {
         const HierarchyNode& node = nodes_.nodes[n];
-        return !node.indices.empty() || !node.children.empty();
+        return nodeTriangleCount(node) > 0 || !node.children.empty();
     }
 
     Box box(uint32_t n) const {
@@ -139,7 +139,7 @@ private:
         t["boundingVolume"] = {{"box", tilesBox(box(n), pad_)}};
         t["geometricError"] = jsonNumber(node.leaf ? 0.0 : node.geometricError);
         t["refine"] = "REPLACE";
-        if (!node.indices.empty()) {
+        if (nodeTriangleCount(node) > 0) {
             ++contentCount_;
             contentNodes_.push_back(n);
             t["content"] = {{"uri", "node" + std::to_string(n) + ".glb"}};
@@ -208,8 +208,12 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
                     : objectLod             ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
                     : node.coarserStep >= 1 ? "node" + std::to_string(n) + "_coarser" + std::to_string(node.coarserStep)
                                             : "node" + std::to_string(n) + "_level" + std::to_string(node.firstLevel);
-        tile.positions = node.positions;
-        tile.indices = node.indices;
+        {
+            NodeMesh storage;  // a mesh out of memory (spillNodeMeshes) comes back here
+            const NodeMeshView mesh = viewNodeMesh(nodes, objects, n, storage);
+            tile.positions = mesh.positions;
+            tile.indices = mesh.indices;
+        }
         if (!node.leaf) {
             // Per-object LODs are finer than level 0: they take its tint.
             const std::vector<double> colour =

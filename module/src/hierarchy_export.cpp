@@ -28,6 +28,13 @@ Vec3 cross(const Vec3& a, const Vec3& b) {
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double length(const Vec3& a) { return std::sqrt(dot(a, a)); }
 
+// Node `at`'s mesh into `storage` when it is out of memory; true (storage untouched) when in
+// the node. False with `error` when it cannot be read back.
+bool readIfSpilled(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, uint32_t at, NodeMesh& storage,
+                   std::string& error) {
+    return nodes.nodes[at].meshPlace.kind == NodeMeshPlace::Kind::InNode || readNodeMesh(nodes, objects, at, storage, error);
+}
+
 }  // namespace
 
 bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
@@ -142,13 +149,13 @@ bool buildRenderMesh(const std::vector<float>& positions, const std::vector<uint
     return true;
 }
 
-bool exportHierarchyNodes(const HierarchyNodes& nodes, int threadCount, const NodeExportSink& emit,
-                          std::string& error) {
+bool exportHierarchyNodes(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, int threadCount,
+                          const NodeExportSink& emit, std::string& error) {
     size_t totalChildren = 0, totalSources = 0, totalIndices = 0;
     for (const HierarchyNode& n : nodes.nodes) {
         totalChildren += n.children.size();
         totalSources += n.sources.size();
-        totalIndices += n.indices.size();
+        totalIndices += 3 * nodeTriangleCount(n);
     }
     // A render mesh has at most one vertex per triangle corner (buildRenderMesh splits, never adds).
     const size_t limit = std::numeric_limits<uint32_t>::max() - 1;
@@ -164,14 +171,20 @@ bool exportHierarchyNodes(const HierarchyNodes& nodes, int threadCount, const No
         if (i % batch == 0) {
             const size_t count = std::min(batch, nodes.nodes.size() - i);
             meshes.assign(count, RenderMesh{});
-            std::vector<char> built(count, 0);
+            std::vector<std::string> failed(count);
             detail::parallelFor(count, threadCount, [&](size_t k) {
-                const HierarchyNode& m = nodes.nodes[i + k];
-                built[k] = buildRenderMesh(m.positions, m.indices, m.faceColors, meshes[k]);
+                const uint32_t at = static_cast<uint32_t>(i + k);
+                NodeMesh storage;  // a mesh spilled out of memory (spillNodeMeshes) comes back here
+                if (!readIfSpilled(nodes, objects, at, storage, failed[k])) return;
+                const HierarchyNode& m = nodes.nodes[at];
+                const bool inNode = m.meshPlace.kind == NodeMeshPlace::Kind::InNode;
+                if (!buildRenderMesh(inNode ? m.positions : storage.positions, inNode ? m.indices : storage.indices,
+                                     inNode ? m.faceColors : storage.faceColors, meshes[k]))
+                    failed[k] = "node " + std::to_string(at) + ": a triangle index is out of range";
             });
             for (size_t k = 0; k < count; ++k)
-                if (!built[k]) {
-                    error = "node " + std::to_string(i + k) + ": a triangle index is out of range";
+                if (!failed[k].empty()) {
+                    error = failed[k];
                     return false;
                 }
         }
@@ -208,7 +221,7 @@ bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>
     for (const HierarchyNode& n : nodes.nodes) {
         totalChildren += n.children.size();
         totalSources += n.sources.size();
-        totalIndices += n.indices.size();
+        totalIndices += 3 * nodeTriangleCount(n);
     }
     if (std::max({nodes.nodes.size(), totalChildren, totalSources, totalIndices}) < std::numeric_limits<uint32_t>::max()) {
         params.nodes.reserve(nodes.nodes.size());
@@ -227,7 +240,7 @@ bool exportHierarchy(const HierarchyNodes& nodes, const std::vector<InputObject>
             params.colors.shrink_to_fit();
         }
     }
-    return exportHierarchyNodes(nodes, threadCount, [&](size_t i, runtime::NodeRecord b, const RenderMesh& mesh,
+    return exportHierarchyNodes(nodes, objects, threadCount, [&](size_t i, runtime::NodeRecord b, const RenderMesh& mesh,
                                                         std::string&) {
         const HierarchyNode& n = nodes.nodes[i];
         b.firstChild = static_cast<uint32_t>(params.childIndices.size());

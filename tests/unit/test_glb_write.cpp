@@ -2,8 +2,10 @@
 // The GLB writer of the bake (bake/gltf_write.cpp): its JSON text is written by aggrelod
 // itself, so names with quotes, control characters, non-ASCII letters and bytes that are not
 // UTF-8 must come out as valid glTF and read back; numbers must keep their type.
+#include "runtime_export.h"
 #include "scene_io.h"
 #include "test_support.h"
+#include "tiles_export.h"
 
 #include <aggrelod/hierarchy_nodes.h>
 #include <aggrelod/samples.h>
@@ -66,6 +68,103 @@ TEST(GlbWrite, AwkwardNamesAreEscapedAndReadBack) {
         for (size_t k = 0; k < objects[i].positions.size(); ++k)
             EXPECT_EQ(back.objects[i].positions[k], double(float(objects[i].positions[k]))) << i << " " << k;
     }
+}
+
+std::string fileBytes(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// The bake moves the nodes' meshes to a spill file before it writes (spillNodeMeshes): every
+// writer must read them back and give the files it gives from the nodes in memory, byte for
+// byte; the spill file goes with the last nodes using it; a spill file damaged under the
+// bake is an error naming it, never a crash.
+TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
+    const fs::path dir = freshTestDir(currentTestName());
+    std::vector<InputObject> objects;
+    for (int i = 0; i < 6; ++i) {
+        const double x = 1.6 * i;
+        objects.push_back(i % 2 ? samples::makeUvSphere("ball" + std::to_string(i), {x + 0.5, 0.5, 0.5}, 0.5, 12, 8)
+                                : samples::makeBox("box" + std::to_string(i), {x, 0, 0}, {x + 1, 1, 1 + 0.2 * i}));
+        if (i % 3 != 2)  // colours on some objects only
+            for (size_t t = 0; t < objects.back().indices.size() / 3; ++t)
+                objects.back().triangleColors.insert(objects.back().triangleColors.end(), {0.1f * float(i), 0.5f, 0.2f, 1.0f});
+    }
+    Settings3D settings;
+    settings.deltas = {0.3, 0.8, 3.0};
+    settings.threadCount = 1;
+    Hierarchy3D h;
+    ASSERT_TRUE(buildHierarchy3D(objects, settings, h));
+    HierarchyNodes nodes;
+    ProxySettings proxySettings;
+    proxySettings.threadCount = 1;
+    std::string error;
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, proxySettings, nodes, error)) << error;
+    ASSERT_GT(nodes.nodes.size(), objects.size() + 3);
+
+    const fs::path spillPath = dir / "meshes.spill";
+    auto spilled = std::make_unique<HierarchyNodes>(nodes);
+    ASSERT_TRUE(spillNodeMeshes(*spilled, objects, spillPath.string(), error)) << error;
+    ASSERT_TRUE(fs::exists(spillPath));
+    size_t inFile = 0;
+    for (uint32_t i = 0; i < nodes.nodes.size(); ++i) {
+        const HierarchyNode& before = nodes.nodes[i];
+        const HierarchyNode& after = spilled->nodes[i];
+        EXPECT_TRUE(after.positions.empty() && after.indices.empty() && after.faceColors.empty()) << i;
+        EXPECT_EQ(nodeTriangleCount(after), before.indices.size() / 3) << i;
+        EXPECT_EQ(after.meshPlace.kind, before.indices.empty() ? NodeMeshPlace::Kind::InNode
+                                        : before.leaf          ? NodeMeshPlace::Kind::Object
+                                                               : NodeMeshPlace::Kind::File)
+            << i;
+        inFile += after.meshPlace.kind == NodeMeshPlace::Kind::File;
+        NodeMesh back;
+        ASSERT_TRUE(readNodeMesh(*spilled, objects, i, back, error)) << error;
+        EXPECT_EQ(back.positions, before.positions) << i;
+        EXPECT_EQ(back.indices, before.indices) << i;
+        EXPECT_EQ(back.faceColors, before.faceColors) << i;
+    }
+    EXPECT_GT(inFile, 3u);
+
+    // Every writer, from the nodes in memory and from the spilled ones.
+    for (const char* which : {"memory", "spilled"}) {
+        const HierarchyNodes& n = std::string(which) == "memory" ? nodes : *spilled;
+        const fs::path out = dir / which;
+        fs::create_directories(out / "tiles");
+        ASSERT_TRUE(io::writeLevelsGlb(h, objects, (out / "levels.glb").string(), error, &n, 2)) << error;
+        ASSERT_TRUE(io::writeProxiesGlb(n, objects, (out / "proxies.glb").string(), error, 2)) << error;
+        ASSERT_TRUE(io::writeRuntimeScene(n, objects, 5, "test", (out / "scene.aglod").string(), error, 2)) << error;
+        io::TilesetSummary summary;
+        ASSERT_TRUE(io::writeTileset(n, objects, (out / "tiles").string(), summary, error)) << error;
+    }
+    for (const char* file : {"levels.glb", "proxies.glb", "scene.aglod", "tiles/tileset.json"})
+        EXPECT_EQ(fileBytes(dir / "memory" / file), fileBytes(dir / "spilled" / file)) << file;
+    size_t tileFiles = 0;
+    for (const auto& e : fs::directory_iterator(dir / "memory" / "tiles")) {
+        ++tileFiles;
+        EXPECT_EQ(fileBytes(e.path()), fileBytes(dir / "spilled" / "tiles" / e.path().filename())) << e.path();
+    }
+    EXPECT_GT(tileFiles, 3u);
+
+    // Damaged under the bake: an error naming the file.
+    fs::resize_file(spillPath, fs::file_size(spillPath) / 2);
+    NodeMesh back;
+    uint32_t last = 0;
+    for (uint32_t i = 0; i < spilled->nodes.size(); ++i)
+        if (spilled->nodes[i].meshPlace.kind == NodeMeshPlace::Kind::File) last = i;
+    EXPECT_FALSE(readNodeMesh(*spilled, objects, last, back, error));
+    EXPECT_NE(error.find(spillPath.string()), std::string::npos) << error;
+    EXPECT_FALSE(io::writeProxiesGlb(*spilled, objects, (dir / "damaged.glb").string(), error, 2));
+    EXPECT_NE(error.find(spillPath.string()), std::string::npos) << error;
+    EXPECT_FALSE(io::writeRuntimeScene(*spilled, objects, 5, "test", (dir / "damaged.aglod").string(), error, 2));
+    EXPECT_NE(error.find(spillPath.string()), std::string::npos) << error;
+    EXPECT_FALSE(fs::exists(dir / "damaged.aglod"));
+
+    // The spill file goes with the last nodes sharing it.
+    HierarchyNodes copy = *spilled;
+    spilled.reset();
+    EXPECT_TRUE(fs::exists(spillPath));
+    copy = HierarchyNodes{};
+    EXPECT_FALSE(fs::exists(spillPath));
 }
 
 // levels.glb and proxies.glb list every object of every node by name: on a large world their

@@ -49,11 +49,12 @@ using NodeExportSink =
 
 /// The runtime contract of `nodes` a node at a time, in node order (what exportHierarchy
 /// stores, for writers that do not hold it all: runtime::RuntimeFileStreamWriter). Records as
-/// exportHierarchy describes; the render meshes are built a batch of 1,024 nodes at a time on
+/// exportHierarchy describes; meshes out of memory (spillNodeMeshes) are read back from `objects`
+/// and the spill file. The render meshes are built a batch of 1,024 nodes at a time on
 /// up to `threadCount` threads (0: all cores), `emit` is called from the calling thread. False
 /// with a message when a count does not fit 32 bits, an index is out of range or emit fails.
-bool exportHierarchyNodes(const HierarchyNodes& nodes, int threadCount, const NodeExportSink& emit,
-                          std::string& error);
+bool exportHierarchyNodes(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, int threadCount,
+                          const NodeExportSink& emit, std::string& error);
 
 /// Fills `out` from `nodes` (node i of the file = nodes.nodes[i]; leaves carry the original
 /// object's triangles, aggregates and per-object LODs their simplified proxy, as float world

@@ -19,6 +19,7 @@
 #include <aggrelod/tile_cache.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,23 @@ struct ProxyError {
     double bound() const;
 };
 
+/// Where a node's mesh is (spillNodeMeshes): in the node's own vectors, or out of memory with
+/// its counts kept here. Read it wherever it is with readNodeMesh / viewNodeMesh.
+struct NodeMeshPlace {
+    enum class Kind : uint8_t {
+        InNode,  ///< positions, indices and faceColors of the node
+        Object,  ///< a leaf: its object's triangles as given (float positions), as the bake copies them
+        File     ///< HierarchyNodes::meshFile at `offset`
+    };
+    Kind kind = Kind::InNode;
+    uint64_t offset = 0;         ///< Kind::File: byte offset in the spill file
+    uint32_t vertexCount = 0;    ///< out of the node (Object, File): its counts
+    uint32_t triangleCount = 0;
+    bool hasFaceColors = false;
+};
+
+class NodeMeshFile;  ///< the spill file of spillNodeMeshes (node_mesh_spill.cpp)
+
 struct HierarchyNode {
     uint32_t parent = kNoNode;         ///< index in HierarchyNodes::nodes; kNoNode for roots
     std::vector<uint32_t> children;    ///< node indices, ascending (all smaller than this node's)
@@ -120,6 +138,9 @@ struct HierarchyNode {
     /// radius rounded up so that the nesting holds when read back as floats.
     double sphereCenter[3] = {0, 0, 0};
     double sphereRadius = 0;
+    /// Where the mesh is: InNode unless spillNodeMeshes moved it out (then positions, indices and
+    /// faceColors are empty).
+    NodeMeshPlace meshPlace;
 };
 
 struct HierarchyNodes {
@@ -134,6 +155,9 @@ struct HierarchyNodes {
     size_t proxyItemsMade = 0, proxyItemsLoaded = 0;
     /// Originals whose search structures this run built (for the items it made).
     size_t originalsPrepared = 0;
+    /// The spill file holding the meshes spillNodeMeshes moved out (null before); shared by
+    /// copies of these nodes, closed and removed with the last of them.
+    std::shared_ptr<const NodeMeshFile> meshFile;
 };
 
 /// One share of buildHierarchyNodes's work, for processes that share ProxySettings::cache
@@ -168,6 +192,41 @@ bool buildHierarchyNodes(const Hierarchy3D& hierarchy, const std::vector<InputOb
 bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject>& objects,
                      const ProxySettings& settings, const ProxyShare& share, std::string& error,
                      size_t* made = nullptr, size_t* loaded = nullptr, size_t* prepared = nullptr);
+
+/// Triangles of node n's mesh, wherever it is (NodeMeshPlace).
+size_t nodeTriangleCount(const HierarchyNode& n);
+
+/// Moves the meshes of `nodes` out of memory, for writers that read them back a node at a
+/// time (a large world's node meshes are most of what a bake holds at its end): a leaf with
+/// geometry refers to its object in `objects` (the array the nodes were built from, which must
+/// outlive the nodes' use), every other non-empty mesh goes to a new spill file at `path`
+/// (removed when the last HierarchyNodes sharing it goes). Nodes already out stay. False with
+/// a message naming the file when it cannot be written (the nodes are then unchanged).
+bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const std::string& path,
+                     std::string& error);
+
+/// A node's mesh read back (fields as in HierarchyNode).
+struct NodeMesh {
+    std::vector<float> positions;
+    std::vector<uint32_t> indices;
+    std::vector<float> faceColors;
+};
+
+/// Node `node`'s mesh, wherever it is, into `out`: the same vectors the node held before
+/// spillNodeMeshes. False with a message when the spill file cannot be read back or does not
+/// match. Safe to call from several threads at once.
+bool readNodeMesh(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, uint32_t node, NodeMesh& out,
+                  std::string& error);
+
+/// Node `node`'s mesh as three vectors: the node's own when it is in memory (no copy), else
+/// read back into `storage`. Throws std::runtime_error where readNodeMesh fails.
+struct NodeMeshView {
+    const std::vector<float>& positions;
+    const std::vector<uint32_t>& indices;
+    const std::vector<float>& faceColors;
+};
+NodeMeshView viewNodeMesh(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, uint32_t node,
+                          NodeMesh& storage);
 
 /// The aggregate node that coarser version `node` simplifies (the end of its chain of single
 /// children); `node` itself when it is not a coarser version. `node` < nodes.nodes.size().

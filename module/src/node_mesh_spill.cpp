@@ -1,0 +1,179 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Hierarchy nodes' meshes out of memory (hierarchy_nodes.h, spillNodeMeshes): a leaf's mesh is
+// its object's, every other mesh waits in one spill file that writers read a node at a time.
+#include <aggrelod/hierarchy_nodes.h>
+
+#include "surface_colors.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <mutex>
+#include <stdexcept>
+
+namespace aggrelod {
+
+/// The spill file: written once by spillNodeMeshes, then read back under a lock (one
+/// std::FILE, portable; reads come from the page cache and are short beside what the
+/// writers do with a mesh).
+class NodeMeshFile {
+public:
+    NodeMeshFile(std::FILE* file, std::string path) : file_(file), path_(std::move(path)) {}
+    ~NodeMeshFile() {
+        std::fclose(file_);
+        std::remove(path_.c_str());
+    }
+    NodeMeshFile(const NodeMeshFile&) = delete;
+    NodeMeshFile& operator=(const NodeMeshFile&) = delete;
+
+    const std::string& path() const { return path_; }
+
+    bool read(uint64_t offset, void* a, size_t aBytes, void* b, size_t bBytes, void* c, size_t cBytes) const {
+        std::lock_guard<std::mutex> lock(mutex_);
+#if defined(_WIN32)
+        if (_fseeki64(file_, static_cast<long long>(offset), SEEK_SET) != 0) return false;
+#else
+        if (fseeko(file_, static_cast<off_t>(offset), SEEK_SET) != 0) return false;
+#endif
+        return std::fread(a, 1, aBytes, file_) == aBytes && std::fread(b, 1, bBytes, file_) == bBytes &&
+               std::fread(c, 1, cBytes, file_) == cBytes;
+    }
+
+private:
+    std::FILE* file_;
+    std::string path_;
+    mutable std::mutex mutex_;
+};
+
+size_t nodeTriangleCount(const HierarchyNode& n) {
+    return n.meshPlace.kind == NodeMeshPlace::Kind::InNode ? n.indices.size() / 3 : n.meshPlace.triangleCount;
+}
+
+bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const std::string& path,
+                     std::string& error) {
+    std::FILE* file = std::fopen(path.c_str(), "w+b");
+    if (!file) {
+        error = path + ": cannot open for writing";
+        return false;
+    }
+    auto spill = std::make_shared<NodeMeshFile>(file, path);  // closes and removes it on any return
+    // Places first, the nodes changed only once the whole file is written.
+    std::vector<NodeMeshPlace> places(nodes.nodes.size());
+    uint64_t offset = 0;
+    for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+        const HierarchyNode& n = nodes.nodes[i];
+        NodeMeshPlace& place = places[i];
+        place = n.meshPlace;
+        if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
+        if (n.positions.size() / 3 > UINT32_MAX || n.indices.size() / 3 > UINT32_MAX) {
+            error = "node " + std::to_string(i) + ": a mesh too large to spill";
+            return false;
+        }
+        place.vertexCount = uint32_t(n.positions.size() / 3);
+        place.triangleCount = uint32_t(n.indices.size() / 3);
+        place.hasFaceColors = !n.faceColors.empty();
+        const InputObject* object = n.leaf && i < objects.size() ? &objects[i] : nullptr;
+        // A leaf holds a copy of its object (hierarchy_nodes.cpp); anything else goes to the file.
+        const auto sameCopy = [&] {
+            for (size_t k = 0; k < n.positions.size(); ++k)
+                if (n.positions[k] != static_cast<float>(object->positions[k])) return false;
+            return true;
+        };
+        if (object && n.positions.size() == object->positions.size() && n.indices == object->indices && sameCopy() &&
+            (place.hasFaceColors ? detail::hasTriangleColors(*object) && n.faceColors == object->triangleColors
+                                 : !detail::hasTriangleColors(*object))) {
+            place.kind = NodeMeshPlace::Kind::Object;
+            continue;
+        }
+        place.kind = NodeMeshPlace::Kind::File;
+        place.offset = offset;
+        const size_t bytes[3] = {4 * n.positions.size(), 4 * n.indices.size(), 4 * n.faceColors.size()};
+        const void* data[3] = {n.positions.data(), n.indices.data(), n.faceColors.data()};
+        for (int k = 0; k < 3; ++k)
+            if (bytes[k] && std::fwrite(data[k], 1, bytes[k], file) != bytes[k]) {
+                error = path + ": write failed (disk full?)";
+                return false;
+            }
+        offset += bytes[0] + bytes[1] + bytes[2];
+    }
+    if (std::fflush(file) != 0) {
+        error = path + ": write failed (disk full?)";
+        return false;
+    }
+    for (size_t i = 0; i < nodes.nodes.size(); ++i) {
+        HierarchyNode& n = nodes.nodes[i];
+        if (places[i].kind == NodeMeshPlace::Kind::InNode) continue;
+        n.meshPlace = places[i];
+        std::vector<float>().swap(n.positions);
+        std::vector<uint32_t>().swap(n.indices);
+        std::vector<float>().swap(n.faceColors);
+    }
+    nodes.meshFile = std::move(spill);
+    return true;
+}
+
+bool readNodeMesh(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, uint32_t node, NodeMesh& out,
+                  std::string& error) {
+    out = NodeMesh{};
+    if (node >= nodes.nodes.size()) {
+        error = "node " + std::to_string(node) + " is out of range";
+        return false;
+    }
+    const HierarchyNode& n = nodes.nodes[node];
+    const NodeMeshPlace& place = n.meshPlace;
+    switch (place.kind) {
+        case NodeMeshPlace::Kind::InNode:
+            out.positions = n.positions;
+            out.indices = n.indices;
+            out.faceColors = n.faceColors;
+            return true;
+        case NodeMeshPlace::Kind::Object: {
+            if (node >= objects.size() || objects[node].positions.size() != 3 * size_t(place.vertexCount) ||
+                objects[node].indices.size() != 3 * size_t(place.triangleCount)) {
+                error = "node " + std::to_string(node) + ": its object is not the one its mesh was spilled from";
+                return false;
+            }
+            const InputObject& o = objects[node];
+            out.positions.assign(o.positions.begin(), o.positions.end());
+            out.indices = o.indices;
+            if (place.hasFaceColors) out.faceColors = o.triangleColors;
+            return true;
+        }
+        case NodeMeshPlace::Kind::File: {
+            if (!nodes.meshFile) {
+                error = "node " + std::to_string(node) + ": its mesh was spilled, but the spill file is gone";
+                return false;
+            }
+            out.positions.resize(3 * size_t(place.vertexCount));
+            out.indices.resize(3 * size_t(place.triangleCount));
+            out.faceColors.resize(place.hasFaceColors ? 4 * size_t(place.triangleCount) : 0);
+            if (!nodes.meshFile->read(place.offset, out.positions.data(), 4 * out.positions.size(), out.indices.data(),
+                                      4 * out.indices.size(), out.faceColors.data(), 4 * out.faceColors.size())) {
+                error = nodes.meshFile->path() + ": node " + std::to_string(node) + "'s mesh cannot be read back";
+                out = NodeMesh{};
+                return false;
+            }
+            for (uint32_t v : out.indices)
+                if (v >= place.vertexCount) {
+                    error = nodes.meshFile->path() + ": node " + std::to_string(node) + "'s mesh read back is damaged";
+                    out = NodeMesh{};
+                    return false;
+                }
+            return true;
+        }
+    }
+    error = "node " + std::to_string(node) + ": unknown mesh place";
+    return false;
+}
+
+NodeMeshView viewNodeMesh(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, uint32_t node,
+                          NodeMesh& storage) {
+    if (node < nodes.nodes.size() && nodes.nodes[node].meshPlace.kind == NodeMeshPlace::Kind::InNode) {
+        const HierarchyNode& n = nodes.nodes[node];
+        return {n.positions, n.indices, n.faceColors};
+    }
+    std::string error;
+    if (!readNodeMesh(nodes, objects, node, storage, error)) throw std::runtime_error(error);
+    return {storage.positions, storage.indices, storage.faceColors};
+}
+
+}  // namespace aggrelod
