@@ -245,11 +245,40 @@ const char* accessorTypeName(int type) {
     }
 }
 
-/// Writes the glTF JSON of `model` with one buffer of `binaryBytes` (none when 0) through `w`
-/// (drained as it goes). frozenExtras[i], where not empty, is node i's extras as JSON text.
-void modelJson(const tinygltf::Model& model, const std::vector<MeshRecord>& meshes,
+/// One glTF node's JSON object; `frozenExtras`: its extras as JSON text, or null (or empty)
+/// to write node.extras.
+void nodeJson(const tinygltf::Node& node, const std::string* frozenExtras, JsonWriter& w) {
+    w.open('{');
+    if (!node.name.empty()) w.member("name", node.name);
+    if (node.mesh >= 0) w.member("mesh", int64_t(node.mesh));
+    if (!node.children.empty()) w.numbers("children", node.children);
+    if (!node.matrix.empty()) w.numbers("matrix", node.matrix);
+    if (!node.translation.empty()) w.numbers("translation", node.translation);
+    if (!node.rotation.empty()) w.numbers("rotation", node.rotation);
+    if (!node.scale.empty()) w.numbers("scale", node.scale);
+    w.extensions(node.extensions);
+    if (frozenExtras && !frozenExtras->empty()) {
+        w.key("extras");
+        w.raw(*frozenExtras);
+    } else {
+        w.extras(node.extras);
+    }
+    w.close('}');
+}
+
+/// A node of a GlbBuilder: live (tinygltf's, still changing), or frozen as JSON text (its
+/// extras only, or the whole node: a fraction of tinygltf's node and value tree, for the
+/// hundreds of thousands of nodes of a large hierarchy).
+struct NodeSlot {
+    std::unique_ptr<tinygltf::Node> live;  ///< null once the whole node is frozen
+    std::string frozen;                    ///< the extras' JSON (live node) or the whole node's
+};
+
+/// Writes the glTF JSON of `model` (its nodes: `nodes`) with one buffer of `binaryBytes` (none
+/// when 0) through `w` (drained as it goes).
+void modelJson(const tinygltf::Model& model, const std::vector<NodeSlot>& nodes, const std::vector<MeshRecord>& meshes,
                const std::vector<AccessorRecord>& accessors, const std::vector<ViewRecord>& views,
-               uint64_t binaryBytes, const std::vector<std::string>& frozenExtras, JsonWriter& w) {
+               uint64_t binaryBytes, JsonWriter& w) {
     w.open('{');
     w.key("asset");
     w.open('{');
@@ -270,27 +299,12 @@ void modelJson(const tinygltf::Model& model, const std::vector<MeshRecord>& mesh
         w.close('}');
     }
     w.close(']');
-    if (!model.nodes.empty()) {
+    if (!nodes.empty()) {
         w.key("nodes");
         w.open('[');
-        for (size_t i = 0; i < model.nodes.size(); ++i) {
-            const tinygltf::Node& node = model.nodes[i];
-            w.open('{');
-            if (!node.name.empty()) w.member("name", node.name);
-            if (node.mesh >= 0) w.member("mesh", int64_t(node.mesh));
-            if (!node.children.empty()) w.numbers("children", node.children);
-            if (!node.matrix.empty()) w.numbers("matrix", node.matrix);
-            if (!node.translation.empty()) w.numbers("translation", node.translation);
-            if (!node.rotation.empty()) w.numbers("rotation", node.rotation);
-            if (!node.scale.empty()) w.numbers("scale", node.scale);
-            w.extensions(node.extensions);
-            if (i < frozenExtras.size() && !frozenExtras[i].empty()) {
-                w.key("extras");
-                w.raw(frozenExtras[i]);
-            } else {
-                w.extras(node.extras);
-            }
-            w.close('}');
+        for (const NodeSlot& slot : nodes) {
+            if (slot.live) nodeJson(*slot.live, &slot.frozen, w);
+            else w.raw(slot.frozen);
             w.drain();
         }
         w.close(']');
@@ -499,21 +513,44 @@ public:
     size_t meshCount() const { return meshes_.size() + deferred_.size(); }
 
     int addNode(tinygltf::Node node) {
-        model_.nodes.push_back(std::move(node));
-        return int(model_.nodes.size()) - 1;
+        nodes_.push_back({std::make_unique<tinygltf::Node>(std::move(node)), {}});
+        return int(nodes_.size()) - 1;
+    }
+    int nodeCount() const { return int(nodes_.size()); }
+    /// Node `index`, to change it; not once frozen whole (freezeNode).
+    tinygltf::Node& node(int index) {
+        NodeSlot& slot = nodes_.at(size_t(index));
+        if (!slot.live) throw std::logic_error("glTF node " + std::to_string(index) + " is already written");
+        return *slot.live;
     }
 
     /// Node `index`'s extras will not change any more: kept as their JSON text from now on, a
     /// fraction of tinygltf's value tree (a large hierarchy lists every object of every node).
     void freezeExtras(int index) {
-        tinygltf::Value& extras = model_.nodes.at(size_t(index)).extras;
+        tinygltf::Value& extras = node(index).extras;
         if (extras.Type() == tinygltf::NULL_TYPE) return;
         JsonWriter w;
         w.value(extras);
-        if (frozenExtras_.size() <= size_t(index)) frozenExtras_.resize(size_t(index) + 1);
-        frozenExtras_[size_t(index)] = std::move(w.text);
-        frozenExtras_[size_t(index)].shrink_to_fit();
+        std::string& frozen = nodes_[size_t(index)].frozen;
+        frozen = std::move(w.text);
+        frozen.shrink_to_fit();
         extras = tinygltf::Value();
+    }
+    /// Node `index` will not change any more: kept as its JSON text only.
+    void freezeNode(int index) {
+        NodeSlot& slot = nodes_.at(size_t(index));
+        if (!slot.live) return;
+        JsonWriter w;
+        nodeJson(*slot.live, &slot.frozen, w);
+        slot.frozen = std::move(w.text);
+        slot.frozen.shrink_to_fit();
+        slot.live.reset();
+    }
+    /// Room for `meshes` meshes of the usual four accessors each (no growth by copying).
+    void reserveMeshes(size_t meshes) {
+        meshes_.reserve(meshes);
+        accessors_.reserve(4 * meshes);
+        views_.reserve(4 * meshes);
     }
 
     tinygltf::Model& model() { return model_; }
@@ -545,7 +582,7 @@ public:
         JsonWriter json;
         json.sink = jsonSpill_.open();
         try {
-            modelJson(model_, meshes_, accessors_, views_, binSize_, frozenExtras_, json);
+            modelJson(model_, nodes_, meshes_, accessors_, views_, binSize_, json);
         } catch (const std::exception& e) {
             error = path + ": cannot write glTF: " + e.what();
             return false;
@@ -794,11 +831,11 @@ private:
 
     // Meshes, accessors and buffer views are only ever made here: kept in records of their own,
     // a fraction of tinygltf's (a large hierarchy has hundreds of thousands of them).
-    tinygltf::Model model_;  ///< everything else: nodes, materials, extensions
+    tinygltf::Model model_;  ///< everything else: materials, extensions
+    std::vector<NodeSlot> nodes_;
     std::vector<MeshRecord> meshes_;
     std::vector<AccessorRecord> accessors_;
     std::vector<ViewRecord> views_;
-    std::vector<std::string> frozenExtras_;  ///< per node: its extras as JSON text (freezeExtras), or empty
     TemporaryFile spill_;      ///< the binary chunk so far
     TemporaryFile jsonSpill_;  ///< the JSON chunk while it is written
     std::vector<unsigned char> inMemory_;         ///< the same without a temporary file
@@ -1074,9 +1111,9 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 }
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
-                glb.freezeExtras(children.back());
+                glb.freezeNode(children.back());  // complete: a mesh node without children
             }
-            model.nodes[size_t(levelIndex)].children = std::move(children);
+            glb.node(levelIndex).children = std::move(children);
         }
         // Support surfaces pass through unchanged, flagged, under their own root node.
         if (!hierarchy.supportObjects.empty()) {
@@ -1112,9 +1149,9 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                 if (nodes && s < nodes->objectCount) extras["node"] = intValue(s);
                 node.extras = tinygltf::Value(std::move(extras));
                 children.push_back(glb.addNode(std::move(node)));
-                glb.freezeExtras(children.back());
+                glb.freezeNode(children.back());  // complete: a mesh node without children
             }
-            model.nodes[size_t(supportIndex)].children = std::move(children);
+            glb.node(supportIndex).children = std::move(children);
         }
         // One scene per level (the first, finest, is the default scene), each with the support
         // surfaces; the finest level's root lists the coarser ones as MSFT_lod stand-ins.
@@ -1138,7 +1175,7 @@ bool writeLevelsGlb(const Hierarchy3D& hierarchy, const std::vector<InputObject>
                     errors.push_back(e);
                 }
             }
-            setMsftLod(model, model.nodes[size_t(roots[0])], ids, radius, errors, nodes != nullptr);
+            setMsftLod(model, glb.node(roots[0]), ids, radius, errors, nodes != nullptr);
         }
         return glb.writeScenes(path, scenes, error);
     } catch (const std::exception& e) {
@@ -1156,6 +1193,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
     try {
         GlbBuilder glb(path);
         glb.setThreads(threadCount);
+        glb.reserveMeshes(nodes.nodes.size());
         tinygltf::Model& model = glb.model();
         int levelCount = 0;
         bool anyColours = false;
@@ -1292,21 +1330,23 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 for (size_t c = b.children.size(); c-- > 0;) stack.push_back({b.children[c], lod0});
             }
             if (p.parentLod0 < 0) finestRoots.push_back(lod0);
-            else model.nodes[size_t(p.parentLod0)].children.push_back(lod0);
+            else glb.node(p.parentLod0).children.push_back(lod0);
             std::vector<int> ids;
             std::vector<double> errors;
             size_t lod = 1;
             for (size_t c = chain.size() - (b.leaf ? 1 : 0); c-- > 0;) {
                 const uint32_t i = chain[c];
                 const int standIn = meshNode(i, stem + "_LOD" + std::to_string(lod), lod);
-                glb.freezeExtras(standIn);
+                glb.freezeNode(standIn);  // complete: a stand-in has no children
                 ++lod;
                 ids.push_back(standIn);
                 errors.push_back(nodes.nodes[i].geometricError);
                 standInRoots.push_back(standIn);
             }
-            setMsftLod(model, model.nodes[size_t(lod0)], ids, nodes.nodes[p.top].sphereRadius, errors, true);
-            glb.freezeExtras(lod0);
+            setMsftLod(model, glb.node(lod0), ids, nodes.nodes[p.top].sphereRadius, errors, true);
+            // A leaf's LOD0 is complete; a group's gets its child groups' LOD0 nodes later.
+            if (b.leaf) glb.freezeNode(lod0);
+            else glb.freezeExtras(lod0);
         }
         // Children were pushed in reverse onto the stack, so they arrive in order; the LOD0
         // nodes of a group's children are appended in that order.
@@ -1337,7 +1377,7 @@ bool writeCollisionGlb(const HierarchyNodes& nodes, const std::vector<InputObjec
             tinygltf::Node node;
             node.name = name;
             node.mesh = glb.addPlainMesh(name, positions, indices);
-            const int index = int(model.nodes.size());
+            const int index = glb.nodeCount();
             tinygltf::Value::Object geometry;
             geometry["node"] = tinygltf::Value(index);
             geometry["convexHull"] = tinygltf::Value(convex);
@@ -1404,7 +1444,7 @@ bool writeCollisionGlb(const HierarchyNodes& nodes, const std::vector<InputObjec
                 children.push_back(colliderNode(stem + "_convex" + std::to_string(j), c.convexParts[j].positions,
                                                 c.convexParts[j].indices, true, std::move(partExtras)));
             }
-            model.nodes[size_t(groupIndex)].children = std::move(children);
+            glb.node(groupIndex).children = std::move(children);
             convexOf[i] = groupIndex;
         }
         // Scenes: per cut its trimesh colliders, then the same cut with convex decompositions

@@ -512,6 +512,7 @@ int runBake(BakeOptions o) {
     proxySettings.threadCount = o.threads;
     proxySettings.progress = settings.progress;
     proxySettings.cache = tiling.cache;
+    proxySettings.leavesByReference = true;  // the originals are held once, in scene.objects
     Hierarchy3D hierarchy;
     TiledBakeReport tiled;
     if (!o.tileTask.empty()) {  // pieces: into the cache, no outputs

@@ -119,14 +119,16 @@ bool buildCollisionShapes(const HierarchyNodes& nodes, const std::vector<InputOb
             for (int k = 0; k < 3; ++k) diagonal += (n.boundsMax[k] - n.boundsMin[k]) * (n.boundsMax[k] - n.boundsMin[k]);
             diagonal = std::sqrt(diagonal);
             shapes.allowance = n.geometricError + settings.roundingFraction * diagonal;
-            if (n.indices.empty()) {
+            if (nodeTriangleCount(n) == 0) {
                 shapes.reason = "no geometry";
                 return;
             }
             std::vector<const detail::PreparedOriginal*> originals;
             for (uint32_t s : n.sources)
                 if (usable[s]) originals.push_back(&prepared[s]);
-            const std::vector<std::vector<double>> shells = shellPoints(n.positions, n.indices);
+            NodeMesh storage;  // a leaf that refers to its object, or a spilled mesh, comes back here
+            const NodeMeshView mesh = viewNodeMesh(nodes, objects, uint32_t(i), storage);
+            const std::vector<std::vector<double>> shells = shellPoints(mesh.positions, mesh.indices);
             shapes.shellCount = shells.size();
             if (originals.empty()) {
                 shapes.reason = "no original geometry to measure against";

@@ -63,13 +63,14 @@ double distance(const double a[3], const double b[3]) {
     return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-/// Fills box and sphere of `node` from its own vertices (float proxy and, for aggregates,
-/// the exact double mesh) and its children, rounded to float outwards.
-void computeBounds(HierarchyNode& node, const std::vector<double>& exactPositions,
+/// Fills box and sphere of `node` from its own vertices (`positions`: its float proxy or
+/// original; for aggregates, also the exact double mesh) and its children, rounded to float
+/// outwards.
+void computeBounds(HierarchyNode& node, const std::vector<float>& positions, const std::vector<double>& exactPositions,
                    const std::vector<HierarchyNode>& nodes) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i + 2 < node.positions.size(); i += 3) {
-        const double p[3] = {node.positions[i], node.positions[i + 1], node.positions[i + 2]};
+    for (size_t i = 0; i + 2 < positions.size(); i += 3) {
+        const double p[3] = {positions[i], positions[i + 1], positions[i + 2]};
         growBox(lo, hi, p);
     }
     for (size_t i = 0; i + 2 < exactPositions.size(); i += 3) growBox(lo, hi, &exactPositions[i]);
@@ -86,8 +87,8 @@ void computeBounds(HierarchyNode& node, const std::vector<double>& exactPosition
         node.sphereCenter[k] = static_cast<float>(0.5 * (lo[k] + hi[k]));
     }
     double r = 0;
-    for (size_t i = 0; i + 2 < node.positions.size(); i += 3) {
-        const double p[3] = {node.positions[i], node.positions[i + 1], node.positions[i + 2]};
+    for (size_t i = 0; i + 2 < positions.size(); i += 3) {
+        const double p[3] = {positions[i], positions[i + 1], positions[i + 2]};
         r = std::max(r, distance(node.sphereCenter, p));
     }
     for (size_t i = 0; i + 2 < exactPositions.size(); i += 3) r = std::max(r, distance(node.sphereCenter, &exactPositions[i]));
@@ -1024,7 +1025,12 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         const bool finite = std::all_of(objects[o].positions.begin(), objects[o].positions.end(),
                                         [](double x) { return std::isfinite(x); });
         leafHasGeometry[o] = inHierarchy && finite;
-        if (leafHasGeometry[o] && !share) {
+        if (leafHasGeometry[o] && !share && settings.leavesByReference) {
+            n.meshPlace.kind = NodeMeshPlace::Kind::Object;
+            n.meshPlace.vertexCount = static_cast<uint32_t>(objects[o].positions.size() / 3);
+            n.meshPlace.triangleCount = static_cast<uint32_t>(objects[o].indices.size() / 3);
+            n.meshPlace.hasFaceColors = detail::hasTriangleColors(objects[o]);
+        } else if (leafHasGeometry[o] && !share) {
             n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
             n.indices = objects[o].indices;
             if (detail::hasTriangleColors(objects[o])) n.faceColors = objects[o].triangleColors;
@@ -1538,24 +1544,35 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     }
 
     // Errors and bounds, children first (children have smaller indices than their parent).
-    // The exact aggregates of a lean hierarchy are read again a run of nodes at a time.
+    // The exact aggregates of a lean hierarchy are read again a run of nodes at a time, a run
+    // ending at kBoundsRunNodes nodes or at kBoundsRunTriangles triangles read (the coarse
+    // levels' aggregates span the world).
     const std::vector<double> none;
-    constexpr size_t kBoundsRun = 16384;
+    constexpr size_t kBoundsRunNodes = 16384, kBoundsRunTriangles = size_t(1) << 20;
     std::vector<Aggregate> exactRun;
     std::vector<uint32_t> exactAt;  // node - run start -> index in exactRun (kNoNode: in memory)
+    size_t runStart = 0;
+    std::vector<float> leafPositions;  // a leaf that refers to its object: the float copy it would hold
     for (size_t i = 0; i < nodes.size(); ++i) {
         HierarchyNode& n = nodes[i];
         const bool exactAggregate = !n.leaf && n.objectLod == 0 && n.coarserStep == 0;
-        if (i % kBoundsRun == 0) {
+        if (i == runStart + exactAt.size()) {
+            runStart = i;
+            exactRun.clear();
+            exactRun.shrink_to_fit();
             std::vector<const Aggregate*> lean;
-            exactAt.assign(std::min(kBoundsRun, nodes.size() - i), kNoNode);
-            for (size_t j = i; j < i + exactAt.size(); ++j) {
+            exactAt.clear();
+            size_t triangles = 0;
+            for (size_t j = i; j < nodes.size() && j - i < kBoundsRunNodes && (j == i || triangles < kBoundsRunTriangles);
+                 ++j) {
+                exactAt.push_back(kNoNode);
                 const HierarchyNode& m = nodes[j];
                 if (m.leaf || m.objectLod > 0 || m.coarserStep > 0) continue;
                 const Aggregate& a = aggregateOf(m);
                 if (!meshLeftInCache(a)) continue;
-                exactAt[j - i] = static_cast<uint32_t>(lean.size());
+                exactAt.back() = static_cast<uint32_t>(lean.size());
                 lean.push_back(&a);
+                triangles += a.meshInCache->triangleCount;
             }
             if (!lean.empty() && !settings.cache)
                 reloadError = "the hierarchy's meshes are in a tile cache, but no cache was given";
@@ -1566,12 +1583,14 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         double e = n.leaf ? 0.0 : n.error.bound();
         for (uint32_t c : n.children) e = std::max(e, nodes[c].geometricError);
         n.geometricError = floatUp(e);
-        const uint32_t at = exactAt[i % kBoundsRun];
-        const std::vector<double>& exact = n.leaf ? (n.positions.empty() ? none : objects[i].positions)
+        const uint32_t at = exactAt[i - runStart];
+        const bool leafByReference = n.leaf && n.meshPlace.kind == NodeMeshPlace::Kind::Object;
+        const std::vector<double>& exact = n.leaf ? (n.positions.empty() && !leafByReference ? none : objects[i].positions)
                                            : !exactAggregate ? none
                                            : at != kNoNode  ? exactRun[at].positions
                                                             : aggregateOf(n).positions;
-        computeBounds(n, exact, nodes);
+        if (leafByReference) leafPositions.assign(objects[i].positions.begin(), objects[i].positions.end());
+        computeBounds(n, leafByReference ? leafPositions : n.positions, exact, nodes);
     }
     return finish(true);
 }

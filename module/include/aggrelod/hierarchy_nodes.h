@@ -56,6 +56,10 @@ struct ProxySettings {
     /// the originals count too). The bound stays certified, only looser.
     size_t maxRefinementsPerDirection = 20000;
     int threadCount = 0;  ///< 0 = hardware concurrency; results identical for every count
+    /// Leaves refer to their objects (NodeMeshPlace::Kind::Object: read them with readNodeMesh
+    /// or viewNodeMesh, the objects kept alive) instead of holding a copy of their triangles:
+    /// a world's originals are not held twice. Everything else is the same.
+    bool leavesByReference = false;
     ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
     /// Optional: keeps every work item of the proxies (an aggregate's proxy, an object's
     /// versions, an aggregate's coarser versions) under a hash of its whole input and reads it
