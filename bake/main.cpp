@@ -34,6 +34,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <string>
 #include <system_error>
@@ -572,6 +573,32 @@ int runBake(BakeOptions o) {
     std::string nodeError;
     bool nodesOk = false;
     releaseFreedMemory();
+    // Write: the whole set into a fresh temporary folder, then switched in (OutputSet). Begun
+    // before the proxies, whose meshes wait in it from the moment they are all made.
+    const fs::path outDir(o.outDir);
+    std::optional<io::OutputSet> set;
+    bool createdOutDir = false;
+    std::error_code ec;
+    if (ok) {
+        createdOutDir = !fs::exists(outDir, ec);
+        fs::create_directories(outDir, ec);
+        if (ec || !fs::is_directory(outDir)) {
+            printError(o.outDir + ": cannot create the output directory" + (ec ? ": " + ec.message() : std::string()));
+            return kFileError;
+        }
+        set.emplace();
+        if (!set->begin(outDir, error)) {
+            printError(error);
+            return kFileError;
+        }
+        proxySettings.meshSpillPath = set->scratchFile("node-meshes.spill").string();
+    }
+    // A bake that fails from here leaves OUTDIR as it found it.
+    const auto abandonOutputs = [&] {
+        nodes = HierarchyNodes{};  // closes the spill file inside the set's folder
+        set.reset();
+        if (createdOutDir) fs::remove(outDir, ec);  // only if empty
+    };
     if (ok) {
         const auto start = std::chrono::steady_clock::now();
         nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
@@ -595,39 +622,31 @@ int runBake(BakeOptions o) {
         return kBakeFailed;
     }
     if (!nodesOk) {
+        abandonOutputs();
         printError(o.scene + ": building the runtime hierarchy failed: " + nodeError + "; nothing was written");
         return kInternal;
     }
 
-    // Write: the whole set into a fresh temporary folder, then switched in (OutputSet).
-    const fs::path outDir(o.outDir);
     const fs::path levelsPath = outDir / "levels.glb";
     const fs::path proxiesPath = outDir / "proxies.glb";
     const fs::path runtimePath = outDir / "scene.aglod";
     const fs::path statsPath = o.statsPath.empty() ? fs::path() : fs::path(o.statsPath);
-    std::error_code ec;
-    fs::create_directories(outDir, ec);
-    if (ec || !fs::is_directory(outDir)) {
-        printError(o.outDir + ": cannot create the output directory" +
-                   (ec ? ": " + ec.message() : std::string()));
-        return kFileError;
-    }
     const auto fail = [&](const std::string& message) {
         printError(message);
         return kFileError;
     };
-    io::OutputSet set;
-    if (!set.begin(outDir, error)) return fail(error);
     if (!statsPath.empty() && statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);
     fs::path levelsTmp, proxiesTmp, runtimeTmp, statsTmp, collisionTmp;
     const fs::path collisionPath = outDir / "collision.glb";
-    if (!set.addFile(levelsPath, levelsTmp, error) || !set.addFile(proxiesPath, proxiesTmp, error) ||
-        !set.addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set.addFile(statsPath, statsTmp, error)) ||
-        (o.collision && !set.addFile(collisionPath, collisionTmp, error)))
+    if (!set->addFile(levelsPath, levelsTmp, error) || !set->addFile(proxiesPath, proxiesTmp, error) ||
+        !set->addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set->addFile(statsPath, statsTmp, error)) ||
+        (o.collision && !set->addFile(collisionPath, collisionTmp, error)))
         return fail(error);
     // The nodes' meshes wait on disk while the files are written, each read back when written
     // (a leaf's is its object's): on a large world they are most of what the bake holds.
-    if (!spillNodeMeshes(nodes, scene.objects, set.scratchFile("node-meshes.spill").string(), error)) return fail(error);
+    // What the proxies stage did not spill (nothing, normally) goes too.
+    if (!spillNodeMeshes(nodes, scene.objects, set->scratchFile("node-meshes-rest.spill").string(), error))
+        return fail(error);
     releaseFreedMemory();
     if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes, o.threads, tiling.cache))
         return fail(error);
@@ -649,12 +668,12 @@ int runBake(BakeOptions o) {
     if (o.collision && !writeCollisionInto(nodes, scene.objects, collisionShapes, runtimeTmp, collisionTmp, collision, error))
         return fail(error);
     io::TilesetSummary tiles;
-    if (o.tiles && !writeTilesInto(nodes, scene.objects, set.folderTemporary(outDir / "tiles"), tiles, error))
+    if (o.tiles && !writeTilesInto(nodes, scene.objects, set->folderTemporary(outDir / "tiles"), tiles, error))
         return fail(error);
     if (!statsPath.empty() &&
         !io::writeStatsJson(hierarchy, scene.objects, scene.diagnostics, statsTmp.string(), error, &nodes))
         return fail(error);
-    if (!set.commit(error)) return fail(error);
+    if (!set->commit(error)) return fail(error);
 
     if (!o.quiet) {
         std::printf("%zu objects, %zu models, %zu triangles; originals: volume %s, sphericity %s\n",

@@ -13,6 +13,7 @@
 #include "hierarchy_serialize.h"
 #include "mesh_optimize.h"
 #include "mesh_preparation.h"
+#include "node_mesh_spiller.h"
 #include "parallel_for.h"
 #include "proxy_error.h"
 #include "solidify.h"
@@ -1483,6 +1484,25 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         }
     }
 
+    // Every mesh made to a spill file now, if asked: the tree is put together and its bounds
+    // computed without them in memory (ProxySettings::meshSpillPath).
+    if (!settings.meshSpillPath.empty()) {
+        detail::NodeMeshSpiller spiller;
+        bool spilled = spiller.open(settings.meshSpillPath, reloadError);
+        for (size_t i = objectCount; spilled && i < nodes.size(); ++i) {
+            if (dropped[i]) {
+                dropMesh(nodes[i]);
+                continue;
+            }
+            spilled = spiller.spill(nodes[i], static_cast<uint32_t>(i), reloadError);
+            for (HierarchyNode& c : coarser[i]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(i), reloadError);
+        }
+        for (size_t o = 0; spilled && o < objectCount; ++o)
+            for (HierarchyNode& c : chains[o]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(o), reloadError);
+        if (!spilled || !spiller.finish(reloadError)) return finish(false);
+        out.meshFile = spiller.file();
+    }
+
     // The tree again: leaves, per-object chains (object by object, finest first), then each
     // aggregate kept followed by its coarser versions (finest first).
     {
@@ -1521,6 +1541,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 below = at;
             }
             parentOf[below] = above;
+            std::vector<HierarchyNode>().swap(chain);  // the moved-from shells too (a large world has many)
         };
         for (size_t o = 0; o < objectCount; ++o)
             hang(chains[o], static_cast<uint32_t>(o), chainTop[o] + 1 - static_cast<uint32_t>(chains[o].size()),
@@ -1553,6 +1574,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     std::vector<uint32_t> exactAt;  // node - run start -> index in exactRun (kNoNode: in memory)
     size_t runStart = 0;
     std::vector<float> leafPositions;  // a leaf that refers to its object: the float copy it would hold
+    NodeMesh spilledMesh;              // a mesh in the spill file, read back
     for (size_t i = 0; i < nodes.size(); ++i) {
         HierarchyNode& n = nodes[i];
         const bool exactAggregate = !n.leaf && n.objectLod == 0 && n.coarserStep == 0;
@@ -1589,8 +1611,15 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                                            : !exactAggregate ? none
                                            : at != kNoNode  ? exactRun[at].positions
                                                             : aggregateOf(n).positions;
-        if (leafByReference) leafPositions.assign(objects[i].positions.begin(), objects[i].positions.end());
-        computeBounds(n, leafByReference ? leafPositions : n.positions, exact, nodes);
+        const std::vector<float>* own = &n.positions;
+        if (leafByReference) {
+            leafPositions.assign(objects[i].positions.begin(), objects[i].positions.end());
+            own = &leafPositions;
+        } else if (n.meshPlace.kind == NodeMeshPlace::Kind::File) {  // spilled above
+            if (!readNodeMesh(out, objects, static_cast<uint32_t>(i), spilledMesh, reloadError)) return finish(false);
+            own = &spilledMesh.positions;
+        }
+        computeBounds(n, *own, exact, nodes);
     }
     return finish(true);
 }

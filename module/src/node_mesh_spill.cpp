@@ -3,8 +3,10 @@
 // its object's, every other mesh waits in one spill file that writers read a node at a time.
 #include <aggrelod/hierarchy_nodes.h>
 
+#include "node_mesh_spiller.h"
 #include "surface_colors.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <mutex>
@@ -48,29 +50,82 @@ size_t nodeTriangleCount(const HierarchyNode& n) {
     return n.meshPlace.kind == NodeMeshPlace::Kind::InNode ? n.indices.size() / 3 : n.meshPlace.triangleCount;
 }
 
-bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const std::string& path,
-                     std::string& error) {
+namespace detail {
+
+bool NodeMeshSpiller::open(const std::string& path, std::string& error) {
     std::FILE* file = std::fopen(path.c_str(), "w+b");
     if (!file) {
         error = path + ": cannot open for writing";
         return false;
     }
-    auto spill = std::make_shared<NodeMeshFile>(file, path);  // closes and removes it on any return
+    file_ = std::make_shared<NodeMeshFile>(file, path);  // closes and removes it with its last user
+    raw_ = file;
+    offset_ = 0;
+    return true;
+}
+
+bool NodeMeshSpiller::write(const HierarchyNode& n, uint32_t node, NodeMeshPlace& place, std::string& error) {
+    if (n.positions.size() / 3 > UINT32_MAX || n.indices.size() / 3 > UINT32_MAX) {
+        error = "node " + std::to_string(node) + ": a mesh too large to spill";
+        return false;
+    }
+    place = NodeMeshPlace{};
+    place.kind = NodeMeshPlace::Kind::File;
+    place.offset = offset_;
+    place.vertexCount = uint32_t(n.positions.size() / 3);
+    place.triangleCount = uint32_t(n.indices.size() / 3);
+    place.hasFaceColors = !n.faceColors.empty();
+    const size_t bytes[3] = {4 * n.positions.size(), 4 * n.indices.size(), 4 * n.faceColors.size()};
+    const void* data[3] = {n.positions.data(), n.indices.data(), n.faceColors.data()};
+    for (int k = 0; k < 3; ++k)
+        if (bytes[k] && std::fwrite(data[k], 1, bytes[k], raw_) != bytes[k]) {
+            error = file_->path() + ": write failed (disk full?)";
+            return false;
+        }
+    offset_ += bytes[0] + bytes[1] + bytes[2];
+    return true;
+}
+
+bool NodeMeshSpiller::spill(HierarchyNode& n, uint32_t node, std::string& error) {
+    if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) return true;
+    NodeMeshPlace place;
+    if (!write(n, node, place, error)) return false;
+    n.meshPlace = place;
+    std::vector<float>().swap(n.positions);
+    std::vector<uint32_t>().swap(n.indices);
+    std::vector<float>().swap(n.faceColors);
+    return true;
+}
+
+bool NodeMeshSpiller::finish(std::string& error) {
+    if (std::fflush(raw_) != 0) {
+        error = file_->path() + ": write failed (disk full?)";
+        return false;
+    }
+    return true;
+}
+
+}  // namespace detail
+
+bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const std::string& path,
+                     std::string& error) {
+    const bool anyInNode = std::any_of(nodes.nodes.begin(), nodes.nodes.end(), [](const HierarchyNode& n) {
+        return n.meshPlace.kind == NodeMeshPlace::Kind::InNode && !n.indices.empty();
+    });
+    if (!anyInNode) return true;  // nothing to move (the spill file of the build, if any, stays)
+    if (nodes.meshFile) {
+        error = "the nodes' meshes are partly in a spill file already";
+        return false;
+    }
+    detail::NodeMeshSpiller spiller;
+    if (!spiller.open(path, error)) return false;
     // Places first, the nodes changed only once the whole file is written.
     std::vector<NodeMeshPlace> places(nodes.nodes.size());
-    uint64_t offset = 0;
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
         const HierarchyNode& n = nodes.nodes[i];
         NodeMeshPlace& place = places[i];
         place = n.meshPlace;
         if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
-        if (n.positions.size() / 3 > UINT32_MAX || n.indices.size() / 3 > UINT32_MAX) {
-            error = "node " + std::to_string(i) + ": a mesh too large to spill";
-            return false;
-        }
-        place.vertexCount = uint32_t(n.positions.size() / 3);
-        place.triangleCount = uint32_t(n.indices.size() / 3);
-        place.hasFaceColors = !n.faceColors.empty();
         const InputObject* object = n.leaf && i < objects.size() ? &objects[i] : nullptr;
         // A leaf holds a copy of its object (hierarchy_nodes.cpp); anything else goes to the file.
         const auto sameCopy = [&] {
@@ -78,27 +133,20 @@ bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& obje
                 if (n.positions[k] != static_cast<float>(object->positions[k])) return false;
             return true;
         };
+        const bool coloured = !n.faceColors.empty();
         if (object && n.positions.size() == object->positions.size() && n.indices == object->indices && sameCopy() &&
-            (place.hasFaceColors ? detail::hasTriangleColors(*object) && n.faceColors == object->triangleColors
-                                 : !detail::hasTriangleColors(*object))) {
+            (coloured ? detail::hasTriangleColors(*object) && n.faceColors == object->triangleColors
+                      : !detail::hasTriangleColors(*object))) {
+            place = NodeMeshPlace{};
             place.kind = NodeMeshPlace::Kind::Object;
+            place.vertexCount = uint32_t(n.positions.size() / 3);
+            place.triangleCount = uint32_t(n.indices.size() / 3);
+            place.hasFaceColors = coloured;
             continue;
         }
-        place.kind = NodeMeshPlace::Kind::File;
-        place.offset = offset;
-        const size_t bytes[3] = {4 * n.positions.size(), 4 * n.indices.size(), 4 * n.faceColors.size()};
-        const void* data[3] = {n.positions.data(), n.indices.data(), n.faceColors.data()};
-        for (int k = 0; k < 3; ++k)
-            if (bytes[k] && std::fwrite(data[k], 1, bytes[k], file) != bytes[k]) {
-                error = path + ": write failed (disk full?)";
-                return false;
-            }
-        offset += bytes[0] + bytes[1] + bytes[2];
+        if (!spiller.write(n, uint32_t(i), place, error)) return false;
     }
-    if (std::fflush(file) != 0) {
-        error = path + ": write failed (disk full?)";
-        return false;
-    }
+    if (!spiller.finish(error)) return false;
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
         HierarchyNode& n = nodes.nodes[i];
         if (places[i].kind == NodeMeshPlace::Kind::InNode) continue;
@@ -107,7 +155,7 @@ bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& obje
         std::vector<uint32_t>().swap(n.indices);
         std::vector<float>().swap(n.faceColors);
     }
-    nodes.meshFile = std::move(spill);
+    nodes.meshFile = spiller.file();
     return true;
 }
 

@@ -125,9 +125,47 @@ TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
     }
     EXPECT_GT(inFile, 3u);
 
+    // The proxies stage spilling as it goes (leaves by reference, meshes to a spill file once
+    // all made): the same nodes, every mesh out of memory and read back the same.
+    HierarchyNodes built;
+    ProxySettings spilling = proxySettings;
+    spilling.leavesByReference = true;
+    spilling.meshSpillPath = (dir / "built.spill").string();
+    ASSERT_TRUE(buildHierarchyNodes(h, objects, spilling, built, error)) << error;
+    ASSERT_TRUE(fs::exists(dir / "built.spill"));
+    ASSERT_EQ(built.nodes.size(), nodes.nodes.size());
+    EXPECT_EQ(built.roots, nodes.roots);
+    for (uint32_t i = 0; i < nodes.nodes.size(); ++i) {
+        const HierarchyNode& a = nodes.nodes[i];
+        const HierarchyNode& b = built.nodes[i];
+        EXPECT_TRUE(b.positions.empty() && b.indices.empty() && b.faceColors.empty()) << i;
+        EXPECT_EQ(b.meshPlace.kind, a.indices.empty() ? NodeMeshPlace::Kind::InNode
+                                    : a.leaf          ? NodeMeshPlace::Kind::Object
+                                                      : NodeMeshPlace::Kind::File)
+            << i;
+        EXPECT_EQ(b.parent, a.parent) << i;
+        EXPECT_EQ(b.children, a.children) << i;
+        EXPECT_EQ(b.sources, a.sources) << i;
+        EXPECT_EQ(b.geometricError, a.geometricError) << i;
+        EXPECT_EQ(b.sphereRadius, a.sphereRadius) << i;
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(b.boundsMin[k], a.boundsMin[k]) << i;
+            EXPECT_EQ(b.boundsMax[k], a.boundsMax[k]) << i;
+            EXPECT_EQ(b.sphereCenter[k], a.sphereCenter[k]) << i;
+        }
+        NodeMesh back;
+        ASSERT_TRUE(readNodeMesh(built, objects, i, back, error)) << error;
+        EXPECT_EQ(back.positions, a.positions) << i;
+        EXPECT_EQ(back.indices, a.indices) << i;
+        EXPECT_EQ(back.faceColors, a.faceColors) << i;
+    }
+    // Nothing left for spillNodeMeshes to move: no second file.
+    ASSERT_TRUE(spillNodeMeshes(built, objects, (dir / "second.spill").string(), error)) << error;
+    EXPECT_FALSE(fs::exists(dir / "second.spill"));
+
     // Every writer, from the nodes in memory and from the spilled ones.
-    for (const char* which : {"memory", "spilled"}) {
-        const HierarchyNodes& n = std::string(which) == "memory" ? nodes : *spilled;
+    for (const char* which : {"memory", "spilled", "built"}) {
+        const HierarchyNodes& n = std::string(which) == "memory" ? nodes : std::string(which) == "built" ? built : *spilled;
         const fs::path out = dir / which;
         fs::create_directories(out / "tiles");
         ASSERT_TRUE(io::writeLevelsGlb(h, objects, (out / "levels.glb").string(), error, &n, 2)) << error;
@@ -136,8 +174,10 @@ TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
         io::TilesetSummary summary;
         ASSERT_TRUE(io::writeTileset(n, objects, (out / "tiles").string(), summary, error)) << error;
     }
-    for (const char* file : {"levels.glb", "proxies.glb", "scene.aglod", "tiles/tileset.json"})
+    for (const char* file : {"levels.glb", "proxies.glb", "scene.aglod", "tiles/tileset.json"}) {
         EXPECT_EQ(fileBytes(dir / "memory" / file), fileBytes(dir / "spilled" / file)) << file;
+        EXPECT_EQ(fileBytes(dir / "memory" / file), fileBytes(dir / "built" / file)) << file;
+    }
     size_t tileFiles = 0;
     for (const auto& e : fs::directory_iterator(dir / "memory" / "tiles")) {
         ++tileFiles;
@@ -165,6 +205,8 @@ TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
     EXPECT_TRUE(fs::exists(spillPath));
     copy = HierarchyNodes{};
     EXPECT_FALSE(fs::exists(spillPath));
+    built = HierarchyNodes{};
+    EXPECT_FALSE(fs::exists(dir / "built.spill"));
 }
 
 // levels.glb and proxies.glb list every object of every node by name: on a large world their

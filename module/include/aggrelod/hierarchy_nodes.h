@@ -60,6 +60,11 @@ struct ProxySettings {
     /// or viewNodeMesh, the objects kept alive) instead of holding a copy of their triangles:
     /// a world's originals are not held twice. Everything else is the same.
     bool leavesByReference = false;
+    /// When not empty: the nodes' meshes go to a new spill file at this path as soon as they
+    /// are all made, before the tree is put together and its bounds computed (as
+    /// spillNodeMeshes would do afterwards; HierarchyNodes::meshFile holds it), so that a
+    /// large world's node meshes are not held through those steps. Everything else is the same.
+    std::string meshSpillPath;
     ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
     /// Optional: keeps every work item of the proxies (an aggregate's proxy, an object's
     /// versions, an aggregate's coarser versions) under a hash of its whole input and reads it
