@@ -592,6 +592,7 @@ int runBake(BakeOptions o) {
             return kFileError;
         }
         proxySettings.meshSpillPath = set->scratchFile("node-meshes.spill").string();
+        proxySettings.releaseFreedMemory = releaseFreedMemory;
     }
     // A bake that fails from here leaves OUTDIR as it found it.
     const auto abandonOutputs = [&] {

@@ -1501,6 +1501,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             for (HierarchyNode& c : chains[o]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(o), reloadError);
         if (!spilled || !spiller.finish(reloadError)) return finish(false);
         out.meshFile = spiller.file();
+        if (settings.releaseFreedMemory) settings.releaseFreedMemory();
     }
 
     // The tree again: leaves, per-object chains (object by object, finest first), then each

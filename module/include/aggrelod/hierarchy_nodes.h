@@ -19,6 +19,7 @@
 #include <aggrelod/tile_cache.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +66,10 @@ struct ProxySettings {
     /// spillNodeMeshes would do afterwards; HierarchyNodes::meshFile holds it), so that a
     /// large world's node meshes are not held through those steps. Everything else is the same.
     std::string meshSpillPath;
+    /// Optional: called once the meshes are in the spill file (meshSpillPath), so that the
+    /// caller can hand the freed pages back to the system (the allocator may keep them; the
+    /// bake calls glibc's malloc_trim).
+    std::function<void()> releaseFreedMemory;
     ProgressCallback progress;  ///< optional, stage "proxies"; called from the calling thread only
     /// Optional: keeps every work item of the proxies (an aggregate's proxy, an object's
     /// versions, an aggregate's coarser versions) under a hash of its whole input and reads it
