@@ -569,16 +569,24 @@ int runBake(BakeOptions o) {
     }
     const bool ok = lean || (o.tileSize.empty() ? buildHierarchy3D(scene.objects, settings, hierarchy)
                                                 : buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled));
+    // Write: the whole set into a fresh temporary folder, then switched in (OutputSet). Begun
+    // before the proxies, whose meshes wait in it from the moment they are all made; declared
+    // before the nodes, which close their spill file first.
+    const fs::path outDir(o.outDir);
+    std::optional<io::OutputSet> set;
     HierarchyNodes nodes;
     std::string nodeError;
     bool nodesOk = false;
     releaseFreedMemory();
-    // Write: the whole set into a fresh temporary folder, then switched in (OutputSet). Begun
-    // before the proxies, whose meshes wait in it from the moment they are all made.
-    const fs::path outDir(o.outDir);
-    std::optional<io::OutputSet> set;
     bool createdOutDir = false;
     std::error_code ec;
+    // A bake that fails from here leaves OUTDIR as it found it (an OUTDIR it made: removed
+    // when empty).
+    const auto abandonOutputs = [&] {
+        nodes = HierarchyNodes{};  // closes the spill file inside the set's folder
+        set.reset();
+        if (createdOutDir) fs::remove(outDir, ec);
+    };
     if (ok) {
         createdOutDir = !fs::exists(outDir, ec);
         fs::create_directories(outDir, ec);
@@ -588,18 +596,13 @@ int runBake(BakeOptions o) {
         }
         set.emplace();
         if (!set->begin(outDir, error)) {
+            abandonOutputs();
             printError(error);
             return kFileError;
         }
         proxySettings.meshSpillPath = set->scratchFile("node-meshes.spill").string();
         proxySettings.releaseFreedMemory = releaseFreedMemory;
     }
-    // A bake that fails from here leaves OUTDIR as it found it.
-    const auto abandonOutputs = [&] {
-        nodes = HierarchyNodes{};  // closes the spill file inside the set's folder
-        set.reset();
-        if (createdOutDir) fs::remove(outDir, ec);  // only if empty
-    };
     if (ok) {
         const auto start = std::chrono::steady_clock::now();
         nodesOk = buildHierarchyNodes(hierarchy, scene.objects, proxySettings, nodes, nodeError);
@@ -634,6 +637,7 @@ int runBake(BakeOptions o) {
     const fs::path statsPath = o.statsPath.empty() ? fs::path() : fs::path(o.statsPath);
     const auto fail = [&](const std::string& message) {
         printError(message);
+        abandonOutputs();
         return kFileError;
     };
     if (!statsPath.empty() && statsPath.has_parent_path()) fs::create_directories(statsPath.parent_path(), ec);

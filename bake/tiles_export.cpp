@@ -209,10 +209,13 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
                     : node.coarserStep >= 1 ? "node" + std::to_string(n) + "_coarser" + std::to_string(node.coarserStep)
                                             : "node" + std::to_string(n) + "_level" + std::to_string(node.firstLevel);
         {
-            NodeMesh storage;  // a mesh out of memory (spillNodeMeshes) comes back here
-            const NodeMeshView mesh = viewNodeMesh(nodes, objects, n, storage);
-            tile.positions = mesh.positions;
-            tile.indices = mesh.indices;
+            NodeMesh mesh;  // wherever it is (in the node, its object, the spill file)
+            if (!readNodeMesh(nodes, objects, n, mesh, error)) {
+                error = (fs::path(dir) / ("node" + std::to_string(n) + ".glb")).string() + ": " + error;
+                return false;
+            }
+            tile.positions = std::move(mesh.positions);
+            tile.indices = std::move(mesh.indices);
         }
         if (!node.leaf) {
             // Per-object LODs are finer than level 0: they take its tint.

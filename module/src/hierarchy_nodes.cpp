@@ -1489,6 +1489,15 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     if (!settings.meshSpillPath.empty()) {
         detail::NodeMeshSpiller spiller;
         bool spilled = spiller.open(settings.meshSpillPath, reloadError);
+        for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
+            HierarchyNode& n = nodes[o];
+            if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
+            n.meshPlace.kind = NodeMeshPlace::Kind::Object;
+            n.meshPlace.vertexCount = static_cast<uint32_t>(n.positions.size() / 3);
+            n.meshPlace.triangleCount = static_cast<uint32_t>(n.indices.size() / 3);
+            n.meshPlace.hasFaceColors = !n.faceColors.empty();
+            dropMesh(n);
+        }
         for (size_t i = objectCount; spilled && i < nodes.size(); ++i) {
             if (dropped[i]) {
                 dropMesh(nodes[i]);

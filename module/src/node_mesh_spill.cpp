@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <mutex>
 #include <stdexcept>
 
@@ -53,9 +54,10 @@ size_t nodeTriangleCount(const HierarchyNode& n) {
 namespace detail {
 
 bool NodeMeshSpiller::open(const std::string& path, std::string& error) {
-    std::FILE* file = std::fopen(path.c_str(), "w+b");
+    // A new file only ("x"): a spill file still in use by other nodes is never overwritten.
+    std::FILE* file = std::fopen(path.c_str(), "w+bx");
     if (!file) {
-        error = path + ": cannot open for writing";
+        error = path + (std::ifstream(path).good() ? ": already exists" : ": cannot open for writing");
         return false;
     }
     file_ = std::make_shared<NodeMeshFile>(file, path);  // closes and removes it with its last user
@@ -67,6 +69,11 @@ bool NodeMeshSpiller::open(const std::string& path, std::string& error) {
 bool NodeMeshSpiller::write(const HierarchyNode& n, uint32_t node, NodeMeshPlace& place, std::string& error) {
     if (n.positions.size() / 3 > UINT32_MAX || n.indices.size() / 3 > UINT32_MAX) {
         error = "node " + std::to_string(node) + ": a mesh too large to spill";
+        return false;
+    }
+    if (!n.faceColors.empty() && n.faceColors.size() != 4 * (n.indices.size() / 3)) {
+        error = "node " + std::to_string(node) + ": " + std::to_string(n.faceColors.size()) +
+                " face colour values for " + std::to_string(n.indices.size() / 3) + " triangles";
         return false;
     }
     place = NodeMeshPlace{};

@@ -529,6 +529,7 @@ FileStatus RuntimeFile::openMemory(const void* data, size_t size, RuntimeFile& o
 
 FileStatus RuntimeFile::openFile(const std::string& path, RuntimeFile& out, std::string& message) {
     out = RuntimeFile();
+    message.clear();
     auto mapping = std::make_unique<MappedFile>();
     if (!mapping->open(path, message)) return FileStatus::IoError;
     if (mapping->size() == 0) {

@@ -125,39 +125,45 @@ TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
     }
     EXPECT_GT(inFile, 3u);
 
-    // The proxies stage spilling as it goes (leaves by reference, meshes to a spill file once
-    // all made): the same nodes, every mesh out of memory and read back the same.
+    // The proxies stage spilling as it goes (leaves by reference or copied, meshes to a spill
+    // file once all made): the same nodes, every mesh out of memory and read back the same.
     HierarchyNodes built;
-    ProxySettings spilling = proxySettings;
-    spilling.leavesByReference = true;
-    spilling.meshSpillPath = (dir / "built.spill").string();
-    ASSERT_TRUE(buildHierarchyNodes(h, objects, spilling, built, error)) << error;
-    ASSERT_TRUE(fs::exists(dir / "built.spill"));
-    ASSERT_EQ(built.nodes.size(), nodes.nodes.size());
-    EXPECT_EQ(built.roots, nodes.roots);
-    for (uint32_t i = 0; i < nodes.nodes.size(); ++i) {
-        const HierarchyNode& a = nodes.nodes[i];
-        const HierarchyNode& b = built.nodes[i];
-        EXPECT_TRUE(b.positions.empty() && b.indices.empty() && b.faceColors.empty()) << i;
-        EXPECT_EQ(b.meshPlace.kind, a.indices.empty() ? NodeMeshPlace::Kind::InNode
-                                    : a.leaf          ? NodeMeshPlace::Kind::Object
-                                                      : NodeMeshPlace::Kind::File)
-            << i;
-        EXPECT_EQ(b.parent, a.parent) << i;
-        EXPECT_EQ(b.children, a.children) << i;
-        EXPECT_EQ(b.sources, a.sources) << i;
-        EXPECT_EQ(b.geometricError, a.geometricError) << i;
-        EXPECT_EQ(b.sphereRadius, a.sphereRadius) << i;
-        for (int k = 0; k < 3; ++k) {
-            EXPECT_EQ(b.boundsMin[k], a.boundsMin[k]) << i;
-            EXPECT_EQ(b.boundsMax[k], a.boundsMax[k]) << i;
-            EXPECT_EQ(b.sphereCenter[k], a.sphereCenter[k]) << i;
+    for (const bool byReference : {false, true}) {
+        built = HierarchyNodes{};
+        ProxySettings spilling = proxySettings;
+        spilling.leavesByReference = byReference;
+        spilling.meshSpillPath = (dir / "built.spill").string();
+        bool released = false;
+        spilling.releaseFreedMemory = [&] { released = true; };
+        ASSERT_TRUE(buildHierarchyNodes(h, objects, spilling, built, error)) << error;
+        EXPECT_TRUE(released);
+        ASSERT_TRUE(fs::exists(dir / "built.spill"));
+        ASSERT_EQ(built.nodes.size(), nodes.nodes.size());
+        EXPECT_EQ(built.roots, nodes.roots);
+        for (uint32_t i = 0; i < nodes.nodes.size(); ++i) {
+            const HierarchyNode& a = nodes.nodes[i];
+            const HierarchyNode& b = built.nodes[i];
+            EXPECT_TRUE(b.positions.empty() && b.indices.empty() && b.faceColors.empty()) << i;
+            EXPECT_EQ(b.meshPlace.kind, a.indices.empty() ? NodeMeshPlace::Kind::InNode
+                                        : a.leaf          ? NodeMeshPlace::Kind::Object
+                                                          : NodeMeshPlace::Kind::File)
+                << i;
+            EXPECT_EQ(b.parent, a.parent) << i;
+            EXPECT_EQ(b.children, a.children) << i;
+            EXPECT_EQ(b.sources, a.sources) << i;
+            EXPECT_EQ(b.geometricError, a.geometricError) << i;
+            EXPECT_EQ(b.sphereRadius, a.sphereRadius) << i;
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_EQ(b.boundsMin[k], a.boundsMin[k]) << i;
+                EXPECT_EQ(b.boundsMax[k], a.boundsMax[k]) << i;
+                EXPECT_EQ(b.sphereCenter[k], a.sphereCenter[k]) << i;
+            }
+            NodeMesh back;
+            ASSERT_TRUE(readNodeMesh(built, objects, i, back, error)) << error;
+            EXPECT_EQ(back.positions, a.positions) << i;
+            EXPECT_EQ(back.indices, a.indices) << i;
+            EXPECT_EQ(back.faceColors, a.faceColors) << i;
         }
-        NodeMesh back;
-        ASSERT_TRUE(readNodeMesh(built, objects, i, back, error)) << error;
-        EXPECT_EQ(back.positions, a.positions) << i;
-        EXPECT_EQ(back.indices, a.indices) << i;
-        EXPECT_EQ(back.faceColors, a.faceColors) << i;
     }
     // Nothing left for spillNodeMeshes to move: no second file.
     ASSERT_TRUE(spillNodeMeshes(built, objects, (dir / "second.spill").string(), error)) << error;
@@ -198,6 +204,14 @@ TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
     EXPECT_FALSE(io::writeRuntimeScene(*spilled, objects, 5, "test", (dir / "damaged.aglod").string(), error, 2));
     EXPECT_NE(error.find(spillPath.string()), std::string::npos) << error;
     EXPECT_FALSE(fs::exists(dir / "damaged.aglod"));
+    fs::create_directories(dir / "damaged-tiles");
+    io::TilesetSummary damagedSummary;
+    EXPECT_FALSE(io::writeTileset(*spilled, objects, (dir / "damaged-tiles").string(), damagedSummary, error));
+    EXPECT_NE(error.find(spillPath.string()), std::string::npos) << error;
+    // A spill file is never written over, even by mistake.
+    HierarchyNodes again = nodes;
+    EXPECT_FALSE(spillNodeMeshes(again, objects, spillPath.string(), error));
+    EXPECT_NE(error.find("already exists"), std::string::npos) << error;
 
     // The spill file goes with the last nodes sharing it.
     HierarchyNodes copy = *spilled;
