@@ -128,8 +128,11 @@ private:
                 const std::function<bool(Hierarchy3D&)>& bake, Hierarchy3D& part, size_t& baked, size_t& loaded);
 };
 
+/// Layout and meaning of the pieces' cache entries: a new tag never reads old ones. Change it
+/// whenever what a piece bakes can change for the same input (any stage of a cell's or a
+/// parent's bake, the wraps of a parent's inputs included), so that no stale piece is read.
 void hashSettings(detail::ContentHash& h, const Settings3D& s) {
-    h.text("aggrelod tile piece 3");
+    h.text("aggrelod tile piece 4");
     h.u64(uint64_t(s.function));
     h.u64(uint64_t(s.distance));
     h.f64(s.touchTolerance);
