@@ -647,12 +647,8 @@ int runBake(BakeOptions o) {
         !set->addFile(runtimePath, runtimeTmp, error) || (!statsPath.empty() && !set->addFile(statsPath, statsTmp, error)) ||
         (o.collision && !set->addFile(collisionPath, collisionTmp, error)))
         return fail(error);
-    // The nodes' meshes wait on disk while the files are written, each read back when written
-    // (a leaf's is its object's): on a large world they are most of what the bake holds.
-    // What the proxies stage did not spill (nothing, normally) goes too.
-    if (!spillNodeMeshes(nodes, scene.objects, set->scratchFile("node-meshes-rest.spill").string(), error))
-        return fail(error);
-    releaseFreedMemory();
+    // The nodes' meshes wait on disk (ProxySettings::meshSpillPath) while the files are written,
+    // each read back when written (a leaf's is its object's).
     if (!io::writeLevelsGlb(hierarchy, scene.objects, levelsTmp.string(), error, &nodes, o.threads, tiling.cache))
         return fail(error);
     // The exact aggregates' meshes are in levels.glb now and nothing after needs them (the

@@ -1027,10 +1027,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                                         [](double x) { return std::isfinite(x); });
         leafHasGeometry[o] = inHierarchy && finite;
         if (leafHasGeometry[o] && !share && settings.leavesByReference) {
-            n.meshPlace.kind = NodeMeshPlace::Kind::Object;
-            n.meshPlace.vertexCount = static_cast<uint32_t>(objects[o].positions.size() / 3);
-            n.meshPlace.triangleCount = static_cast<uint32_t>(objects[o].indices.size() / 3);
-            n.meshPlace.hasFaceColors = detail::hasTriangleColors(objects[o]);
+            n.meshPlace = detail::objectMeshPlace(objects[o]);
         } else if (leafHasGeometry[o] && !share) {
             n.positions.assign(objects[o].positions.begin(), objects[o].positions.end());
             n.indices = objects[o].indices;
@@ -1492,10 +1489,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
             HierarchyNode& n = nodes[o];
             if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
-            n.meshPlace.kind = NodeMeshPlace::Kind::Object;
-            n.meshPlace.vertexCount = static_cast<uint32_t>(n.positions.size() / 3);
-            n.meshPlace.triangleCount = static_cast<uint32_t>(n.indices.size() / 3);
-            n.meshPlace.hasFaceColors = !n.faceColors.empty();
+            n.meshPlace = detail::objectMeshPlace(objects[o]);
             dropMesh(n);
         }
         for (size_t i = objectCount; spilled && i < nodes.size(); ++i) {

@@ -53,6 +53,15 @@ size_t nodeTriangleCount(const HierarchyNode& n) {
 
 namespace detail {
 
+NodeMeshPlace objectMeshPlace(const InputObject& object) {
+    NodeMeshPlace place;
+    place.kind = NodeMeshPlace::Kind::Object;
+    place.vertexCount = uint32_t(object.positions.size() / 3);
+    place.triangleCount = uint32_t(object.indices.size() / 3);
+    place.hasFaceColors = hasTriangleColors(object);
+    return place;
+}
+
 bool NodeMeshSpiller::open(const std::string& path, std::string& error) {
     // A new file only ("x"): a spill file still in use by other nodes is never overwritten.
     std::FILE* file = std::fopen(path.c_str(), "w+bx");
@@ -144,11 +153,7 @@ bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& obje
         if (object && n.positions.size() == object->positions.size() && n.indices == object->indices && sameCopy() &&
             (coloured ? detail::hasTriangleColors(*object) && n.faceColors == object->triangleColors
                       : !detail::hasTriangleColors(*object))) {
-            place = NodeMeshPlace{};
-            place.kind = NodeMeshPlace::Kind::Object;
-            place.vertexCount = uint32_t(n.positions.size() / 3);
-            place.triangleCount = uint32_t(n.indices.size() / 3);
-            place.hasFaceColors = coloured;
+            place = detail::objectMeshPlace(*object);
             continue;
         }
         if (!spiller.write(n, uint32_t(i), place, error)) return false;

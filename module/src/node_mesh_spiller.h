@@ -12,6 +12,10 @@
 
 namespace aggrelod::detail {
 
+/// The place of a leaf's mesh that is its object's (NodeMeshPlace::Kind::Object): the
+/// object's counts, coloured where it has per-triangle colours.
+NodeMeshPlace objectMeshPlace(const InputObject& object);
+
 class NodeMeshSpiller {
 public:
     /// A new spill file at `path` (removed when the last holder of file() goes).

@@ -9,6 +9,7 @@
 #include "aglod_layout.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <iterator>
@@ -178,7 +179,8 @@ bool emitFile(const FileLayout& plan, Put&& put) {
     return true;
 }
 
-/// layout::fileChecksum over bytes given in pieces (the checksum field given as 0).
+/// layout::fileChecksum over bytes given in pieces of any size (the checksum field given as
+/// 0): whole 32-byte blocks go to layout::FileChecksum.
 class StreamChecksum {
 public:
     void add(const void* data, size_t size) {
@@ -190,21 +192,16 @@ public:
             p += n;
             size -= n;
             if (filled_ == sizeof(block_)) {
-                for (int k = 0; k < 4; ++k) lane_[k] = (lane_[k] ^ layout::loadU64(block_ + 8 * k)) * kPrime;
+                sum_.add(block_, total_, sizeof(block_), SIZE_MAX);  // nothing to skip: the field is 0
                 filled_ = 0;
                 total_ += sizeof(block_);
             }
         }
     }
-    uint64_t value() const {
-        uint64_t h = 0xcbf29ce484222325ull;
-        for (uint64_t l : lane_) h = (h ^ l) * kPrime;
-        return h ^ (total_ + filled_);
-    }
+    uint64_t value() const { return sum_.value(total_ + filled_); }
 
 private:
-    static constexpr uint64_t kPrime = 0x100000001b3ull;
-    uint64_t lane_[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull, 0x2325cbf29ce48422ull};
+    layout::FileChecksum sum_;
     uint8_t block_[32] = {};
     size_t filled_ = 0;
     uint64_t total_ = 0;
