@@ -707,7 +707,7 @@ struct WorkItems {
 /// Layout of the proxies' cache entries and of their keys: a new layout never reads old ones.
 /// Change it too whenever what an item makes changes (any constant or step of this file or
 /// of the simplifier, the error measure or the colours), so that no stale entry is read.
-constexpr char kProxyItemTag[] = "aggrelod proxy item 2";
+constexpr char kProxyItemTag[] = "aggrelod proxy item 3";
 
 /// ProxySettings::cache: the keys of the proxies' work items (each a hash of everything the
 /// item's result depends on) and what was made and read.

@@ -55,6 +55,36 @@ inline std::string edgeManifoldProblem(const std::vector<uint32_t>& indices) {
     return {};
 }
 
+/// Index edges whose two triangles fold onto each other: normals within about 2.6 degrees
+/// of opposite (a fin that encloses nothing; a ray along it meets both faces at one point).
+/// positions: 3 * n floats; indices as edgeManifoldProblem's (pairs used other than once in
+/// each direction are not counted here).
+inline size_t foldedEdgeCount(const std::vector<float>& positions, const std::vector<uint32_t>& indices) {
+    const auto normal = [&](size_t t) {
+        double c[3][3];
+        for (int k = 0; k < 3; ++k)
+            for (int d = 0; d < 3; ++d) c[k][d] = positions[3 * size_t(indices[3 * t + size_t(k)]) + size_t(d)];
+        const double u[3] = {c[1][0] - c[0][0], c[1][1] - c[0][1], c[1][2] - c[0][2]};
+        const double v[3] = {c[2][0] - c[0][0], c[2][1] - c[0][1], c[2][2] - c[0][2]};
+        return std::array<double, 3>{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    };
+    std::map<std::pair<uint32_t, uint32_t>, size_t> directed;
+    for (size_t t = 0; 3 * t + 2 < indices.size(); ++t)
+        for (int k = 0; k < 3; ++k) directed[{indices[3 * t + size_t(k)], indices[3 * t + size_t(k + 1) % 3]}] = t;
+    size_t folded = 0;
+    for (const auto& [edge, t] : directed) {
+        if (edge.first > edge.second) continue;  // each undirected edge once
+        const auto back = directed.find({edge.second, edge.first});
+        if (back == directed.end()) continue;
+        const auto m = normal(t), n = normal(back->second);
+        const double dot = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+        const double lm = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        const double ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (dot < -0.999 * lm * ln) ++folded;
+    }
+    return folded;
+}
+
 /// Edge-connected shells of an indexed mesh (triangles sharing an undirected index edge).
 inline int shellCount(const std::vector<uint32_t>& indices) {
     const size_t triangles = indices.size() / 3;

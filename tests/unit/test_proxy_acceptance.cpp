@@ -96,7 +96,7 @@ struct ProxyUnderTest {
 };
 
 struct Figures {
-    size_t proxies = 0, notClosed = 0, notEdgeManifold = 0, nonPositiveVolume = 0, shellMismatch = 0;
+    size_t proxies = 0, notClosed = 0, notEdgeManifold = 0, nonPositiveVolume = 0, shellMismatch = 0, folded = 0;
     size_t verticesChecked = 0, verticesOutside = 0, proxiesWithVerticesOutside = 0;
     double maxVertexOutside = 0;  ///< world units
     size_t rays = 0, raysHittingOriginals = 0, rayViolations = 0, proxiesWithRayViolations = 0;
@@ -118,6 +118,7 @@ struct Figures {
     std::string summary() const {
         std::ostringstream s;
         s << proxies << " proxies: " << notClosed << " not closed, " << notEdgeManifold << " not edge-manifold, "
+          << folded << " with folded edges, "
           << nonPositiveVolume << " volume <= 0, " << shellMismatch << " shell count != exact aggregate's; "
           << verticesOutside << " of " << verticesChecked << " original vertices outside (in " << proxiesWithVerticesOutside
           << " proxies, max " << maxVertexOutside << "); " << rayViolations << " of " << rays << " rays ("
@@ -158,6 +159,11 @@ Figures checkProxies(const std::vector<ProxyUnderTest>& proxies, const std::vect
         if (!manifold.empty()) {
             ++f.notEdgeManifold;
             f.example("manifold", name + ": not edge-manifold: " + manifold);
+        }
+        const size_t folds = foldedEdgeCount(*p.positions, *p.indices);
+        if (folds > 0) {
+            ++f.folded;
+            f.example("folded", name + ": " + std::to_string(folds) + " edges whose faces fold onto each other");
         }
         const double volume = signedVolumeOf(mesh);
         if (!(volume > 0)) {
