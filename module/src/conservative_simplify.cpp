@@ -250,7 +250,6 @@ public:
         quadric_.resize(n);
         error_.assign(n, 0.0);
         stamp_.assign(n, 0);
-        touch_.assign(n, 0);
         alive_.assign(n, 0);
         double extent = 0;
         for (const V3& q : p_) extent = std::max({extent, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
@@ -292,8 +291,8 @@ public:
         if (!started_) {
             started_ = true;
             // Each edge once, collapsing into its lower vertex: evaluate() gives both
-            // directions the same candidates, planes and cost, and of two equal entries the
-            // heap pops that one first.
+            // directions the same candidates and planes (to rounding: in another order), and
+            // of two equal entries the heap pops that one first.
             for (uint32_t v = 0; v < p_.size(); ++v)
                 if (alive_[v]) pushEdgesOf(v, v + 1);
         }
@@ -301,19 +300,13 @@ public:
             const Entry e = heap_.top();
             heap_.pop();
             if (!alive_[e.a] || !alive_[e.b] || stamp_[e.a] != e.stampA || stamp_[e.b] != e.stampB) continue;
-            Candidate c = e.candidate;
-            if (touch_[e.a] == e.touchA && touch_[e.b] == e.touchB) {
-                // Nothing evaluate() reads has changed since the entry was made: the same
-                // result, without the work; crossesOtherFaces() needs the faces around.
-                facesAround(e.a, e.b);
-            } else {
-                if (!evaluate(e.a, e.b, c)) continue;
-                if (c.cost > e.cost + epsilon_) {  // the neighbourhood changed since it was pushed
-                    heap_.push(entry(c, e.a, e.b));
-                    continue;
-                }
+            Candidate c;
+            if (!evaluate(e.a, e.b, c)) continue;
+            if (c.cost > e.cost + epsilon_) {  // the neighbourhood changed since it was pushed
+                heap_.push(entry(c, e.a, e.b));
+                continue;
             }
-            if (crossesOtherFaces(e.a, e.b, c.position)) continue;  // tried again if a neighbour changes
+            if (crossesOtherFaces(e.a, e.b, c.position)) continue;  // tried again when its edge is pushed again
             collapse(e.a, e.b, c);
             ++result.collapses;
             result.errorEstimate = std::max(result.errorEstimate, c.cost);
@@ -349,8 +342,6 @@ private:
         double cost;
         uint32_t a, b;
         uint32_t stampA, stampB;
-        uint32_t touchA, touchB;  ///< touch_ of a and b when `candidate` was evaluated
-        Candidate candidate;      ///< evaluate(a, b) then
         bool operator<(const Entry& o) const {  // priority_queue pops the largest: invert
             if (cost != o.cost) return cost > o.cost;
             if (a != o.a) return a > o.a;
@@ -358,19 +349,7 @@ private:
         }
     };
 
-    Entry entry(const Candidate& c, uint32_t a, uint32_t b) const {
-        return Entry{c.cost, a, b, stamp_[a], stamp_[b], touch_[a], touch_[b], c};
-    }
-
-    /// scratchFaces_ = the faces around edge (a, b), as evaluate() leaves them.
-    void facesAround(uint32_t a, uint32_t b) {
-        std::vector<uint32_t>& around = scratchFaces_;
-        around.assign(vertexFaces_[a].begin(), vertexFaces_[a].end());
-        for (uint32_t f : vertexFaces_[b]) {
-            const auto& t = faces_[f];
-            if (t[0] != a && t[1] != a && t[2] != a) around.push_back(f);
-        }
-    }
+    Entry entry(const Candidate& c, uint32_t a, uint32_t b) const { return Entry{c.cost, a, b, stamp_[a], stamp_[b]}; }
 
     V3 faceNormal(uint32_t f) const {
         const auto& t = faces_[f];
@@ -620,7 +599,8 @@ private:
     }
 
     /// Would a face made by collapsing (a, b) into `position` cross a face that shares no
-    /// vertex with it? Neighbours sharing a vertex are left to the fold test; the check keeps
+    /// vertex with it? Faces sharing a corner with a new face are not tested (the fold tests
+    /// cover those sharing an edge with it, facesStayUpright); the check keeps
     /// two parts of the surface pushed towards each other across a narrow gap from meeting.
     bool crossesOtherFaces(uint32_t a, uint32_t b, V3 position) {
         // The new faces (every one holds a), and one query over the box around all of them.
@@ -647,7 +627,7 @@ private:
         if (newFaces_.empty()) return false;
         return tree_.query(all, [&](uint32_t g) {
             const auto& u = faces_[g];
-            // Faces around the edge share a with every new face: left to the fold test.
+            // Faces around the edge share a with every new face: not tested.
             if (u[0] == a || u[1] == a || u[2] == a || u[0] == b || u[1] == b || u[2] == b) return false;
             double other[9];
             FaceTree::Box box;
@@ -663,7 +643,7 @@ private:
                 if (!FaceTree::overlap(n.box, box)) continue;
                 if (u[0] == n.ids[1] || u[0] == n.ids[2] || u[1] == n.ids[1] || u[1] == n.ids[2] || u[2] == n.ids[1] ||
                     u[2] == n.ids[2] || u[0] == n.ids[0] || u[1] == n.ids[0] || u[2] == n.ids[0])
-                    continue;  // shares a vertex: the fold test's
+                    continue;  // shares a corner: not tested
                 if (sharePosition(n.corners, other) || separatedByPlaneOf(n.corners, other) ||
                     separatedByPlaneOf(other, n.corners))
                     continue;
@@ -713,14 +693,6 @@ private:
         error_[a] = c.cost;
         ++stamp_[a];
         ++stamp_[b];
-        // evaluate(x, y) reads the faces around x and y, their corners, and the quadrics and
-        // errors of x and y: a collapse changes them for a, b and a's new ring only.
-        ++touch_[a];
-        ++touch_[b];
-        ++markStamp_;
-        for (uint32_t f : listA)
-            for (uint32_t w : faces_[f])
-                if (w != a && mark_[w] != markStamp_) mark_[w] = markStamp_, ++touch_[w];
         // The neighbours' own edges now see other faces: their entries are re-evaluated
         // when popped, and their stamps are kept so the entries stay valid.
     }
@@ -732,7 +704,6 @@ private:
     std::vector<Quadric> quadric_;
     std::vector<double> error_;
     std::vector<uint32_t> stamp_;
-    std::vector<uint32_t> touch_;  ///< per vertex: bumped whenever a collapse changes what evaluate() reads about it
     std::priority_queue<Entry> heap_;
     size_t liveFaces_ = 0;
     double epsilon_ = 0;

@@ -22,7 +22,8 @@ struct ConservativeSimplifyResult {
 /// so that every intermediate mesh (and the output) encloses the input (progressive hulls).
 /// Collapses run cheapest first while their accumulated estimate stays <= maxError (world
 /// units) and the mesh has more than minTriangles triangles. Collapses that would make the
-/// mesh non-manifold, fold a face over (normal turned by more than ~70 degrees) or reduce a
+/// mesh non-manifold, fold a face over (normal turned by more than ~70 degrees), fold two
+/// neighbouring faces onto each other (normals within ~2.6 degrees of opposite) or reduce a
 /// shell below a tetrahedron are skipped, and so are collapses that would give a vertex
 /// more than 24 neighbours (flat regions would otherwise become fans, whose cost grows with
 /// every collapse near them); vertices that share their position with another

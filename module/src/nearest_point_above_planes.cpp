@@ -29,7 +29,10 @@ bool nearestPointAbovePlanes(const HalfSpace* spaces, size_t count, Vec3 c, Vec3
             const double rj = sj.offset - dot(sj.normal, origin);
             if (aj * u + bj * v - rj >= 0) continue;
             const double aa = aj * aj + bj * bj;
-            if (!(aa > tiny * tiny)) return false;  // parallel to plane i, facing away
+            if (!(aa > tiny * tiny)) {  // parallel to plane i: the same plane (to rounding) or facing away
+                if (rj > tiny * (1 + std::fabs(sj.offset))) return false;
+                continue;
+            }
             // The optimum lies on the line a_j u + b_j v = r_j: base + t (-b_j, a_j) / |(a_j, b_j)|,
             // t within the interval the half-spaces before j leave.
             const double la = std::sqrt(aa);

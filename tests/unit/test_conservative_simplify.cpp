@@ -5,6 +5,7 @@
 #include "mesh_distance.h"
 #include "nearest_point_above_planes.h"
 #include "solidify.h"
+#include "mesh_checks.h"
 #include "test_support.h"
 
 #include <aggrelod/samples.h>
@@ -113,7 +114,7 @@ TEST(NearestPointAbovePlanes, MatchesTheBestActiveSet) {
             if (length(v) > 0.1 && length(v) <= 1) return (1 / length(v)) * v;
         }
     };
-    size_t feasibleCases = 0, emptyCases = 0, wedges = 0;
+    size_t feasibleCases = 0, emptyCases = 0, wedges = 0, coplanarCases = 0;
     for (int trial = 0; trial < 4000; ++trial) {
         const size_t count = 1 + trial % 14;
         std::vector<detail::HalfSpace> spaces(count);
@@ -121,9 +122,22 @@ TEST(NearestPointAbovePlanes, MatchesTheBestActiveSet) {
         const Vec3 axis = randomUnit();
         for (auto& h : spaces) {
             // Wedges: normals within a few degrees of one axis, the region a thin cone or slab.
-            h.normal = wedge ? (1 / length(axis + 0.05 * randomUnit())) * (axis + 0.05 * randomUnit()) : randomUnit();
-            if (wedge) h.normal = (1 / length(h.normal)) * h.normal;
+            if (wedge) {
+                const Vec3 jitter = randomUnit();
+                h.normal = axis + 0.05 * jitter;
+                h.normal = (1 / length(h.normal)) * h.normal;
+            } else {
+                h.normal = randomUnit();
+            }
             h.offset = unit(rng);
+        }
+        // Coplanar planes, as the faces of a flat region give: a copy of the first one (its
+        // offset off by rounding), and the point on it.
+        const bool coplanar = trial % 4 == 1 && count >= 3;
+        if (coplanar) {
+            spaces[count - 1] = spaces[0];
+            spaces[count - 1].offset = std::nextafter(spaces[0].offset, trial % 8 == 1 ? 2.0 : -2.0);
+            ++coplanarCases;
         }
         if (wedge && count >= 2) {  // two planes almost facing each other: a thin slab, or none
             spaces[1].normal = -1.0 * spaces[0].normal + 0.01 * randomUnit();
@@ -131,7 +145,8 @@ TEST(NearestPointAbovePlanes, MatchesTheBestActiveSet) {
             spaces[1].offset = -spaces[0].offset - 0.02 * std::fabs(unit(rng));
             ++wedges;
         }
-        const Vec3 c{2 * unit(rng), 2 * unit(rng), 2 * unit(rng)};
+        Vec3 c{2 * unit(rng), 2 * unit(rng), 2 * unit(rng)};
+        if (coplanar) c = c - (dot(spaces[0].normal, c) - spaces[0].offset) * spaces[0].normal;
         Vec3 ours;
         const bool found = detail::nearestPointAbovePlanes(spaces.data(), spaces.size(), c, ours);
         const std::optional<Vec3> expected = nearestByActiveSets(spaces, c);
@@ -150,6 +165,7 @@ TEST(NearestPointAbovePlanes, MatchesTheBestActiveSet) {
     EXPECT_GT(feasibleCases, 1000u);
     EXPECT_GT(emptyCases, 100u);
     EXPECT_GT(wedges, 500u);
+    EXPECT_GT(coplanarCases, 500u);
 }
 
 TEST(ConservativeSimplify, GriddedBoxBecomesTwelveTriangles) {
@@ -237,6 +253,32 @@ TEST(ConservativeSimplify, FlatSidesOfAWrapDoNotBecomeFans) {
     for (const auto& n : neighbours) most = std::max(most, n.size());
     EXPECT_LE(most, 24u);
     expectValidEnclosure(asObject(wrap, wrapIdx), pos, idx);
+}
+
+// Flat regions: a position placed exactly on their planes could fold a face onto its
+// neighbour (a fin enclosing nothing, which a ray along it meets twice at one point). No
+// output has such a pair, on boxes of flat faces and on the alpha wrap of one.
+TEST(ConservativeSimplify, NoTwoFacesFoldOntoEachOther) {
+    std::vector<std::pair<std::string, InputObject>> shapes;
+    shapes.emplace_back("gridded box", samples::makeBox("box", {0, 0, 0}, {2, 1, 0.5}, 0.1));
+    shapes.emplace_back("sphere", samples::makeUvSphere("sphere", {0, 0, 0}, 1.0, 32, 16));
+    InputObject openBox = samples::makeBox("box", {0, 0, 0}, {1, 1, 1});
+    openBox.indices.resize(openBox.indices.size() - 3);
+    InputObject wrap;
+    std::string error;
+    ASSERT_TRUE(detail::alphaWrap(openBox.positions, openBox.indices, 0.05, 0.01, wrap.positions, wrap.indices, error)) << error;
+    shapes.emplace_back("alpha wrap", wrap);
+    size_t outputs = 0;
+    for (const auto& [name, shape] : shapes)
+        for (double maxError : {0.002, 0.01, 0.05, 0.2}) {
+            std::vector<double> pos;
+            std::vector<uint32_t> idx;
+            detail::simplifyConservative(shape.positions, shape.indices, maxError, 0, pos, idx);
+            const std::vector<float> floats(pos.begin(), pos.end());
+            EXPECT_EQ(foldedEdgeCount(floats, idx), 0u) << name << " at " << maxError;
+            ++outputs;
+        }
+    EXPECT_EQ(outputs, 12u);
 }
 
 TEST(ConservativeSimplify, ZeroErrorKeepsTheMesh) {
