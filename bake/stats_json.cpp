@@ -126,6 +126,7 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
         j["objects"] = names;
         j["method"] = r.method == SolidifyMethod::Wrap    ? "alpha_wrap"
                       : r.method == SolidifyMethod::Union ? "boolean_union"
+                      : r.method == SolidifyMethod::Shell ? "shell"
                                                           : "convex_hull";
         j["reason"] = r.reason;
         j["alpha"] = jsonNumber(r.alpha);

@@ -138,7 +138,7 @@ struct Model {
     std::vector<uint32_t> objects;    ///< ascending input indices
     /// What the surface given to the triangulator is: the objects' own faces, or a solid
     /// standing in for them (docs/design.md §2.0).
-    enum class Kind { Original, Union, Wrap, Hull } kind = Kind::Original;
+    enum class Kind { Original, Union, Shell, Wrap, Hull } kind = Kind::Original;
     bool standIn() const { return kind != Kind::Original; }
     std::string reason;               ///< why it is solidified
     double alpha = 0, offset = 0;     ///< wrap parameters

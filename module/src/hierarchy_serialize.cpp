@@ -176,7 +176,7 @@ bool deserializeHierarchy(const std::vector<uint8_t>& bytes, Hierarchy3D& h) {
     for (SolidReport& s : h.solids) {
         r.array(s.objects);
         const uint8_t method = r.pod<uint8_t>();
-        if (method > uint8_t(SolidifyMethod::Union)) return false;
+        if (method > uint8_t(SolidifyMethod::Shell)) return false;
         s.method = SolidifyMethod(method);
         s.reason = r.text();
         for (double* v : {&s.alpha, &s.offset, &s.volumeOriginal, &s.volumeSolid, &s.distanceSolidToOriginal,

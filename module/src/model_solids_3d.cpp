@@ -7,6 +7,7 @@
 #include "convex_hull.h"
 #include "parallel_for.h"
 #include "solidify.h"
+#include "surface_shell.h"
 
 #include <aggrelod/disjoint_sets.h>
 
@@ -140,6 +141,7 @@ void Baker3D::measureSolids() {
         SolidReport& r = reports[k];
         r.objects = m.objects;
         r.method = m.kind == Model::Kind::Union ? SolidifyMethod::Union
+                   : m.kind == Model::Kind::Shell ? SolidifyMethod::Shell
                    : m.kind == Model::Kind::Wrap ? SolidifyMethod::Wrap
                                                  : SolidifyMethod::Hull;
         r.reason = m.reason;
@@ -268,6 +270,7 @@ void Baker3D::solidifyModels(const std::vector<size_t>& which, const std::vector
     std::vector<std::string> failure(which.size());
     std::vector<char> flat(which.size(), 0);
     std::vector<char> fellBack(which.size(), 0);
+    std::vector<std::string> shellWhy(which.size());  // why a model of open surfaces was not thickened
     // Largest first (by input triangles): the two threads then finish together.
     std::vector<size_t> order(which.size()), load(which.size(), 0);
     std::iota(order.begin(), order.end(), size_t(0));
@@ -319,6 +322,25 @@ void Baker3D::solidifyModels(const std::vector<size_t>& which, const std::vector
             // with closed parts are not tried: their hidden inner surfaces lie deep inside any
             // wrap, so the test could not pass.
             const bool allOpen = std::none_of(m.objects.begin(), m.objects.end(), [&](uint32_t o) { return prepared_[o].validSolid(); });
+            // Open sheets (walls, floors, panels) are thickened first: the tightest solid and
+            // the cheapest, when the surface allows it (no detail finer than twice the offset,
+            // no fold sharper than 60 degrees, one fan of faces at every vertex).
+            if (allOpen && size > 0) {
+                if (thickenSurface(pts, tris, offset, 2 * offset, m.positions, m.triangles, shellWhy[k])) {
+                    PreparedObject check = checkedSurface(m.positions, m.triangles);
+                    if (check.validSolid() && check.positions.size() == m.positions.size()) {
+                        m.positions = std::move(check.positions);
+                        m.triangles = std::move(check.triangles);
+                        m.kind = Model::Kind::Shell;
+                        m.alpha = 0;
+                        m.offset = offset;
+                        return;
+                    }
+                    shellWhy[k] = "the shell is not a closed, consistently oriented solid";
+                }
+                m.positions.clear();
+                m.triangles.clear();
+            }
             std::vector<double> alphas;
             if (allOpen) alphas.push_back(alpha * (edgesLongerThan(pts, tris, alpha * 4.0 / 3.0) >= 0.75 ? 4.0 / 3.0 : 1.1));
             alphas.push_back(alpha);
@@ -382,10 +404,15 @@ void Baker3D::solidifyModels(const std::vector<size_t>& which, const std::vector
         if (m.kind == Model::Kind::Union)
             diag(out_, Diagnostic::Severity::Note, names,
                  why[k] + "; solidified by their exact boolean union for the triangulation");
+        else if (m.kind == Model::Kind::Shell)
+            diag(out_, Diagnostic::Severity::Note, names,
+                 why[k] + "; solidified by thickening its surface by " + fmt(m.offset) +
+                     " on both sides for the triangulation");
         else if (m.kind == Model::Kind::Wrap)
             diag(out_, Diagnostic::Severity::Note, names,
                  why[k] + "; solidified by an alpha wrap (alpha " + fmt(m.alpha) + ", offset " + fmt(m.offset) +
-                     ") for the triangulation");
+                     ") for the triangulation" +
+                     (shellWhy[k].empty() ? std::string() : " (not thickened: " + shellWhy[k] + ")"));
         else
             diag(out_, Diagnostic::Severity::Warning, names,
                  why[k] + (fellBack[k] ? "; alpha wrap failed (" + failure[k] + ")" : std::string()) +
@@ -425,7 +452,7 @@ void Baker3D::solidifyNestedLast(const std::vector<size_t>& which, const std::ve
         objectsBounds(inner.objects, b);
         for (size_t f : first) {
             const Model& outer = models_[f];
-            if ((outer.kind != Model::Kind::Wrap && outer.kind != Model::Kind::Union) || outer.objects.empty()) continue;
+            if (outer.kind == Model::Kind::Original || outer.kind == Model::Kind::Hull || outer.objects.empty()) continue;
             double ob[6];
             computeBounds(outer.positions, ob);
             bool boxInside = true;

@@ -132,7 +132,7 @@ private:
 /// whenever what a piece bakes can change for the same input (any stage of a cell's or a
 /// parent's bake, the wraps of a parent's inputs included), so that no stale piece is read.
 void hashSettings(detail::ContentHash& h, const Settings3D& s) {
-    h.text("aggrelod tile piece 4");
+    h.text("aggrelod tile piece 5");
     h.u64(uint64_t(s.function));
     h.u64(uint64_t(s.distance));
     h.f64(s.touchTolerance);

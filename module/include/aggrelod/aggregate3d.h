@@ -50,7 +50,10 @@ enum class SolidifyMethod {
     Off,   ///< nothing: such objects are left out of aggregation (passed through as support)
     /// (reported in SolidReport only) the exact boolean union of objects that are closed
     /// solids alone but touch or cross each other; Wrap tries it first for them.
-    Union
+    Union,
+    /// (reported in SolidReport only) an open surface thickened by the offset on both sides
+    /// into a thin closed shell; Wrap tries it first for models made only of open surfaces.
+    Shell
 };
 
 /// How support surfaces (ground, terrain, sky dome, road network, room shell) are found.
