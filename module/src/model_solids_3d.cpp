@@ -323,17 +323,20 @@ void Baker3D::solidifyModels(const std::vector<size_t>& which, const std::vector
             // wrap, so the test could not pass.
             const bool allOpen = std::none_of(m.objects.begin(), m.objects.end(), [&](uint32_t o) { return prepared_[o].validSolid(); });
             // Open sheets (walls, floors, panels) are thickened first: the tightest solid and
-            // the cheapest, when the surface allows it (no detail finer than twice the offset,
-            // no fold sharper than 60 degrees, one fan of faces at every vertex).
+            // the cheapest, when the surface allows it (no detail finer than the offset, no fold
+            // sharper than 60 degrees, one fan of faces at every vertex, openings wider than
+            // alpha: a wrap fills a nearly closed mesh where a shell would be a hollow skin).
+            // Half the offset each side, so that no point of the shell lies farther than the
+            // offset from the surface, as for a wrap.
             if (allOpen && size > 0) {
-                if (thickenSurface(pts, tris, offset, 2 * offset, m.positions, m.triangles, shellWhy[k])) {
+                if (thickenSurface(pts, tris, offset / 2, offset, alpha, m.positions, m.triangles, shellWhy[k])) {
                     PreparedObject check = checkedSurface(m.positions, m.triangles);
                     if (check.validSolid() && check.positions.size() == m.positions.size()) {
                         m.positions = std::move(check.positions);
                         m.triangles = std::move(check.triangles);
                         m.kind = Model::Kind::Shell;
                         m.alpha = 0;
-                        m.offset = offset;
+                        m.offset = offset / 2;
                         return;
                     }
                     shellWhy[k] = "the shell is not a closed, consistently oriented solid";
@@ -504,8 +507,8 @@ void Baker3D::solidifyNestedLast(const std::vector<size_t>& which, const std::ve
         }
         Model& outer = models_[host[k]];
         diag(out_, Diagnostic::Severity::Note, objectNames(objects_, inner.objects),
-             nestedWhy[k] + "; inside the alpha wrap of " + objectNames(objects_, outer.objects) +
-                 ": joins that model, whose wrap stands for both");
+             nestedWhy[k] + "; inside the solid of " + objectNames(objects_, outer.objects) +
+                 ": joins that model, whose solid stands for both");
         outer.objects.insert(outer.objects.end(), inner.objects.begin(), inner.objects.end());
         std::sort(outer.objects.begin(), outer.objects.end());
         outer.volumeOriginal += inner.volumeOriginal;

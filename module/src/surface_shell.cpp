@@ -5,6 +5,7 @@
 // the vertices, keep their distance.
 #include "surface_shell.h"
 
+#include "mesh_distance.h"
 #include "mesh_preparation.h"
 #include "nearest_point_above_planes.h"
 
@@ -30,8 +31,8 @@ bool fail(std::string& why, const char* reason) {
 }  // namespace
 
 bool thickenSurface(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double offset,
-                    double maxDisplacement, std::vector<double>& outPositions, std::vector<uint32_t>& outTriangles,
-                    std::string& why) {
+                    double maxDisplacement, double smallestOpening, std::vector<double>& outPositions,
+                    std::vector<uint32_t>& outTriangles, std::string& why) {
     outPositions.clear();
     outTriangles.clear();
     const size_t n = positions.size() / 3;
@@ -90,19 +91,29 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
     }
     // Orient the faces of each piece alike (breadth first from its first face); every piece
     // must have a boundary (a closed piece would give two nested sheets: a hollow solid).
+    // A piece whose openings all fit in a ball of `smallestOpening` (a closed mesh with a face
+    // missing) is nearly closed: thickened it would be a hollow skin, where a wrap fills it.
     std::vector<int8_t> flip(m, -1);
-    std::vector<uint32_t> queue;
+    std::vector<uint32_t> queue, pieceOf(m, 0);
+    uint32_t pieces = 0;
     for (uint32_t seed = 0; seed < m; ++seed) {
         if (flip[seed] >= 0) continue;
         flip[seed] = 0;
         queue.assign(1, seed);
         bool open = false;
+        double rim[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
         for (size_t q = 0; q < queue.size(); ++q) {
             const uint32_t f = queue[q];
+            pieceOf[f] = pieces;
             for (int c = 0; c < 3; ++c) {
                 const uint32_t g = across[f][c];
                 if (g == UINT32_MAX) {
                     open = true;
+                    for (uint32_t v : {faces[f][c], faces[f][(c + 1) % 3]})
+                        for (int k = 0; k < 3; ++k) {
+                            rim[k] = std::min(rim[k], positions[3 * v + k]);
+                            rim[3 + k] = std::max(rim[3 + k], positions[3 * v + k]);
+                        }
                     continue;
                 }
                 // f (as oriented) runs a -> b along this edge; g must run b -> a.
@@ -121,6 +132,10 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
             }
         }
         if (!open) return fail(why, "a piece of it is closed");
+        const double opening = std::sqrt((rim[3] - rim[0]) * (rim[3] - rim[0]) + (rim[4] - rim[1]) * (rim[4] - rim[1]) +
+                                         (rim[5] - rim[2]) * (rim[5] - rim[2]));
+        if (opening < smallestOpening) return fail(why, "a piece of it is nearly closed (its openings are small)");
+        ++pieces;
     }
     for (uint32_t f = 0; f < m; ++f)
         if (flip[f]) {
@@ -232,10 +247,56 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
             return fail(why, "a sheet folds over (detail finer than twice the offset)");
         }
     }
-    if (selfIntersects(outPositions, outTriangles)) {
+    auto refuse = [&](const char* reason) {
         outPositions.clear();
         outTriangles.clear();
-        return fail(why, "its two sheets would cross (detail finer than twice the offset)");
+        return fail(why, reason);
+    };
+    if (selfIntersects(outPositions, outTriangles)) return refuse("its two sheets would cross (detail finer than twice the offset)");
+    // Each face keeps the offset from the sheet faces made from its own vertices; a face of
+    // another part of the surface may come nearer. Half the offset from both sheets everywhere
+    // is what the caller relies on.
+    {
+        std::vector<uint32_t> flat(3 * m);
+        for (uint32_t f = 0; f < m; ++f) std::copy(faces[f].begin(), faces[f].end(), flat.begin() + 3 * f);
+        TriangleBvh surface, sheets;
+        surface.build(positions.data(), n, flat.data(), m);
+        sheets.build(outPositions.data(), outPositions.size() / 3, outTriangles.data(), 2 * m);
+        if (meshDistance(surface, sheets, 0.5 * offset, 0.5 * offset).distance < 0.5 * offset)
+            return refuse("its sheets come nearer it than half the offset (detail finer than twice the offset)");
+    }
+    // Pieces apart (their shells do not cross, checked above) must not lie inside one another:
+    // nested shells do not bound a solid. One vertex of each piece's shell against the others'
+    // (generalized winding number), within a fixed budget of work.
+    if (pieces > 1) {
+        if (double(pieces) * double(outTriangles.size() / 3) > 2e7) return refuse("too many separate pieces");
+        std::vector<uint32_t> probe(pieces, UINT32_MAX);
+        for (uint32_t f = 0; f < m; ++f)
+            if (probe[pieceOf[f]] == UINT32_MAX) probe[pieceOf[f]] = outer[faces[f][0]];
+        for (uint32_t piece = 0; piece < pieces; ++piece) {
+            const Vec3 q = vertexAt(outPositions, probe[piece]);
+            double total = 0;
+            auto add = [&](const uint32_t* t) {
+                const Vec3 a = vertexAt(outPositions, t[0]) - q, b = vertexAt(outPositions, t[1]) - q, c = vertexAt(outPositions, t[2]) - q;
+                const double la = length(a), lb = length(b), lc = length(c);
+                total += 2 * std::atan2(dot(a, cross(b, c)), la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb);
+            };
+            // Sheets of the other pieces, and their strips (each strip follows its face's order).
+            for (uint32_t f = 0; f < m; ++f)
+                if (pieceOf[f] != piece) {
+                    add(&outTriangles[3 * f]);
+                    add(&outTriangles[3 * (m + f)]);
+                }
+            size_t strip = 2 * m;
+            for (uint32_t f = 0; f < m; ++f)
+                for (int c = 0; c < 3; ++c) {
+                    if (across[f][c] != UINT32_MAX) continue;
+                    if (pieceOf[f] != piece)
+                        for (int k = 0; k < 4; ++k) add(&outTriangles[3 * (strip + k)]);
+                    strip += 4;
+                }
+            if (std::fabs(total) > 2 * M_PI) return refuse("a piece of it lies inside another's shell");
+        }
     }
     return true;
 }
