@@ -186,11 +186,12 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
         ->check(CLI::Range(0, 1000));
     cmd->add_option("--solidify", o.solidify,
                     "What stands in for objects that are not closed solids (open, non-manifold, self-intersecting, "
-                    "touching): wrap (default: the exact union of touching closed solids, else a tight watertight alpha wrap), hull (convex hull) or off (left out)")
+                    "touching): wrap (default: the exact union of touching closed solids, open sheets thickened into a shell, else a tight "
+                    "watertight alpha wrap), hull (convex hull) or off (left out)")
         ->transform(CLI::IsMember({"wrap", "hull", "off"}, CLI::ignore_case));
     cmd->add_option("--wrap-offset", o.wrapOffset,
-                    "Distance of the wrap from the original surface, in scene units (default: automatic, see "
-                    "docs/real-art.md)")
+                    "Distance of the wrap (or the shell's surface) from the original surface, in scene units (default: "
+                    "automatic, see docs/real-art.md)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--support", o.support,
                     "Support surfaces (ground, terrain, sky, roads, room shell) kept out of aggregation and passed "
