@@ -47,7 +47,10 @@ void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint
 
 bool selfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& triangles) {
     const size_t m = triangles.size() / 3;
+    if (m < 2) return false;
     std::vector<std::array<double, 6>> box(m);
+    double all[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    double extentSum = 0;
     for (size_t t = 0; t < m; ++t) {
         for (int k = 0; k < 3; ++k) {
             box[t][k] = INFINITY;
@@ -59,27 +62,84 @@ bool selfIntersects(const std::vector<double>& positions, const std::vector<uint
                 box[t][k] = std::min(box[t][k], v);
                 box[t][3 + k] = std::max(box[t][3 + k], v);
             }
-    }
-    std::vector<uint32_t> order(m);
-    std::iota(order.begin(), order.end(), 0u);
-    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return std::make_pair(box[a][0], a) < std::make_pair(box[b][0], b); });
-    for (size_t i = 0; i < m; ++i) {
-        const uint32_t a = order[i];
-        const uint32_t* ta = &triangles[3 * a];
-        for (size_t j = i + 1; j < m; ++j) {
-            const uint32_t b = order[j];
-            if (box[b][0] > box[a][3]) break;
-            if (box[b][1] > box[a][4] || box[a][1] > box[b][4] || box[b][2] > box[a][5] || box[a][2] > box[b][5]) continue;
-            const uint32_t* tb = &triangles[3 * b];
-            bool shares = false;
-            for (int x = 0; x < 3; ++x)
-                for (int y = 0; y < 3; ++y) shares = shares || ta[x] == tb[y];
-            if (shares) continue;
-            bool intersecting = false;
-            triangleTriangleDistance(&positions[3 * ta[0]], &positions[3 * ta[1]], &positions[3 * ta[2]], &positions[3 * tb[0]],
-                                     &positions[3 * tb[1]], &positions[3 * tb[2]], nullptr, nullptr, &intersecting);
-            if (intersecting) return true;
+        for (int k = 0; k < 3; ++k) {
+            all[k] = std::min(all[k], box[t][k]);
+            all[3 + k] = std::max(all[3 + k], box[t][3 + k]);
         }
+        extentSum += std::max({box[t][3] - box[t][0], box[t][4] - box[t][1], box[t][5] - box[t][2]});
+    }
+    // The pairs tested: boxes that overlap, triangles that share no vertex. Found in a uniform
+    // grid of cells twice the mean triangle size (each pair in the first cell both boxes
+    // touch), a sweep along x within each cell; the few triangles that would span more than
+    // 27 cells are tested against every other by box. A single sweep along x over a flat sheet lying across
+    // x would compare each triangle with a whole column of the sheet.
+    auto test = [&](uint32_t a, uint32_t b) {
+        if (box[b][0] > box[a][3] || box[a][0] > box[b][3] || box[b][1] > box[a][4] || box[a][1] > box[b][4] ||
+            box[b][2] > box[a][5] || box[a][2] > box[b][5])
+            return false;
+        const uint32_t* ta = &triangles[3 * a];
+        const uint32_t* tb = &triangles[3 * b];
+        for (int x = 0; x < 3; ++x)
+            for (int y = 0; y < 3; ++y)
+                if (ta[x] == tb[y]) return false;
+        bool intersecting = false;
+        triangleTriangleDistance(&positions[3 * ta[0]], &positions[3 * ta[1]], &positions[3 * ta[2]], &positions[3 * tb[0]],
+                                 &positions[3 * tb[1]], &positions[3 * tb[2]], nullptr, nullptr, &intersecting);
+        return intersecting;
+    };
+    const double cell = std::max(2 * extentSum / double(m),
+                                 1e-9 * std::max({all[3] - all[0], all[4] - all[1], all[5] - all[2], 1e-300}));
+    uint64_t dims[3];
+    for (int k = 0; k < 3; ++k) dims[k] = std::min<uint64_t>(uint64_t((all[3 + k] - all[k]) / cell) + 1, uint64_t(1) << 20);
+    auto cellOf = [&](double v, int k) {
+        return std::min<uint64_t>(uint64_t(std::max(0.0, (v - all[k]) / cell)), dims[k] - 1);
+    };
+    constexpr uint64_t kMaxCellsPerTriangle = 27;
+    std::vector<std::pair<uint64_t, uint32_t>> entries;  // (cell key, triangle)
+    std::vector<uint32_t> large;
+    std::vector<std::array<uint64_t, 6>> range(m);
+    for (uint32_t t = 0; t < m; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            range[t][k] = cellOf(box[t][k], k);
+            range[t][3 + k] = cellOf(box[t][3 + k], k);
+        }
+        const uint64_t count = (range[t][3] - range[t][0] + 1) * (range[t][4] - range[t][1] + 1) * (range[t][5] - range[t][2] + 1);
+        if (count > kMaxCellsPerTriangle) {
+            large.push_back(t);
+            continue;
+        }
+        for (uint64_t z = range[t][2]; z <= range[t][5]; ++z)
+            for (uint64_t y = range[t][1]; y <= range[t][4]; ++y)
+                for (uint64_t x = range[t][0]; x <= range[t][3]; ++x) entries.emplace_back(x + dims[0] * (y + dims[1] * z), t);
+    }
+    std::vector<char> isLarge(m, 0);
+    for (uint32_t t : large) isLarge[t] = 1;
+    for (uint32_t a : large)
+        for (uint32_t b = 0; b < m; ++b)
+            if (b != a && (!isLarge[b] || b > a) && test(a, b)) return true;
+    std::sort(entries.begin(), entries.end());
+    std::vector<uint32_t> run;
+    for (size_t i = 0; i < entries.size();) {
+        size_t j = i;
+        while (j < entries.size() && entries[j].first == entries[i].first) ++j;
+        if (j - i >= 2) {
+            const uint64_t key = entries[i].first;
+            run.clear();
+            for (size_t k = i; k < j; ++k) run.push_back(entries[k].second);
+            std::sort(run.begin(), run.end(), [&](uint32_t a, uint32_t b) { return std::make_pair(box[a][0], a) < std::make_pair(box[b][0], b); });
+            for (size_t p = 0; p < run.size(); ++p) {
+                const uint32_t a = run[p];
+                for (size_t q = p + 1; q < run.size(); ++q) {
+                    const uint32_t b = run[q];
+                    if (box[b][0] > box[a][3]) break;
+                    // Only in the first cell both ranges share: each pair once.
+                    const uint64_t first = std::max(range[a][0], range[b][0]) +
+                                           dims[0] * (std::max(range[a][1], range[b][1]) + dims[1] * std::max(range[a][2], range[b][2]));
+                    if (first == key && test(a, b)) return true;
+                }
+            }
+        }
+        i = j;
     }
     return false;
 }

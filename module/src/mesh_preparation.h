@@ -29,9 +29,10 @@ void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject
                    std::vector<Diagnostic>& diagnostics);
 
 /// Whether two triangles of the mesh that share no vertex intersect or touch (exact
-/// triangle-triangle test of mesh_distance.h on the pairs whose boxes overlap, found by a
-/// sweep along x). Triangles sharing a vertex are not tested: a fold there is not seen.
-/// positions 3 * n, triangles 3 * m. O(m log m + overlapping pairs).
+/// triangle-triangle test of mesh_distance.h on the pairs whose boxes overlap, found in a
+/// uniform grid of cells about twice the mean triangle size). Triangles sharing a vertex are
+/// not tested: a fold there is not seen. positions 3 * n, triangles 3 * m. O(m log m + pairs
+/// in a cell) when triangle sizes are alike; memory O(m) (at most 27 cells per triangle).
 bool selfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& triangles);
 
 /// Signed volume (divergence theorem) and area of a triangle mesh.

@@ -3,6 +3,7 @@
 // Known-answer cases on cubes and triangles, degenerate inputs, and comparisons of the BVH
 // queries against brute force over all triangle pairs on random meshes (fixed seeds).
 #include "mesh_distance.h"
+#include "mesh_preparation.h"
 
 #include <gtest/gtest.h>
 
@@ -747,4 +748,59 @@ TEST(MeshDistance, AllCentroidsEqual) {
     ClosestPoint bp = bruteForcePoint(m, p);
     EXPECT_EQ(cp.distance, bp.distance);
     EXPECT_EQ(cp.triangle, bp.triangle);
+}
+
+// selfIntersects (its grid of cells and the triangles too large for it)
+// against every pair tested directly, on soups of many sizes: sheets of small triangles with
+// a few large ones, mixed sizes, random soups that cross and ones that barely do not.
+TEST(SelfIntersects, MatchesEveryPairTested) {
+    auto bruteForce = [](const std::vector<double>& p, const std::vector<uint32_t>& t) {
+        for (size_t a = 0; a < t.size() / 3; ++a)
+            for (size_t b = a + 1; b < t.size() / 3; ++b) {
+                bool shares = false;
+                for (int x = 0; x < 3; ++x)
+                    for (int y = 0; y < 3; ++y) shares = shares || t[3 * a + x] == t[3 * b + y];
+                if (shares) continue;
+                bool hit = false;
+                triangleTriangleDistance(&p[3 * t[3 * a]], &p[3 * t[3 * a + 1]], &p[3 * t[3 * a + 2]], &p[3 * t[3 * b]],
+                                         &p[3 * t[3 * b + 1]], &p[3 * t[3 * b + 2]], nullptr, nullptr, &hit);
+                if (hit) return true;
+            }
+        return false;
+    };
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> unit(0, 1);
+    size_t crossing = 0, apart = 0;
+    for (int round = 0; round < 300; ++round) {
+        std::vector<double> p;
+        std::vector<uint32_t> t;
+        const int kind = round % 3;
+        // 0: a flat grid of small triangles plus a few large ones above or through it;
+        // 1: random triangles of mixed sizes; 2: large triangles of every orientation.
+        if (kind == 0) {
+            const int n = 6 + round % 9;
+            for (int j = 0; j <= n; ++j)
+                for (int i = 0; i <= n; ++i) p.insert(p.end(), {double(i) / n, double(j) / n, 0.0});
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) {
+                    const uint32_t v = uint32_t(j * (n + 1) + i);
+                    t.insert(t.end(), {v, v + 1, v + uint32_t(n) + 2, v, v + uint32_t(n) + 2, v + uint32_t(n) + 1});
+                }
+        }
+        const int count = kind == 0 ? 1 + round % 3 : kind == 1 ? 40 : 30;
+        for (int k = 0; k < count; ++k) {
+            const double size = kind == 1 ? (k % 5 == 0 ? 0.5 : 0.03) : kind == 2 ? 0.6 : 0.8;
+            const double c[3] = {unit(random), unit(random), kind == 0 ? 0.02 + 0.3 * unit(random) - (round % 4 == 0 ? 0.2 : 0) : unit(random)};
+            const double depth = kind == 2 ? 1.0 : 0.2;
+            const uint32_t base = uint32_t(p.size() / 3);
+            for (int v = 0; v < 3; ++v)
+                p.insert(p.end(), {c[0] + size * (unit(random) - 0.5), c[1] + size * (unit(random) - 0.5), c[2] + size * depth * (unit(random) - 0.5)});
+            t.insert(t.end(), {base, base + 1, base + 2});
+        }
+        const bool expected = bruteForce(p, t);
+        EXPECT_EQ(selfIntersects(p, t), expected) << "round " << round;
+        (expected ? crossing : apart) += 1;
+    }
+    EXPECT_GT(crossing, 30u);
+    EXPECT_GT(apart, 30u);
 }
