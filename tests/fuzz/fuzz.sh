@@ -45,6 +45,16 @@ case "$mode" in
  "bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],
  "buffers":[{"byteLength":42,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA"}]}
 GLTF
+    # Two open boxes (no top face) sharing one mesh: open sheets, thickened into shells.
+    cat > "$dir/seeds/gltf/open_boxes.gltf" <<'GLTF'
+{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
+ "nodes":[{"name":"a","mesh":0},{"name":"b","mesh":0,"translation":[5,0,0]}],
+ "meshes":[{"name":"open_box","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
+ "accessors":[{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[0,0,0],"max":[2,1,1.5]},
+              {"bufferView":1,"componentType":5123,"count":30,"type":"SCALAR"}],
+ "bufferViews":[{"buffer":0,"byteLength":96},{"buffer":0,"byteOffset":96,"byteLength":60}],
+ "buffers":[{"byteLength":156,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAQAAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAMA/AAAAQAAAAAAAAMA/AAAAQAAAgD8AAMA/AAAAAAAAgD8AAMA/AAADAAIAAAACAAEAAAABAAUAAAAFAAQAAQACAAYAAQAGAAUAAgADAAcAAgAHAAYAAwAAAAQAAwAEAAcA"}]}
+GLTF
     printf 'POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0), (2 2, 4 2, 4 4, 2 4, 2 2))\nMULTIPOLYGON (((20 0, 30 0, 30 5, 20 0)), ((40 0, 41 0, 41 1, 40 0)))\n' \
       > "$dir/seeds/geo/two.wkt"
     printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{"name":"a"},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,0]]]}},{"type":"Feature","geometry":{"type":"MultiPolygon","coordinates":[[[[2,2],[3,2],[3,3],[2,2]]]]}}]}\n' \
