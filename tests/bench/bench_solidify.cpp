@@ -135,18 +135,31 @@ int main(int argc, char** argv) {
                 std::string names;
                 for (uint32_t o : r.objects) names += (names.empty() ? "" : ",") + scene.objects[o].name;
                 if (names.size() > 40) names.resize(40);
-                std::printf("    %-40s %6.2f s  alpha %.4g offset %.4g  %6zu tris  hausdorff %.2f %% diag", names.c_str(),
+                std::printf("    %-40s %7.3f s  alpha %.4g offset %.4g  %6zu tris  hausdorff %.2f %% diag", names.c_str(),
                             r.seconds, r.alpha, r.offset, r.triangles.size() / 3,
                             100 * std::max(r.distanceSolidToOriginal, r.distanceOriginalToSolid) / r.bboxDiagonal);
+                // The objects as read.
+                std::vector<double> positions;
+                std::vector<uint32_t> triangles;
+                for (uint32_t o : r.objects) {
+                    const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
+                    positions.insert(positions.end(), scene.objects[o].positions.begin(), scene.objects[o].positions.end());
+                    for (uint32_t i : scene.objects[o].indices) triangles.push_back(base + i);
+                }
+                if (r.method == SolidifyMethod::Shell) {
+                    // What a user would do instead: CGAL's alpha wrap, at the wrap path's alpha
+                    // for surfaces of large faces (2 % of the diagonal) and the same reach.
+                    std::vector<double> outPositions;
+                    std::vector<uint32_t> outTriangles;
+                    std::string ignored;
+                    const auto begin = std::chrono::steady_clock::now();
+                    detail::alphaWrap(positions, triangles, 0.02 * r.bboxDiagonal, 2 * r.offset, outPositions, outTriangles, ignored,
+                                      detail::WrapOracle::Cgal);
+                    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+                    std::printf("  shell; CGAL's alpha wrap (alpha 2 %% diag) %.3f s, %zu tris", seconds, outTriangles.size() / 3);
+                }
                 if (r.method == SolidifyMethod::Wrap) {
-                    // The wrap of the objects as read, with either oracle.
-                    std::vector<double> positions;
-                    std::vector<uint32_t> triangles;
-                    for (uint32_t o : r.objects) {
-                        const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
-                        positions.insert(positions.end(), scene.objects[o].positions.begin(), scene.objects[o].positions.end());
-                        for (uint32_t i : scene.objects[o].indices) triangles.push_back(base + i);
-                    }
+                    // The wrap, with either oracle.
                     double seconds[2] = {0, 0};
                     std::vector<double> outPositions[2];
                     std::vector<uint32_t> outTriangles[2];
