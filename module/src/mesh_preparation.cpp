@@ -45,6 +45,28 @@ void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint
     }
 }
 
+double windingNumber(const std::vector<double>& p, const std::vector<uint32_t>& t, const double* q) {
+    double total = 0;
+    for (size_t i = 0; i + 2 < t.size(); i += 3) {
+        double a[3], b[3], c[3];
+        for (int k = 0; k < 3; ++k) {
+            a[k] = p[3 * t[i] + k] - q[k];
+            b[k] = p[3 * t[i + 1] + k] - q[k];
+            c[k] = p[3 * t[i + 2] + k] - q[k];
+        }
+        const double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        const double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                           a[2] * (b[0] * c[1] - b[1] * c[0]);
+        const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+        const double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
+        total += 2.0 * std::atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
+    }
+    return total / (4.0 * M_PI);
+}
+
 bool selfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& triangles) {
     const size_t m = triangles.size() / 3;
     if (m < 2) return false;

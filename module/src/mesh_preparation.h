@@ -35,6 +35,11 @@ void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject
 /// in a cell) when triangle sizes are alike; memory O(m) (at most 27 cells per triangle).
 bool selfIntersects(const std::vector<double>& positions, const std::vector<uint32_t>& triangles);
 
+/// Generalized winding number of a closed surface around q (Jacobson et al. 2013; solid
+/// angles by Van Oosterom and Strackee 1983): about 1 inside, 0 outside, robust to small
+/// defects. p: 3 * n doubles, t: 3 * m indices, q: 3 doubles (world units). O(m).
+double windingNumber(const std::vector<double>& p, const std::vector<uint32_t>& t, const double* q);
+
 /// Signed volume (divergence theorem) and area of a triangle mesh.
 void meshVolumeArea(const std::vector<double>& positions, const std::vector<uint32_t>& triangles,
                     double& volume, double& area);

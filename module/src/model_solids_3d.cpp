@@ -30,31 +30,6 @@ PreparedObject checkedSurface(const std::vector<double>& positions, const std::v
     return check;
 }
 
-// Generalized winding number of a closed surface around q (Jacobson et al. 2013; solid
-// angles by Van Oosterom and Strackee 1983): about 1 inside, 0 outside, robust to small
-// defects. O(triangles).
-double windingNumber(const std::vector<double>& p, const std::vector<uint32_t>& t, const double* q) {
-    double total = 0;
-    for (size_t i = 0; i + 2 < t.size(); i += 3) {
-        double a[3], b[3], c[3];
-        for (int k = 0; k < 3; ++k) {
-            a[k] = p[3 * t[i] + k] - q[k];
-            b[k] = p[3 * t[i + 1] + k] - q[k];
-            c[k] = p[3 * t[i + 2] + k] - q[k];
-        }
-        const double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-        const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-        const double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                           a[2] * (b[0] * c[1] - b[1] * c[0]);
-        const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
-        const double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
-        total += 2.0 * std::atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
-    }
-    return total / (4.0 * M_PI);
-}
-
 // Sample i of a surface (p, t) for the sampled distances: its vertices, then its triangles'
 // centroids (c: 3 doubles).
 void surfaceSample(const std::vector<double>& p, const std::vector<uint32_t>& t, size_t i, double* c) {

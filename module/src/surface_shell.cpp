@@ -28,6 +28,19 @@ bool fail(std::string& why, const char* reason) {
     return false;
 }
 
+/// Diagonal of a box given as min xyz, max xyz.
+double diagonal(const double* box) {
+    return std::sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
+                     (box[5] - box[2]) * (box[5] - box[2]));
+}
+
+void grow(double* box, const double* p) {
+    for (int k = 0; k < 3; ++k) {
+        box[k] = std::min(box[k], p[k]);
+        box[3 + k] = std::max(box[3 + k], p[k]);
+    }
+}
+
 }  // namespace
 
 bool thickenSurface(const std::vector<double>& positions, const std::vector<uint32_t>& triangles, double offset,
@@ -40,14 +53,11 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
     // Exact weld: the first of equal positions (in coordinate order) stands for all.
     std::vector<uint32_t> order(n), weld(n);
     std::iota(order.begin(), order.end(), 0u);
-    auto key = [&](uint32_t i) { return std::make_tuple(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], i); };
-    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
+    auto point = [&](uint32_t i) { return std::make_tuple(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); };
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return std::make_pair(point(a), a) < std::make_pair(point(b), b); });
     for (size_t k = 0; k < n; ++k) {
         const uint32_t i = order[k];
-        const bool same = k > 0 && std::get<0>(key(i)) == std::get<0>(key(order[k - 1])) &&
-                          std::get<1>(key(i)) == std::get<1>(key(order[k - 1])) &&
-                          std::get<2>(key(i)) == std::get<2>(key(order[k - 1]));
-        weld[i] = same ? weld[order[k - 1]] : i;
+        weld[i] = k > 0 && point(i) == point(order[k - 1]) ? weld[order[k - 1]] : i;
     }
     std::vector<std::array<uint32_t, 3>> faces;
     faces.reserve(triangles.size() / 3);
@@ -60,13 +70,8 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
     if (m == 0) return fail(why, "nothing to thicken");
     double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (const auto& f : faces)
-        for (uint32_t v : f)
-            for (int k = 0; k < 3; ++k) {
-                box[k] = std::min(box[k], positions[3 * v + k]);
-                box[3 + k] = std::max(box[3 + k], positions[3 * v + k]);
-            }
-    const double size = std::sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
-                                  (box[5] - box[2]) * (box[5] - box[2]));
+        for (uint32_t v : f) grow(box, &positions[3 * v]);
+    const double size = diagonal(box);
 
     // Edges: (smaller vertex, larger vertex, face, corner the edge starts at), sorted.
     std::vector<std::tuple<uint32_t, uint32_t, uint32_t, uint8_t>> edges;
@@ -109,20 +114,17 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
                 const uint32_t g = across[f][c];
                 if (g == UINT32_MAX) {
                     open = true;
-                    for (uint32_t v : {faces[f][c], faces[f][(c + 1) % 3]})
-                        for (int k = 0; k < 3; ++k) {
-                            rim[k] = std::min(rim[k], positions[3 * v + k]);
-                            rim[3 + k] = std::max(rim[3 + k], positions[3 * v + k]);
-                        }
+                    grow(rim, &positions[3 * faces[f][c]]);
+                    grow(rim, &positions[3 * faces[f][(c + 1) % 3]]);
                     continue;
                 }
-                // f (as oriented) runs a -> b along this edge; g must run b -> a.
+                // f as stored runs a -> b along this edge. Oriented alike, g runs b -> a: when
+                // g as stored runs a -> b too, exactly one of the two is turned over.
                 const uint32_t a = faces[f][c], b = faces[f][(c + 1) % 3];
                 int gc = 0;
                 while (!(faces[g][gc] == a || faces[g][gc] == b) || !(faces[g][(gc + 1) % 3] == a || faces[g][(gc + 1) % 3] == b)) ++gc;
-                const bool gRunsAB = faces[g][gc] == a;  // as stored
-                const bool fRunsAB = true;               // faces[f] as stored runs a -> b
-                const int want = (gRunsAB == fRunsAB) ? 1 - flip[f] : flip[f];
+                const bool gRunsAB = faces[g][gc] == a;
+                const int want = gRunsAB ? 1 - flip[f] : flip[f];
                 if (flip[g] < 0) {
                     flip[g] = int8_t(want);
                     queue.push_back(g);
@@ -132,9 +134,7 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
             }
         }
         if (!open) return fail(why, "a piece of it is closed");
-        const double opening = std::sqrt((rim[3] - rim[0]) * (rim[3] - rim[0]) + (rim[4] - rim[1]) * (rim[4] - rim[1]) +
-                                         (rim[5] - rim[2]) * (rim[5] - rim[2]));
-        if (opening < smallestOpening) return fail(why, "a piece of it is nearly closed (its openings are small)");
+        if (diagonal(rim) < smallestOpening) return fail(why, "a piece of it is nearly closed (its openings are small)");
         ++pieces;
     }
     for (uint32_t f = 0; f < m; ++f)
@@ -235,23 +235,19 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
             outTriangles.insert(outTriangles.end(), {outer[b], outer[a], middle[a], outer[b], middle[a], middle[b],
                                                      middle[b], middle[a], inner[a], middle[b], inner[a], inner[b]});
         }
-    // Every sheet face keeps its side (a face turned over is a fold the sweep below may not
-    // see, since it skips faces that share a vertex), and no two faces meet.
-    for (uint32_t f = 0; f < 2 * m; ++f) {
-        const uint32_t* t = &outTriangles[3 * f];
-        const Vec3 a = vertexAt(outPositions, t[0]), b = vertexAt(outPositions, t[1]), c = vertexAt(outPositions, t[2]);
-        const Vec3 n0 = f < m ? normal[f] : -normal[f - m];
-        if (!(dot(cross(b - a, c - a), n0) > 0)) {
-            outPositions.clear();
-            outTriangles.clear();
-            return fail(why, "a sheet folds over (detail finer than twice the offset)");
-        }
-    }
     auto refuse = [&](const char* reason) {
         outPositions.clear();
         outTriangles.clear();
         return fail(why, reason);
     };
+    // Every sheet face keeps its side (a face turned over is a fold the check below may not
+    // see, since it skips faces that share a vertex), and no two faces meet.
+    for (uint32_t f = 0; f < 2 * m; ++f) {
+        const uint32_t* t = &outTriangles[3 * f];
+        const Vec3 a = vertexAt(outPositions, t[0]), b = vertexAt(outPositions, t[1]), c = vertexAt(outPositions, t[2]);
+        const Vec3 n0 = f < m ? normal[f] : -normal[f - m];
+        if (!(dot(cross(b - a, c - a), n0) > 0)) return refuse("a sheet folds over (detail finer than twice the offset)");
+    }
     if (selfIntersects(outPositions, outTriangles)) return refuse("its two sheets would cross (detail finer than twice the offset)");
     // Each face keeps the offset from the sheet faces made from its own vertices; a face of
     // another part of the surface may come nearer. Half the offset from both sheets everywhere
@@ -266,36 +262,27 @@ bool thickenSurface(const std::vector<double>& positions, const std::vector<uint
             return refuse("its sheets come nearer it than half the offset (detail finer than twice the offset)");
     }
     // Pieces apart (their shells do not cross, checked above) must not lie inside one another:
-    // nested shells do not bound a solid. One vertex of each piece's shell against the others'
-    // (generalized winding number), within a fixed budget of work.
+    // nested shells do not bound a solid. One vertex of each piece's shell against the shells
+    // of the others (generalized winding number), within a fixed budget of work.
     if (pieces > 1) {
         if (double(pieces) * double(outTriangles.size() / 3) > 2e7) return refuse("too many separate pieces");
-        std::vector<uint32_t> probe(pieces, UINT32_MAX);
+        // The piece of each output face: sheets in face order, then four per boundary edge.
+        std::vector<uint32_t> pieceOfOutput(outTriangles.size() / 3);
+        for (uint32_t f = 0; f < m; ++f) pieceOfOutput[f] = pieceOfOutput[m + f] = pieceOf[f];
+        size_t strip = 2 * m;
+        for (uint32_t f = 0; f < m; ++f)
+            for (int c = 0; c < 3; ++c)
+                if (across[f][c] == UINT32_MAX)
+                    for (int k = 0; k < 4; ++k) pieceOfOutput[strip++] = pieceOf[f];
+        std::vector<uint32_t> probe(pieces, UINT32_MAX), others;
         for (uint32_t f = 0; f < m; ++f)
             if (probe[pieceOf[f]] == UINT32_MAX) probe[pieceOf[f]] = outer[faces[f][0]];
         for (uint32_t piece = 0; piece < pieces; ++piece) {
-            const Vec3 q = vertexAt(outPositions, probe[piece]);
-            double total = 0;
-            auto add = [&](const uint32_t* t) {
-                const Vec3 a = vertexAt(outPositions, t[0]) - q, b = vertexAt(outPositions, t[1]) - q, c = vertexAt(outPositions, t[2]) - q;
-                const double la = length(a), lb = length(b), lc = length(c);
-                total += 2 * std::atan2(dot(a, cross(b, c)), la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb);
-            };
-            // Sheets of the other pieces, and their strips (each strip follows its face's order).
-            for (uint32_t f = 0; f < m; ++f)
-                if (pieceOf[f] != piece) {
-                    add(&outTriangles[3 * f]);
-                    add(&outTriangles[3 * (m + f)]);
-                }
-            size_t strip = 2 * m;
-            for (uint32_t f = 0; f < m; ++f)
-                for (int c = 0; c < 3; ++c) {
-                    if (across[f][c] != UINT32_MAX) continue;
-                    if (pieceOf[f] != piece)
-                        for (int k = 0; k < 4; ++k) add(&outTriangles[3 * (strip + k)]);
-                    strip += 4;
-                }
-            if (std::fabs(total) > 2 * M_PI) return refuse("a piece of it lies inside another's shell");
+            others.clear();
+            for (size_t t = 0; t < pieceOfOutput.size(); ++t)
+                if (pieceOfOutput[t] != piece) others.insert(others.end(), &outTriangles[3 * t], &outTriangles[3 * t] + 3);
+            if (windingNumber(outPositions, others, &outPositions[3 * probe[piece]]) > 0.5)
+                return refuse("a piece of it lies inside another's shell");
         }
     }
     return true;
