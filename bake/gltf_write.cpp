@@ -1255,6 +1255,10 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 extras["coarser_step"] = intValue(size_t(n.coarserStep));
                 extras["aggregate_level"] = tinygltf::Value(std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0));
                 extras["delta"] = tinygltf::Value(n.delta);
+            } else if (n.bundleStep >= 1) {
+                extras["bundle_step"] = intValue(size_t(n.bundleStep));
+                extras["aggregate_level"] = tinygltf::Value(std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0));
+                extras["delta"] = tinygltf::Value(n.delta);
             } else {
                 extras["level"] = tinygltf::Value(n.firstLevel);
                 extras["last_level"] = tinygltf::Value(n.lastLevel);

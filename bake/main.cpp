@@ -115,6 +115,7 @@ struct BakeOptions {
     double touchTolerance = -1;
     int threads = 0;
     double proxyError = 0.25;
+    int bundles = 16;
     bool tiles = false;
     bool collision = false;
     bool constantBaseline = false;
@@ -146,6 +147,7 @@ std::string settingsText(const BakeOptions& o) {
                   o.includeAnimated ? 1 : 0);
     text += ";solidify=" + o.solidify + ";support=" + o.support + buffer;
     if (!o.tileSize.empty()) text += ";tile=" + o.tileSize;  // only when tiled: untiled hashes stay as they were
+    text += ";bundles=" + std::to_string(o.bundles);
     return text;
 }
 
@@ -233,6 +235,10 @@ CLI::App* addBakeCommand(CLI::App& app, BakeOptions& o) {
                     "Room each level's proxies get above their exact aggregate's certified error, as a "
                     "fraction of the level's delta (default 0.25; 0 keeps the exact aggregates)")
         ->check(CLI::Range(0.0, 10.0));
+    cmd->add_option("--bundles", o.bundles,
+                    "Most bundles below each group: its children's versions merged into one mesh, so that a distant "
+                    "group is one draw call (default 16; 0: none)")
+        ->check(CLI::Range(0, 64));
     cmd->add_flag("--tiles", o.tiles,
                   "Also write OUTDIR/tiles/: a 3D Tiles 1.1 tileset (tileset.json, one GLB per hierarchy node) "
                   "for CesiumJS or 3DTilesRendererJS");
@@ -511,6 +517,7 @@ int runBake(BakeOptions o) {
     // tile cache, each of their work items is kept there too.
     ProxySettings proxySettings;
     proxySettings.simplifyFraction = o.proxyError;
+    proxySettings.bundleCount = o.bundles;
     proxySettings.threadCount = o.threads;
     proxySettings.progress = settings.progress;
     proxySettings.cache = tiling.cache;
@@ -755,6 +762,9 @@ void printInspectLine(const runtime::RuntimeFile& file, uint32_t index, size_t d
         const std::string level = n.level == runtime::kObjectLodLevel ? std::string("object LOD")
                                   : n.level == runtime::kCoarserLevel
                                       ? "coarser version  delta " + cli::formatNumber(n.delta)
+                                  : runtime::isBundleLevel(n.level)
+                                      ? "bundle of level " + std::to_string(n.level & 0xFFFFu) + "  delta " +
+                                            cli::formatNumber(n.delta)
                                       : "level " + std::to_string(n.level) + "  delta " + cli::formatNumber(n.delta);
         std::printf("%snode %u  %s  error %s  triangles %u  box [%s %s %s]..[%s %s %s]  sphere r %s  "
                     "%u objects:",
@@ -799,8 +809,8 @@ int runInspect(const InspectOptions& o) {
         printError(o.file + ": " + runtime::toString(status) + (message.empty() ? "" : ": " + message));
         return kFileError;
     }
-    uint32_t aggregates = 0, leaves = 0, objectLods = 0;
-    uint64_t proxyTriangles = 0, leafTriangles = 0, objectLodTriangles = 0;
+    uint32_t aggregates = 0, leaves = 0, objectLods = 0, bundles = 0;
+    uint64_t proxyTriangles = 0, leafTriangles = 0, objectLodTriangles = 0, bundleTriangles = 0;
     for (const runtime::NodeRecord& n : file.nodes()) {
         if (n.level == runtime::kLeafLevel) {
             ++leaves;
@@ -808,6 +818,9 @@ int runInspect(const InspectOptions& o) {
         } else if (n.level == runtime::kObjectLodLevel) {
             ++objectLods;
             objectLodTriangles += n.indexCount / 3;
+        } else if (runtime::isBundleLevel(n.level)) {
+            ++bundles;
+            bundleTriangles += n.indexCount / 3;
         } else {
             ++aggregates;
             proxyTriangles += n.indexCount / 3;
@@ -817,9 +830,10 @@ int runInspect(const InspectOptions& o) {
                 unsigned(file.versionMajor()), unsigned(file.versionMinor()), int(file.toolVersion().size()),
                 file.toolVersion().data(), static_cast<unsigned long long>(file.settingsHash()), file.byteSize());
     std::printf("%u nodes: %u aggregates (%llu proxy triangles), %u per-object LODs (%llu triangles), "
-                "%u original objects (%llu triangles); %zu roots, depth %u\n",
+                "%u bundles (%llu triangles), %u original objects (%llu triangles); %zu roots, depth %u\n",
                 file.nodeCount(), aggregates, static_cast<unsigned long long>(proxyTriangles), objectLods,
-                static_cast<unsigned long long>(objectLodTriangles), leaves,
+                static_cast<unsigned long long>(objectLodTriangles), bundles,
+                static_cast<unsigned long long>(bundleTriangles), leaves,
                 static_cast<unsigned long long>(leafTriangles), file.roots().size, file.depth());
     for (uint32_t r : file.roots()) printInspectTree(file, r, o);
     // The set the file belongs to, when a bake's manifest lies beside it and names it.

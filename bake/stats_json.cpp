@@ -51,17 +51,18 @@ std::pair<double, double> maxAndMedian(std::vector<double> values) {
 }
 
 /// The proxies of the nodes a cut of `nodes` would draw at one level (level -1: the
-/// per-object LOD nodes, -2: the coarser versions of aggregates): their budgets, certified
-/// errors and triangles.
+/// per-object LOD nodes, -2: the coarser versions of aggregates, -3: the bundles): their
+/// budgets, certified errors and triangles.
 Json proxyFiguresJson(const HierarchyNodes& nodes, int level) {
     std::vector<double> budgets, errors;
     size_t triangles = 0, count = 0;
     for (const HierarchyNode& n : nodes.nodes) {
         if (n.leaf) continue;
-        const bool wanted = level >= 0   ? n.objectLod == 0 && n.coarserStep == 0 && n.firstLevel <= level &&
-                                               level <= n.lastLevel
+        const bool wanted = level >= 0   ? n.objectLod == 0 && n.coarserStep == 0 && n.bundleStep == 0 &&
+                                               n.firstLevel <= level && level <= n.lastLevel
                             : level == -1 ? n.objectLod >= 1
-                                          : n.coarserStep >= 1;
+                            : level == -2 ? n.coarserStep >= 1
+                                          : n.bundleStep >= 1;
         if (!wanted) continue;
         ++count;
         budgets.push_back(n.budget);
@@ -115,6 +116,7 @@ std::string statsJsonText(const Hierarchy3D& h, const std::vector<InputObject>& 
     if (nodes) {
         w["object_lods"] = proxyFiguresJson(*nodes, -1);       // the per-object LOD nodes below the levels
         w["coarser_versions"] = proxyFiguresJson(*nodes, -2);  // between each aggregate and its parent
+        w["bundles"] = proxyFiguresJson(*nodes, -3);           // between a group and its children
     }
 
     // Solidified models (docs/design.md §2.0): distances sampled, not certified.

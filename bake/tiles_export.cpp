@@ -158,6 +158,11 @@ private:
             extras["coarserStep"] = node.coarserStep;
             extras["delta"] = jsonNumber(node.delta);
             extras["objects"] = node.sources.size();
+        } else if (node.bundleStep >= 1) {
+            // The aggregate's children's versions merged into one mesh: no level of its own.
+            extras["bundleStep"] = node.bundleStep;
+            extras["delta"] = jsonNumber(node.delta);
+            extras["objects"] = node.sources.size();
         } else {
             extras["level"] = node.firstLevel;
             extras["lastLevel"] = node.lastLevel;
@@ -202,11 +207,13 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
         const HierarchyNode& node = nodes.nodes[n];
         TileMesh tile;
         const bool objectLod = node.objectLod >= 1;
-        // A coarser version takes the level (and tint) of the aggregate it simplifies.
+        // A coarser version takes the level (and tint) of the aggregate it simplifies, a bundle that
+        // of the aggregate above it.
         const int level = std::max(nodes.nodes[aggregateBelow(nodes, n)].firstLevel, 0);
         tile.name = node.leaf                ? "object_" + objects[n].name
                     : objectLod             ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
                     : node.coarserStep >= 1 ? "node" + std::to_string(n) + "_coarser" + std::to_string(node.coarserStep)
+                    : node.bundleStep >= 1  ? "node" + std::to_string(n) + "_bundle" + std::to_string(node.bundleStep)
                                             : "node" + std::to_string(n) + "_level" + std::to_string(node.firstLevel);
         {
             NodeMesh mesh;  // wherever it is (in the node, its object, the spill file)

@@ -17,12 +17,13 @@ static void print_cut(int frame, float distance, const aglod_file* file, const a
                       const aglod_cut_changes* changes) {
     /* A renderer would draw the proxy mesh of each proxy node and its own meshes of the
      * original objects listed in cut->originals. Here we only count them per level
-     * (per-object LODs, simplified single objects, and coarser versions of aggregates have no
-     * aggregate level of their own). */
+     * (per-object LODs, simplified single objects, coarser versions of aggregates and bundles
+     * have no aggregate level of their own). */
     int coarsest = -1;
     for (uint32_t i = 0; i < cut->proxy_count; ++i) {
         const uint32_t level = aglod_node_level(file, cut->proxies[i]);
-        if (level != AGLOD_OBJECT_LOD_LEVEL && level != AGLOD_COARSER_LEVEL && (int)level > coarsest)
+        if (level != AGLOD_OBJECT_LOD_LEVEL && level != AGLOD_COARSER_LEVEL && !(level & AGLOD_BUNDLE_LEVEL_FLAG) &&
+            (int)level > coarsest)
             coarsest = (int)level;
     }
     printf("frame %2d  distance %9.1f  cut %5u nodes: %5u proxies (coarsest level %2d), %5u originals;"
@@ -138,7 +139,7 @@ int main(int argc, char** argv) {
         for (uint32_t n = 0; n < aglod_node_count(file); ++n) {
             const uint32_t level = aglod_node_level(file, n);
             if (level != AGLOD_LEAF_LEVEL && level != AGLOD_OBJECT_LOD_LEVEL && level != AGLOD_COARSER_LEVEL &&
-                level > coarsest)
+                !(level & AGLOD_BUNDLE_LEVEL_FLAG) && level > coarsest)
                 coarsest = level;
         }
         if (aglod_collision_use_level(collision, coarsest) == AGLOD_OK) {

@@ -10,6 +10,7 @@
 #include "bounding_polytope.h"
 #include "conservative_simplify.h"
 #include "convex_hull.h"
+#include "draw_bundles.h"
 #include "hierarchy_serialize.h"
 #include "mesh_optimize.h"
 #include "mesh_preparation.h"
@@ -1481,32 +1482,6 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         }
     }
 
-    // Every mesh made to a spill file now, if asked: the tree is put together and its bounds
-    // computed without them in memory (ProxySettings::meshSpillPath).
-    if (!settings.meshSpillPath.empty()) {
-        detail::NodeMeshSpiller spiller;
-        bool spilled = spiller.open(settings.meshSpillPath, reloadError);
-        for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
-            HierarchyNode& n = nodes[o];
-            if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
-            n.meshPlace = detail::objectMeshPlace(objects[o]);
-            dropMesh(n);
-        }
-        for (size_t i = objectCount; spilled && i < nodes.size(); ++i) {
-            if (dropped[i]) {
-                dropMesh(nodes[i]);
-                continue;
-            }
-            spilled = spiller.spill(nodes[i], static_cast<uint32_t>(i), reloadError);
-            for (HierarchyNode& c : coarser[i]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(i), reloadError);
-        }
-        for (size_t o = 0; spilled && o < objectCount; ++o)
-            for (HierarchyNode& c : chains[o]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(o), reloadError);
-        if (!spilled || !spiller.finish(reloadError)) return finish(false);
-        out.meshFile = spiller.file();
-        if (settings.releaseFreedMemory) settings.releaseFreedMemory();
-    }
-
     // The tree again: leaves, per-object chains (object by object, finest first), then each
     // aggregate kept followed by its coarser versions (finest first).
     {
@@ -1568,6 +1543,27 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         nodes = std::move(renumbered);
     }
 
+    // Bundles: the drawn versions of each group's children merged into one draw call.
+    detail::addDrawBundles(nodes, out.roots, out.nodeOfAggregate, objects, settings);
+
+    // Every mesh made to a spill file now, if asked: the bounds are computed without them in
+    // memory (ProxySettings::meshSpillPath).
+    if (!settings.meshSpillPath.empty()) {
+        detail::NodeMeshSpiller spiller;
+        bool spilled = spiller.open(settings.meshSpillPath, reloadError);
+        for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
+            HierarchyNode& n = nodes[o];
+            if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
+            n.meshPlace = detail::objectMeshPlace(objects[o]);
+            dropMesh(n);
+        }
+        for (size_t i = objectCount; spilled && i < nodes.size(); ++i)
+            spilled = spiller.spill(nodes[i], static_cast<uint32_t>(i), reloadError);
+        if (!spilled || !spiller.finish(reloadError)) return finish(false);
+        out.meshFile = spiller.file();
+        if (settings.releaseFreedMemory) settings.releaseFreedMemory();
+    }
+
     // Errors and bounds, children first (children have smaller indices than their parent).
     // The exact aggregates of a lean hierarchy are read again a run of nodes at a time, a run
     // ending at kBoundsRunNodes nodes or at kBoundsRunTriangles triangles read (the coarse
@@ -1581,7 +1577,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     NodeMesh spilledMesh;              // a mesh in the spill file, read back
     for (size_t i = 0; i < nodes.size(); ++i) {
         HierarchyNode& n = nodes[i];
-        const bool exactAggregate = !n.leaf && n.objectLod == 0 && n.coarserStep == 0;
+        const bool exactAggregate = !n.leaf && n.objectLod == 0 && n.coarserStep == 0 && n.bundleStep == 0;
         if (i == runStart + exactAt.size()) {
             runStart = i;
             exactRun.clear();
@@ -1593,7 +1589,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                  ++j) {
                 exactAt.push_back(kNoNode);
                 const HierarchyNode& m = nodes[j];
-                if (m.leaf || m.objectLod > 0 || m.coarserStep > 0) continue;
+                if (m.leaf || m.objectLod > 0 || m.coarserStep > 0 || m.bundleStep > 0) continue;
                 const Aggregate& a = aggregateOf(m);
                 if (!meshLeftInCache(a)) continue;
                 exactAt.back() = static_cast<uint32_t>(lean.size());
@@ -1680,6 +1676,7 @@ std::vector<HierarchyNode> enclosingVersions(const InputObject& object, const So
 }
 
 uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node) {
+    while (nodes.nodes[node].bundleStep >= 1) node = nodes.nodes[node].parent;
     while (nodes.nodes[node].coarserStep >= 1) node = nodes.nodes[node].children.front();
     return node;
 }

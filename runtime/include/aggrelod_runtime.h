@@ -50,6 +50,9 @@ typedef struct aglod_collision aglod_collision;
 #define AGLOD_OBJECT_LOD_LEVEL 0xFFFEu
 /** Level of a coarser version of an aggregate (one child: that aggregate or a finer version). */
 #define AGLOD_COARSER_LEVEL 0xFFFDu
+/** Flag of a bundle's level, AGLOD_BUNDLE_LEVEL_FLAG | k (k: the level of the aggregate above
+ * it): that aggregate's children's drawn versions merged into one mesh (one draw call). */
+#define AGLOD_BUNDLE_LEVEL_FLAG 0x10000u
 #define AGLOD_NO_INDEX 0xFFFFFFFFu
 
 /* Short name of a status, e.g. "checksum mismatch". Never NULL. */
@@ -69,7 +72,7 @@ uint32_t aglod_node_count(const aglod_file* file);
 uint32_t aglod_object_count(const aglod_file* file);
 /* Level of a node: 0, 1, ... for aggregates, AGLOD_LEAF_LEVEL for originals,
  * AGLOD_OBJECT_LOD_LEVEL for per-object LODs, AGLOD_COARSER_LEVEL for coarser versions of an
- * aggregate; AGLOD_NO_INDEX when out of range. */
+ * aggregate, AGLOD_BUNDLE_LEVEL_FLAG | k for bundles; AGLOD_NO_INDEX when out of range. */
 uint32_t aglod_node_level(const aglod_file* file, uint32_t node);
 /* Geometric error of a node, world units (-1 when out of range). */
 float aglod_node_error(const aglod_file* file, uint32_t node);

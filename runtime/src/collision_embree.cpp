@@ -43,7 +43,7 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
     auto rank = [&](uint32_t node) -> int64_t {
         if (file.isLeaf(node)) return -2;
         if (file.isObjectLod(node)) return wanted == -1 ? -1 : std::numeric_limits<int64_t>::max();
-        if (file.isCoarser(node)) return std::numeric_limits<int64_t>::max();  // passed through
+        if (file.isCoarser(node) || file.isBundle(node)) return std::numeric_limits<int64_t>::max();  // passed through
         return rankOf(file.node(node).level);
     };
     std::vector<uint32_t> stack(file.roots().begin(), file.roots().end());
@@ -62,7 +62,8 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
 std::vector<uint32_t> levelsOf(const RuntimeFile& file) {
     std::vector<uint32_t> levels;
     for (uint32_t i = 0; i < file.nodeCount(); ++i)
-        if (!file.isLeaf(i) && !file.isObjectLod(i) && !file.isCoarser(i)) levels.push_back(file.node(i).level);
+        if (!file.isLeaf(i) && !file.isObjectLod(i) && !file.isCoarser(i) && !file.isBundle(i))
+            levels.push_back(file.node(i).level);
     std::sort(levels.begin(), levels.end());
     levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
     return levels;

@@ -281,7 +281,8 @@ struct FileValidator {
             if (r.level == kCoarserLevel && r.childCount != 1)
                 return fail(FileStatus::BadValue, where() + ": coarser version with " + std::to_string(r.childCount) +
                                                       " children");
-            if (!leaf && r.level != kObjectLodLevel && r.level != kCoarserLevel && r.level >= kMaxAggregateLevel)
+            if (!leaf && r.level != kObjectLodLevel && r.level != kCoarserLevel && !isBundleLevel(r.level) &&
+                r.level >= kMaxAggregateLevel)
                 return fail(FileStatus::BadValue, where() + ": level " + std::to_string(r.level));
         }
         if (FileStatus s = checkDisjoint("vertices", &NodeRecord::firstVertex, &NodeRecord::vertexCount);
@@ -368,13 +369,15 @@ struct FileValidator {
         return true;
     }
 
-    /// Order of levels from fine to coarse: leaves, per-object LODs, aggregate levels 0, 1, ...
-    /// A child's level must be below its parent's (per-object LODs may also chain; a coarser
-    /// version ranks as the aggregate it simplifies).
+    /// Order of levels from fine to coarse: leaves, per-object LODs, aggregate levels 0, 1, ...,
+    /// a bundle of level k between k - 1 and k. A child's level must be below its parent's
+    /// (per-object LODs and bundles of one level may also chain; a coarser version ranks as the
+    /// aggregate it simplifies).
     static int64_t levelRank(uint32_t level) {
-        if (level == kLeafLevel) return -2;
-        if (level == kObjectLodLevel) return -1;
-        return level;
+        if (level == kLeafLevel) return -4;
+        if (level == kObjectLodLevel) return -2;
+        if (isBundleLevel(level)) return 2 * int64_t(level & 0xFFFFu) - 1;
+        return 2 * int64_t(level);
     }
 
     FileStatus checkTree() {
@@ -422,7 +425,7 @@ struct FileValidator {
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + " is listed twice as a child");
                 // Per-object LODs form chains: one may stand under another.
                 if (rank[c] >= rank[i] && r.level != kCoarserLevel &&
-                    !(r.level == kObjectLodLevel && nodes[c].level == kObjectLodLevel))
+                    !((r.level == kObjectLodLevel || isBundleLevel(r.level)) && nodes[c].level == r.level))
                     return fail(FileStatus::BadTree, "node " + std::to_string(c) + ": level " +
                                                          std::to_string(nodes[c].level) + " is not below its parent's (" +
                                                          std::to_string(r.level) + ")");

@@ -23,6 +23,7 @@
 // Usage: bench_lod_budget [--scenes random,forest,village,truck_town] [--seed 1]
 //          [--objects 400] [--triangles 200000] [--levels 8] [--threads 2] [--elevation 25]
 //          [--data DIR (holds 3d/truck_town/town_model.gltf)] [--breakdown (the cut by node kind)]
+//          [--bundles N (ProxySettings::bundleCount; 0: none, as before bundles; default: the bake's)]
 //        bench_lod_budget --cut-for FILE.aglod --cameras FRAMES.csv   (the cut per given camera,
 //          see lod_budget_cut_for.h)
 #include "acceptance_scenes.h"
@@ -66,6 +67,7 @@ struct Options {
     std::vector<std::string> scenes = {"random", "forest", "village", "truck_town"};
     uint32_t seed = 1;
     int objects = 400, triangles = 200000, levels = 8, threads = 2;
+    int bundles = -1;  ///< -1: the bake's default
     double elevationDegrees = 25;
     bool breakdown = false;
     std::string data = AGGRELOD_SHARED_DATA;
@@ -188,10 +190,11 @@ double median(std::vector<double> v) {
 
 /// Proxy error and budget per level, relative to the level's delta: what the cut can select.
 void printNodeErrors(const testing::Baked& b) {
-    // -2: per-object LOD nodes, -1: coarser versions of aggregates
+    // -3: bundles, -2: per-object LOD nodes, -1: coarser versions of aggregates
     std::map<int, std::vector<const HierarchyNode*>> byLevel;
     for (const HierarchyNode& n : b.nodes.nodes)
-        if (!n.leaf) byLevel[n.objectLod >= 1 ? -2 : n.coarserStep >= 1 ? -1 : n.firstLevel].push_back(&n);
+        if (!n.leaf)
+            byLevel[n.bundleStep >= 1 ? -3 : n.objectLod >= 1 ? -2 : n.coarserStep >= 1 ? -1 : n.firstLevel].push_back(&n);
     std::printf("| level | delta | nodes | budget / delta (median) | certified error / delta (median, max) | over budget | proxy triangles | exact triangles |\n");
     std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const auto& [level, nodes] : byLevel) {
@@ -206,7 +209,8 @@ void printNodeErrors(const testing::Baked& b) {
             exact += n->exactTriangleCount;
         }
         char name[32];
-        std::snprintf(name, sizeof name, level == -2 ? "object LOD" : level == -1 ? "coarser versions" : "%d", level);
+        std::snprintf(name, sizeof name,
+                      level == -3 ? "bundles" : level == -2 ? "object LOD" : level == -1 ? "coarser versions" : "%d", level);
         std::printf("| %s | %.4g | %zu | %.3f | %.3f, %.3f | %zu | %zu | %zu |\n", name, level == -2 ? 0.0 : nodes[0]->delta,
                     nodes.size(), median(budget), median(error), *std::max_element(error.begin(), error.end()), over,
                     triangles, exact);
@@ -240,7 +244,7 @@ bool runScene(const Options& o, const std::string& name) {
                 input.label.c_str(), objects.size(), totalTriangles, sphere.radius, "xyz"[input.upAxis], o.levels,
                 input.constantFunction ? ", constant function" : "");
 
-    const testing::Baked b = testing::bakeScene(input, o.levels, o.threads);
+    const testing::Baked b = testing::bakeScene(input, o.levels, o.threads, o.bundles);
     if (!b.ok) {
         std::printf("bake FAILED: %s\n", b.problem.c_str());
         return false;
@@ -500,6 +504,7 @@ int main(int argc, char** argv) {
         else if (arg == "--triangles") o.triangles = std::atoi(value);
         else if (arg == "--levels") o.levels = std::atoi(value);
         else if (arg == "--threads") o.threads = std::atoi(value);
+        else if (arg == "--bundles") o.bundles = std::atoi(value);
         else if (arg == "--elevation") o.elevationDegrees = std::atof(value);
         else if (arg == "--data") o.data = value;
         else if (arg == "--cut-for") cutFor = value;

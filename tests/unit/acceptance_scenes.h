@@ -111,8 +111,9 @@ struct Baked {
 };
 
 /// Bakes `input` with `levels` automatic levels (spheres15: the paper's deltas), proxies at
-/// the default settings, `threads` threads (results do not depend on it).
-inline Baked bakeScene(const SceneInput& input, int levels, int threads) {
+/// the default settings (bundles >= 0: that ProxySettings::bundleCount), `threads` threads
+/// (results do not depend on it).
+inline Baked bakeScene(const SceneInput& input, int levels, int threads, int bundles = -1) {
     Baked b;
     Settings3D settings;
     if (input.label == "spheres15") settings.deltas = {1, 1.5, 2, 3, 4};
@@ -128,6 +129,7 @@ inline Baked bakeScene(const SceneInput& input, int levels, int threads) {
     const auto middle = std::chrono::steady_clock::now();
     ProxySettings proxies;
     proxies.threadCount = threads;
+    if (bundles >= 0) proxies.bundleCount = bundles;
     std::string error;
     if (!buildHierarchyNodes(b.hierarchy, input.objects, proxies, b.nodes, error)) {
         b.problem = "buildHierarchyNodes failed: " + error;

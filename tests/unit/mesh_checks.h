@@ -85,8 +85,9 @@ inline size_t foldedEdgeCount(const std::vector<float>& positions, const std::ve
     return folded;
 }
 
-/// Edge-connected shells of an indexed mesh (triangles sharing an undirected index edge).
-inline int shellCount(const std::vector<uint32_t>& indices) {
+/// The index triples of each edge-connected shell of an indexed mesh (triangles sharing an
+/// undirected index edge), in order of their first triangle.
+inline std::vector<std::vector<uint32_t>> shellsOf(const std::vector<uint32_t>& indices) {
     const size_t triangles = indices.size() / 3;
     DisjointSets sets(triangles);
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> firstUse;
@@ -96,10 +97,18 @@ inline int shellCount(const std::vector<uint32_t>& indices) {
             const auto [it, fresh] = firstUse.emplace(std::make_pair(std::min(a, b), std::max(a, b)), uint32_t(t));
             if (!fresh) sets.unite(uint32_t(t), it->second);
         }
-    int shells = 0;
-    for (size_t t = 0; t < triangles; ++t) shells += sets.find(uint32_t(t)) == t ? 1 : 0;
-    return shells;
+    std::map<uint32_t, size_t> shellOfRoot;
+    std::vector<std::vector<uint32_t>> out;
+    for (size_t t = 0; t < triangles; ++t) {
+        const auto [it, fresh] = shellOfRoot.emplace(sets.find(uint32_t(t)), out.size());
+        if (fresh) out.emplace_back();
+        out[it->second].insert(out[it->second].end(), indices.begin() + 3 * t, indices.begin() + 3 * t + 3);
+    }
+    return out;
 }
+
+/// Edge-connected shells of an indexed mesh (triangles sharing an undirected index edge).
+inline int shellCount(const std::vector<uint32_t>& indices) { return int(shellsOf(indices).size()); }
 
 /// The indices with vertices of bit-identical positions merged (glTF art repeats vertices at
 /// seams): each index replaced by the first vertex at its position.

@@ -15,8 +15,10 @@
 #include "test_support.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 #include <set>
 
 using namespace aggrelod;
@@ -65,12 +67,12 @@ bool sphereInsideFloat(const HierarchyNode& inner, const HierarchyNode& outer) {
     return std::sqrt(d2) + float(inner.sphereRadius) <= float(outer.sphereRadius);
 }
 
-/// Triangles of the cut the runtime's screen-space rule selects (docs/design.md §3): from the
-/// roots down, a node is drawn when its geometric error seen from `eye` at the nearest point
-/// of its bounding sphere is at most `pixels` (1080 px viewport, 60 degree field of view).
-size_t cutTriangles(const HierarchyNodes& h, const double eye[3], double pixels) {
+/// Nodes and triangles of the cut the runtime's screen-space rule selects (docs/design.md §3):
+/// from the roots down, a node is drawn when its geometric error seen from `eye` at the nearest
+/// point of its bounding sphere is at most `pixels` (1080 px viewport, 60 degree field of view).
+std::pair<size_t, size_t> cutNodesAndTriangles(const HierarchyNodes& h, const double eye[3], double pixels) {
     const double k = 1080.0 / (2 * std::tan(3.14159265358979323846 / 6));
-    size_t triangles = 0;
+    size_t drawn = 0, triangles = 0;
     std::vector<uint32_t> stack(h.roots.begin(), h.roots.end());
     while (!stack.empty()) {
         const HierarchyNode& n = h.nodes[stack.back()];
@@ -78,10 +80,59 @@ size_t cutTriangles(const HierarchyNodes& h, const double eye[3], double pixels)
         double d2 = 0;
         for (int c = 0; c < 3; ++c) d2 += (eye[c] - n.sphereCenter[c]) * (eye[c] - n.sphereCenter[c]);
         const double d = std::max(std::sqrt(d2) - n.sphereRadius, 1e-9);
-        if (n.leaf || n.geometricError * k / d <= pixels) triangles += n.indices.size() / 3;
-        else stack.insert(stack.end(), n.children.begin(), n.children.end());
+        if (n.leaf || n.geometricError * k / d <= pixels) {
+            ++drawn;
+            triangles += n.indices.size() / 3;
+        } else {
+            stack.insert(stack.end(), n.children.begin(), n.children.end());
+        }
     }
-    return triangles;
+    return {drawn, triangles};
+}
+
+/// The forest sample's hierarchy (8 automatic levels) with the default proxies and with the
+/// proxies `change` makes different: the same hierarchy, so that the two trees differ only there.
+struct ForestPair {
+    std::vector<InputObject> objects = samples::makeForest(1);
+    HierarchyNodes with, without;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double diameter = 0;
+
+    /// Cut figures summed over 8 cameras on a circle at `distance` scene diameters (as
+    /// bench_lod_budget): {nodes, triangles} with and without.
+    std::array<size_t, 4> cuts(int distance) const {
+        std::array<size_t, 4> sum{};
+        for (int az = 0; az < 8; ++az) {
+            const double phi = 2 * 3.14159265358979323846 * az / 8, r = distance * diameter;
+            const double eye[3] = {0.5 * (lo[0] + hi[0]) + r * std::cos(phi), 0.5 * (lo[1] + hi[1]) + r * std::sin(phi),
+                                   0.5 * (lo[2] + hi[2]) + 0.4 * r};
+            const auto [a, b] = cutNodesAndTriangles(with, eye, 1.0);
+            const auto [c, d] = cutNodesAndTriangles(without, eye, 1.0);
+            sum[0] += a, sum[1] += b, sum[2] += c, sum[3] += d;
+        }
+        return sum;
+    }
+};
+
+bool bakeForestPair(ForestPair& f, void (*change)(ProxySettings&)) {
+    Settings3D s;
+    s.automaticLevelCount = 8;
+    s.threadCount = 2;
+    Hierarchy3D hierarchy;
+    if (!buildHierarchy3D(f.objects, s, hierarchy)) return false;
+    ProxySettings p;
+    p.threadCount = 2;
+    std::string error;
+    if (!buildHierarchyNodes(hierarchy, f.objects, p, f.with, error)) return false;
+    change(p);
+    if (!buildHierarchyNodes(hierarchy, f.objects, p, f.without, error)) return false;
+    for (const InputObject& o : f.objects)
+        for (size_t v = 0; v < o.positions.size(); v += 3)
+            for (int c = 0; c < 3; ++c)
+                f.lo[c] = std::min(f.lo[c], o.positions[v + c]), f.hi[c] = std::max(f.hi[c], o.positions[v + c]);
+    for (int c = 0; c < 3; ++c) f.diameter += (f.hi[c] - f.lo[c]) * (f.hi[c] - f.lo[c]);
+    f.diameter = std::sqrt(f.diameter);
+    return true;
 }
 
 }  // namespace
@@ -91,19 +142,9 @@ size_t cutTriangles(const HierarchyNodes& h, const double eye[3], double pixels)
 // and below the parent's; and they make the drawn cut lighter at middle and far distances
 // than the same hierarchy without them.
 TEST(HierarchyNodes, CoarserVersionsLightenTheCut) {
-    const std::vector<InputObject> objects = samples::makeForest(1);
-    Settings3D s;
-    s.automaticLevelCount = 8;
-    s.threadCount = 2;
-    Hierarchy3D hierarchy;
-    ASSERT_TRUE(buildHierarchy3D(objects, s, hierarchy));
-    HierarchyNodes with, without;
-    ProxySettings p;
-    p.threadCount = 2;
-    std::string error;
-    ASSERT_TRUE(buildHierarchyNodes(hierarchy, objects, p, with, error)) << error;
-    p.coarserCount = 0;
-    ASSERT_TRUE(buildHierarchyNodes(hierarchy, objects, p, without, error)) << error;
+    ForestPair f;
+    ASSERT_TRUE(bakeForestPair(f, [](ProxySettings& p) { p.coarserCount = 0; }));
+    const HierarchyNodes& with = f.with;
 
     size_t coarser = 0;
     for (size_t i = 0; i < with.nodes.size(); ++i) {
@@ -119,32 +160,85 @@ TEST(HierarchyNodes, CoarserVersionsLightenTheCut) {
         EXPECT_EQ(n.firstLevel, -1);
         EXPECT_LE(10 * n.indices.size(), 9 * below.indices.size()) << "node " << i << " is not 10 % lighter";
         EXPECT_LE(n.error.bound(), n.budget) << "node " << i;
-        if (n.parent != kNoNode && with.nodes[n.parent].coarserStep == 0)
+        // Below its parent's error (a bundle holding it may have the same error: its part's).
+        if (n.parent != kNoNode && with.nodes[n.parent].coarserStep == 0 && with.nodes[n.parent].bundleStep == 0)
             EXPECT_LT(n.error.bound(), with.nodes[n.parent].error.bound()) << "node " << i;
     }
-    for (const HierarchyNode& n : without.nodes) EXPECT_EQ(n.coarserStep, 0);
+    for (const HierarchyNode& n : f.without.nodes) EXPECT_EQ(n.coarserStep, 0);
     std::printf("forest: %zu coarser versions over %zu nodes\n", coarser, with.nodes.size());
     EXPECT_GT(coarser, 20u);
 
-    // Cameras at 4, 8 and 16 scene diameters on a circle (as bench_lod_budget).
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (const InputObject& o : objects)
-        for (size_t v = 0; v < o.positions.size(); v += 3)
-            for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], o.positions[v + c]), hi[c] = std::max(hi[c], o.positions[v + c]);
-    const double diameter = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                      (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    for (int distance : {4, 8, 16}) {
-        size_t withTriangles = 0, withoutTriangles = 0;
-        for (int az = 0; az < 8; ++az) {
-            const double phi = 2 * 3.14159265358979323846 * az / 8, r = distance * diameter;
-            const double eye[3] = {0.5 * (lo[0] + hi[0]) + r * std::cos(phi), 0.5 * (lo[1] + hi[1]) + r * std::sin(phi),
-                                   0.5 * (lo[2] + hi[2]) + 0.4 * r};
-            withTriangles += cutTriangles(with, eye, 1.0);
-            withoutTriangles += cutTriangles(without, eye, 1.0);
-        }
+    for (int distance : {4, 8, 16}) {  // cameras at 4, 8 and 16 scene diameters
+        const auto [withNodes, withTriangles, withoutNodes, withoutTriangles] = f.cuts(distance);
         std::printf("  %2d diameters: cut %zu triangles with coarser versions, %zu without (8 cameras)\n", distance,
                     withTriangles, withoutTriangles);
         EXPECT_LT(withTriangles, withoutTriangles) << distance << " diameters";
+    }
+}
+
+// Bundles (docs/design.md §2.6): below an aggregate of several objects, a chain of merged
+// meshes of its children's versions, each with the aggregate's objects, an error within its
+// threshold and below the aggregate's, lighter than the bundle below it; a distant cut draws
+// at least a quarter fewer nodes with them (a third on the forest), at about the same triangles.
+TEST(HierarchyNodes, BundlesDrawADistantGroupInOneCall) {
+    ForestPair f;
+    ASSERT_TRUE(bakeForestPair(f, [](ProxySettings& p) { p.bundleCount = 0; }));
+    const HierarchyNodes& with = f.with;
+    const std::vector<InputObject>& objects = f.objects;
+
+    size_t bundles = 0;
+    for (size_t i = 0; i < with.nodes.size(); ++i) {
+        const HierarchyNode& n = with.nodes[i];
+        if (n.bundleStep == 0) continue;
+        ++bundles;
+        ASSERT_NE(n.parent, kNoNode);
+        const HierarchyNode& above = with.nodes[n.parent];
+        const HierarchyNode& group = with.nodes[aggregateBelow(with, uint32_t(i))];
+        EXPECT_EQ(group.bundleStep, 0);
+        EXPECT_EQ(group.coarserStep, 0);
+        EXPECT_GE(group.sources.size(), 2u);
+        EXPECT_TRUE(std::includes(group.sources.begin(), group.sources.end(), n.sources.begin(), n.sources.end()));
+        EXPECT_GE(n.sources.size(), 2u);
+        EXPECT_EQ(n.firstLevel, -1);
+        EXPECT_LE(n.error.bound(), n.budget) << "node " << i;
+        EXPECT_LT(n.budget, group.error.bound()) << "node " << i;
+        EXPECT_LE(n.geometricError, above.geometricError);
+        if (above.bundleStep >= 1) {  // the next coarser bundle
+            EXPECT_EQ(above.bundleStep, n.bundleStep + 1);
+            EXPECT_LE(20 * above.indices.size(), 19 * n.indices.size()) << "node " << n.parent << " is not 5 % lighter";
+            EXPECT_GT(above.budget, n.budget);
+        } else {
+            EXPECT_EQ(&above, &group);
+            // The group's other children (aggregates with wide fills) beside the chain, apart.
+            size_t beside = 0;
+            for (uint32_t c : above.children) beside += with.nodes[c].bundleStep == 0;
+            EXPECT_EQ(beside + 1, above.children.size());
+        }
+        if (n.bundleStep == 1) {
+            EXPECT_GE(n.children.size(), 2u);
+            std::vector<uint32_t> below;  // the bundle stands for exactly its children's objects
+            for (uint32_t c : n.children) below.insert(below.end(), with.nodes[c].sources.begin(), with.nodes[c].sources.end());
+            std::sort(below.begin(), below.end());
+            EXPECT_EQ(below, n.sources) << "node " << i;
+            size_t childTriangles = 0;  // each child within the bundle's threshold
+            for (uint32_t c : n.children) {
+                EXPECT_LE(float(with.nodes[c].geometricError), std::nextafter(float(n.budget), INFINITY)) << "node " << c;
+                childTriangles += with.nodes[c].leaf ? objects[c].indices.size() / 3 : with.nodes[c].indices.size() / 3;
+            }
+            EXPECT_LE(n.indices.size() / 3, childTriangles) << "node " << i;
+        }
+    }
+    for (const HierarchyNode& n : f.without.nodes) EXPECT_EQ(n.bundleStep, 0);
+    std::printf("forest: %zu bundles over %zu nodes (%zu without)\n", bundles, with.nodes.size(), f.without.nodes.size());
+    EXPECT_GT(bundles, 20u);
+
+    for (int distance : {8, 16}) {
+        const auto [withNodes, withTriangles, withoutNodes, withoutTriangles] = f.cuts(distance);
+        std::printf("  %2d diameters: cut of %zu nodes, %zu triangles with bundles; %zu nodes, %zu triangles without "
+                    "(8 cameras)\n",
+                    distance, withNodes, withTriangles, withoutNodes, withoutTriangles);
+        EXPECT_LE(4 * withNodes, 3 * withoutNodes) << distance << " diameters";
+        EXPECT_LE(withTriangles, withoutTriangles + withoutTriangles / 10) << distance << " diameters";
     }
 }
 
@@ -158,7 +252,7 @@ TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
     size_t aggregateNodes = 0, objectLodNodes = 0;
     for (const HierarchyNode& n : nodes) {
         if (n.leaf) continue;
-        if (n.coarserStep == 0) ++(n.objectLod > 0 ? objectLodNodes : aggregateNodes);
+        if (n.coarserStep == 0 && n.bundleStep == 0) ++(n.objectLod > 0 ? objectLodNodes : aggregateNodes);
         if (n.objectLod > 0) {  // per-object LOD: one object, no level, within its budget
             EXPECT_EQ(n.sources.size(), 1u);
             EXPECT_EQ(n.firstLevel, -1);

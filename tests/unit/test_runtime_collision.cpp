@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -234,6 +235,42 @@ TEST(RuntimeCollision, CutAtLevelRanksPerObjectLodsBetweenLeavesAndLevelZero) {
     ASSERT_TRUE(world.ok()) << world.error();
     world.useLevel(kObjectLodLevel);
     EXPECT_EQ(world.currentCut(), lods);
+}
+
+// Bundles are not a level: levelsOf leaves them out and a cut at a level passes through them.
+TEST(RuntimeCollision, CutAtLevelPassesThroughBundles) {
+    BuildArrays p = makeSyntheticHierarchy(200, 7);
+    std::vector<uint8_t> plainBytes, bundledBytes;
+    std::string error;
+    ASSERT_TRUE(writeRuntimeFile(p, plainBytes, error)) << error;
+    const auto rankOf = [](uint32_t level) { return level == kLeafLevel ? -4 : 2 * int64_t(level); };
+    std::vector<uint32_t> bundled;
+    for (uint32_t i = 0; i < p.nodes.size(); ++i) {  // as RuntimeFormat.BundleLevelsAreAcceptedBetweenTheirLevels
+        NodeRecord& n = p.nodes[i];
+        if (n.level == kLeafLevel || n.level >= kMaxAggregateLevel || n.level == 0) continue;
+        bool fits = true;
+        for (uint32_t c = n.firstChild; c < n.firstChild + n.childCount; ++c)
+            fits = fits && rankOf(p.nodes[p.childIndices[c]].level) < 2 * int64_t(n.level) - 1;
+        if (!fits) continue;
+        n.level |= kBundleLevelFlag;
+        bundled.push_back(i);
+    }
+    ASSERT_FALSE(bundled.empty());
+    ASSERT_TRUE(writeRuntimeFile(p, bundledBytes, error)) << error;
+    RuntimeFile plain, bundles;
+    ASSERT_EQ(RuntimeFile::openMemory(plainBytes.data(), plainBytes.size(), plain, error), FileStatus::Ok) << error;
+    ASSERT_EQ(RuntimeFile::openMemory(bundledBytes.data(), bundledBytes.size(), bundles, error), FileStatus::Ok) << error;
+    for (uint32_t k : levelsOf(bundles)) EXPECT_FALSE(isBundleLevel(k));
+    for (uint32_t k : levelsOf(plain)) {
+        std::vector<uint32_t> cut;
+        cutAtLevel(bundles, k, cut);
+        size_t covered = 0;
+        for (uint32_t n : cut) {
+            EXPECT_FALSE(bundles.isBundle(n)) << "level " << k << " node " << n;
+            covered += bundles.sources(n).size;
+        }
+        EXPECT_EQ(covered, bundles.objectCount()) << "level " << k;
+    }
 }
 
 TEST(RuntimeCollision, RaysThroughSharedEdgesAndCornersDoNotSlipThrough) {

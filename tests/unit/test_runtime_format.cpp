@@ -195,6 +195,8 @@ TEST(RuntimeFormat, WriterRefusesInconsistentHierarchies) {
         {"per-object LOD of several objects", [](BuildArrays& p) { p.nodes.back().level = kObjectLodLevel; }, "bad value"},
         {"level out of range", [](BuildArrays& p) { p.nodes.back().level = kMaxAggregateLevel; }, "bad value"},
         {"coarser version with two children", [](BuildArrays& p) { p.nodes.back().level = kCoarserLevel; }, "coarser version"},
+        {"bundle of a level out of range", [](BuildArrays& p) { p.nodes.back().level = kBundleLevelFlag | kMaxAggregateLevel; }, "bad value"},
+        {"bundle of level 0 above aggregates", [](BuildArrays& p) { p.nodes.back().level = kBundleLevelFlag; }, "bad tree"},
     };
     for (const Case& c : cases) {
         BuildArrays p = good;
@@ -423,6 +425,40 @@ TEST(RuntimeFormat, PerObjectLodNodesAreAcceptedAndRoundTrip) {
         EXPECT_FALSE(file.isObjectLod(file.node(i).parent) && file.isLeaf(file.node(i).parent));
     }
     EXPECT_EQ(lods, 2u * 50u);
+}
+
+// A bundle of level k (kBundleLevelFlag | k) ranks between levels k - 1 and k: accepted
+// between them, under another bundle of the same level, and read back as a bundle.
+TEST(RuntimeFormat, BundleLevelsAreAcceptedBetweenTheirLevels) {
+    BuildArrays p = makeSyntheticHierarchy(200, 7);
+    const auto rankOf = [](uint32_t level) { return level == kLeafLevel ? -4 : 2 * int64_t(level); };
+    uint32_t bundled = 0;
+    for (uint32_t i = 0; i < p.nodes.size(); ++i) {
+        NodeRecord& n = p.nodes[i];
+        if (n.level == kLeafLevel || n.level >= kMaxAggregateLevel || n.level == 0) continue;
+        bool fits = true;  // every child strictly below level - 1/2
+        for (uint32_t c = n.firstChild; c < n.firstChild + n.childCount; ++c)
+            fits = fits && rankOf(p.nodes[p.childIndices[c]].level) < 2 * int64_t(n.level) - 1;
+        if (!fits) continue;
+        n.level |= kBundleLevelFlag;
+        ++bundled;
+    }
+    ASSERT_GT(bundled, 0u);
+    const std::vector<uint8_t> bytes = writeOrDie(p);
+    RuntimeFile file;
+    std::string message;
+    ASSERT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), file, message), FileStatus::Ok) << message;
+    EXPECT_EQ(file.versionMinor(), kFormatMinor);
+    uint32_t read = 0;
+    for (uint32_t i = 0; i < file.nodeCount(); ++i) {
+        EXPECT_EQ(file.isBundle(i), isBundleLevel(p.nodes[i].level));
+        read += file.isBundle(i);
+    }
+    EXPECT_EQ(read, bundled);
+    EXPECT_TRUE(isBundleLevel(kBundleLevelFlag | 3));
+    EXPECT_FALSE(isBundleLevel(3));
+    EXPECT_FALSE(isBundleLevel(kLeafLevel));
+    EXPECT_FALSE(isBundleLevel(kBundleLevelFlag | kCoarserLevel));
 }
 
 TEST(RuntimeFormat, MisalignedBufferIsRefused) {

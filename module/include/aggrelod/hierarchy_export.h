@@ -60,7 +60,8 @@ bool exportHierarchyNodes(const HierarchyNodes& nodes, const std::vector<InputOb
 /// object's triangles, aggregates and per-object LODs their simplified proxy, as float world
 /// coordinates, with normals and the node's faceColors through buildRenderMesh). Levels:
 /// leaves kLeafLevel, per-object LOD nodes (objectLod >= 1) kObjectLodLevel, coarser versions
-/// kCoarserLevel, aggregates their firstLevel. `objects`: the baked input (names only).
+/// kCoarserLevel, bundles kBundleLevelFlag | the firstLevel of the aggregate above them,
+/// aggregates their firstLevel. `objects`: the baked input (names only).
 /// Returns false with a message when a count does not fit 32 bits or an index is out of range.
 /// The nodes' meshes are built on up to `threadCount` threads (0: all cores). Deterministic:
 /// the same output for any thread count.

@@ -44,6 +44,19 @@ struct ProxySettings {
     /// simplifications of its proxy at error targets sqrt(2) apart from its budget up to its
     /// parent's error (a root: up to its diagonal). 0 = none.
     int coarserCount = 16;
+    /// Most bundles below one aggregate of several objects: its children's drawn versions
+    /// merged into one mesh (the lightest version of each child within a threshold), at
+    /// thresholds between the children's errors and the aggregate's, so that a distant group
+    /// costs one draw call. Each kept bundle has at most 19/20 of the triangles of the finer
+    /// one. Children that are aggregates with an error above bundleMinErrorFraction of the
+    /// group's diagonal stay apart. 0 = none.
+    int bundleCount = 16;
+    /// Finest bundle threshold as a fraction of the aggregate's diagonal: a bundle is drawn only
+    /// where one pixel is at least this fraction of the group's size, far enough for one error
+    /// over the whole group to cost no more than one per child.
+    double bundleMinErrorFraction = 1.0 / 64;
+    /// Most triangles of one bundle (a larger merged mesh is not made).
+    size_t bundleMaxTriangles = 65536;
     /// Most vertices of the few-faced convex polytopes that enclose a one-shell proxy's
     /// convex hull (intersections of its supporting half-spaces), tried beside the enclosing
     /// simplifications for per-object LOD levels and coarser versions: they reach down to a
@@ -128,6 +141,12 @@ struct HierarchyNode {
     /// aggregate's and its parent's. sources and delta are the aggregate's, firstLevel and
     /// lastLevel are -1 (no level of its own).
     int coarserStep = 0;
+    /// 0 for every other node; j >= 1 for the j-th bundle below an aggregate of several
+    /// objects (j rises towards it): the drawn versions of the aggregate's children merged into
+    /// one mesh, error between theirs and the aggregate's (ProxySettings::bundleCount). sources
+    /// and delta are the aggregate's, firstLevel and lastLevel are -1. Its shells are its parts'
+    /// and may overlap one another.
+    int bundleStep = 0;
     int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
     int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
     uint32_t aggregateIndex = 0;       ///< index in levels[firstLevel].aggregates (aggregates only)
@@ -243,7 +262,8 @@ NodeMeshView viewNodeMesh(const HierarchyNodes& nodes, const std::vector<InputOb
                           NodeMesh& storage);
 
 /// The aggregate node that coarser version `node` simplifies (the end of its chain of single
-/// children); `node` itself when it is not a coarser version. `node` < nodes.nodes.size().
+/// children); for a bundle, the aggregate above its chain of bundles; `node` itself otherwise.
+/// `node` < nodes.nodes.size().
 uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node);
 
 /// Measures the error of a proxy (float positions, 3 * vertexCount; indices 3 * triangleCount,

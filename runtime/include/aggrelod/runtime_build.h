@@ -37,7 +37,8 @@ struct NodeRecord {
     uint32_t indexCount = 0;         ///<   indices are relative to firstVertex
     uint32_t level = 0;              ///< 0 = finest aggregate level, rising with delta; kLeafLevel
                                      ///<   for originals, kObjectLodLevel for per-object LODs,
-                                     ///<   kCoarserLevel for coarser versions of an aggregate
+                                     ///<   kCoarserLevel for coarser versions of an aggregate,
+                                     ///<   kBundleLevelFlag | k for bundles (isBundleLevel)
     float delta = 0.0f;              ///< threshold of the level, world units (0 for leaves)
     float geometricError = 0.0f;     ///< world units; >= every child's (0 for leaves)
     float boundsMin[3] = {0, 0, 0};  ///< axis-aligned box, world units, contains the children's
@@ -58,8 +59,21 @@ constexpr uint32_t kObjectLodLevel = 0xFFFEu;
 /// and its parent's; same objects, same delta. No level of its own: a cut at a level passes
 /// through it (cutAtLevel), levelsOf does not list it; selection by screen-space error draws it.
 constexpr uint32_t kCoarserLevel = 0xFFFDu;
-/// Aggregate levels are < kMaxAggregateLevel; larger values other than the two above are refused.
+/// Aggregate levels are < kMaxAggregateLevel; larger values other than the two above and the
+/// bundle levels below are refused.
 constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
+/// Level of a bundle: kBundleLevelFlag | k, k the level of the aggregate above its chain of
+/// bundles (k < kMaxAggregateLevel). A bundle is the drawn versions of that aggregate's
+/// children merged into one mesh, so that a distant group costs one draw call: same objects,
+/// error between the children's and the aggregate's. It ranks between levels k - 1 and k; a
+/// bundle may stand under another of the same level. No level of its own: a cut at a level
+/// passes through it (cutAtLevel), levelsOf does not list it; selection by screen-space error
+/// draws it.
+constexpr uint32_t kBundleLevelFlag = 0x10000u;
+/// True for a bundle's level (kBundleLevelFlag | k with k < kMaxAggregateLevel).
+constexpr bool isBundleLevel(uint32_t level) {
+    return (level & ~0xFFFFu) == kBundleLevelFlag && (level & 0xFFFFu) < kMaxAggregateLevel;
+}
 
 /// Float rounding in the nesting of bounds, decided here for the bake, the reader and the
 /// selector. The reader accepts a child's sphere or box that pokes out of its parent's by up to
@@ -148,7 +162,8 @@ struct BuildArrays {
 ///   at least one node;
 /// - level kLeafLevel exactly for the leaves; kCoarserLevel only on an inner node with one
 ///   child; kObjectLodLevel only on an inner node standing
-///   for one object; any other level < kMaxAggregateLevel;
+///   for one object; bundle levels (isBundleLevel) on inner nodes; any other level <
+///   kMaxAggregateLevel;
 /// - each leaf (childCount 0) stands for >= 1 object, every object in exactly one leaf, an
 ///   inner node lists exactly the objects of its leaves (any order, no duplicates);
 /// - child error <= parent error (exact), child sphere and box inside the parent's (slack

@@ -16,9 +16,10 @@
 namespace aggrelod::runtime {
 
 /// Format version written by writeRuntimeFile. A reader accepts only its own major version.
-/// 2: per-vertex normals and colours (sections 9 and 10).
+/// 2: per-vertex normals and colours (sections 9 and 10). 3.1: bundle levels (isBundleLevel),
+/// which a 3.0 reader refuses as a bad level.
 constexpr uint16_t kFormatMajor = 3;
-constexpr uint16_t kFormatMinor = 0;
+constexpr uint16_t kFormatMinor = 1;
 
 /// Why a file was refused (FileStatus::Ok when it was accepted).
 enum class FileStatus : uint32_t {
@@ -101,6 +102,9 @@ public:
     bool isObjectLod(uint32_t node) const { return nodes_.data[node].level == kObjectLodLevel; }
     /// A coarser version of the aggregate below it (level kCoarserLevel), not a level of its own.
     bool isCoarser(uint32_t node) const { return nodes_.data[node].level == kCoarserLevel; }
+    /// A bundle (level kBundleLevelFlag | k): the drawn versions of the aggregate above it
+    /// merged into one mesh, not a level of its own.
+    bool isBundle(uint32_t node) const { return isBundleLevel(nodes_.data[node].level); }
     /// The whole source-object array (NodeRecord::firstSource indexes it).
     Span<uint32_t> allSourceObjects() const { return sourceObjects_; }
     /// Name of original object `object` (< objectCount()), UTF-8.
