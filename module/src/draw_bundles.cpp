@@ -9,81 +9,68 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace aggrelod::detail {
 namespace {
 
-/// A kept bundle is lighter than the finer one kept before it by at least this share, as a
-/// chain version must be to be worth a node.
+/// A kept bundle is lighter than the finer one kept before it by at least this share.
 constexpr size_t kWorthNumerator = 19, kWorthDenominator = 20;
+/// Most thresholds tried for one group.
+constexpr size_t kMaxThresholds = 256;
 
 double ownError(const HierarchyNode& n) { return n.leaf ? 0.0 : n.error.bound(); }
 
-size_t triangleCount(const HierarchyNode& n, const std::vector<InputObject>& objects, uint32_t index) {
-    if (n.leaf && n.meshPlace.kind == NodeMeshPlace::Kind::Object) return objects[index].indices.size() / 3;
-    return n.indices.size() / 3;
-}
-
-/// One child of a group: its chain from the top down to its base (an aggregate or a leaf).
+/// One child of a group: its chain from the top down to its end (an aggregate or a leaf).
 struct Chain {
-    std::vector<uint32_t> members;  ///< top first, base last
+    std::vector<uint32_t> members;  ///< top first
+    double end = INFINITY;          ///< the smallest error of a member other than a leaf
 };
 
 struct Plan {
     uint32_t group = kNoNode;
-    std::vector<Chain> chains;
-    std::vector<double> thresholds;              ///< of the bundles kept, finest first
-    std::vector<std::vector<uint32_t>> pieces;   ///< per bundle kept, one node per chain
-    std::vector<uint32_t> newTops;               ///< per chain: its top below the finest bundle
+    std::vector<Chain> chains;                  ///< the bundled ones
+    std::vector<double> thresholds;             ///< of the bundles kept, finest first
+    std::vector<std::vector<uint32_t>> pieces;  ///< per bundle kept, one node per chain
+    std::vector<uint32_t> newTops;              ///< per chain: its top below the finest bundle
 };
 
-/// The lightest member of `chain` whose error (eff) is at most t; the base qualifies for
-/// every t >= its error. Ties: the one nearest the top.
+/// The lightest member of `chain` other than a leaf whose error (eff) is at most t; kNoNode for
+/// none. Ties: the one nearest the top.
 uint32_t lightestWithin(const Chain& chain, double t, const std::vector<double>& eff,
-                        const std::vector<HierarchyNode>& nodes, const std::vector<InputObject>& objects) {
+                        const std::vector<HierarchyNode>& nodes) {
     uint32_t best = kNoNode;
     size_t bestTriangles = SIZE_MAX;
     for (uint32_t m : chain.members) {
-        if (!(eff[m] <= t)) continue;
-        const size_t tri = triangleCount(nodes[m], objects, m);
-        if (tri < bestTriangles) best = m, bestTriangles = tri;
+        if (nodes[m].leaf || !(eff[m] <= t)) continue;
+        const size_t triangles = nodeTriangleCount(nodes[m]);
+        if (triangles < bestTriangles) best = m, bestTriangles = triangles;
     }
     return best;
 }
 
-/// Appends node m's mesh (a leaf's may be its object's) to `out`; colours white where m has
-/// none, when `colored`.
-void appendMesh(const HierarchyNode& m, uint32_t index, const std::vector<InputObject>& objects, bool colored,
-                HierarchyNode& out) {
-    const bool byObject = m.leaf && m.meshPlace.kind == NodeMeshPlace::Kind::Object;
-    const InputObject& object = objects[byObject ? index : 0];
+/// Appends `mesh` (a node's, coloured or not) to `out`; white where it has no colours, when
+/// `colored`.
+void appendMesh(const NodeMeshView& mesh, bool colored, HierarchyNode& out) {
     const uint32_t base = static_cast<uint32_t>(out.positions.size() / 3);
-    if (byObject) {
-        out.positions.insert(out.positions.end(), object.positions.begin(), object.positions.end());
-        for (uint32_t i : object.indices) out.indices.push_back(base + i);
-    } else {
-        out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
-        for (uint32_t i : m.indices) out.indices.push_back(base + i);
-    }
+    out.positions.insert(out.positions.end(), mesh.positions.begin(), mesh.positions.end());
+    for (uint32_t i : mesh.indices) out.indices.push_back(base + i);
     if (!colored) return;
-    const size_t triangles = (byObject ? object.indices.size() : m.indices.size()) / 3;
-    const std::vector<float>* colors = byObject ? (hasTriangleColors(object) ? &object.triangleColors : nullptr)
-                                                : (m.faceColors.size() == 4 * triangles ? &m.faceColors : nullptr);
-    if (colors) out.faceColors.insert(out.faceColors.end(), colors->begin(), colors->end());
+    const size_t triangles = mesh.indices.size() / 3;
+    if (mesh.faceColors.size() == 4 * triangles) out.faceColors.insert(out.faceColors.end(), mesh.faceColors.begin(), mesh.faceColors.end());
     else out.faceColors.insert(out.faceColors.end(), 4 * triangles, 1.0f);
 }
 
-bool hasColors(const HierarchyNode& m, uint32_t index, const std::vector<InputObject>& objects) {
-    if (m.leaf && m.meshPlace.kind == NodeMeshPlace::Kind::Object) return hasTriangleColors(objects[index]);
-    return !m.faceColors.empty();
+bool hasColors(const HierarchyNode& m) {
+    return m.meshPlace.kind == NodeMeshPlace::Kind::InNode ? !m.faceColors.empty() : m.meshPlace.hasFaceColors;
 }
 
 }  // namespace
 
-void addDrawBundles(std::vector<HierarchyNode>& nodes, std::vector<uint32_t>& roots,
-                    std::vector<std::vector<uint32_t>>& nodeOfAggregate, const std::vector<InputObject>& objects,
-                    const ProxySettings& settings) {
-    if (settings.bundleCount <= 0) return;
+bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& objects, const ProxySettings& settings,
+                    NodeMeshSpiller* spiller, std::string& error) {
+    if (settings.bundleCount <= 0) return true;
+    std::vector<HierarchyNode>& nodes = tree.nodes;
     const uint32_t count = static_cast<uint32_t>(nodes.size());
     // Error of a node as the cut sees it: the largest on its subtree (children come first).
     std::vector<double> eff(count, 0.0);
@@ -94,60 +81,78 @@ void addDrawBundles(std::vector<HierarchyNode>& nodes, std::vector<uint32_t>& ro
     const auto isVersion = [&](const HierarchyNode& n) {
         return !n.leaf && (n.objectLod >= 1 || n.coarserStep >= 1) && n.children.size() == 1;
     };
+    // Each object's box, for its groups' diagonals (a group's proxy may be out of memory).
+    std::vector<std::array<double, 6>> objectBox(objects.size());
+    for (size_t o = 0; o < objects.size(); ++o) {
+        std::array<double, 6>& b = objectBox[o];
+        b = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+        for (size_t v = 0; v + 2 < objects[o].positions.size(); v += 3)
+            for (int k = 0; k < 3; ++k)
+                b[k] = std::min(b[k], objects[o].positions[v + k]), b[3 + k] = std::max(b[3 + k], objects[o].positions[v + k]);
+    }
 
     std::vector<Plan> plans;
     std::vector<uint32_t> planOf(count, kNoNode);
     for (uint32_t g = 0; g < count; ++g) {
         const HierarchyNode& group = nodes[g];
         if (group.leaf || group.objectLod != 0 || group.coarserStep != 0 || group.sources.size() < 2 ||
-            group.children.size() < 2 || group.positions.empty())
+            group.children.size() < 2)
             continue;
         Plan plan;
         plan.group = g;
         std::vector<Chain> chains;
-        std::vector<double> ends;  // the error of each chain's end, ascending
+        std::vector<double> ends;  // ascending, below
         for (uint32_t c : group.children) {
             Chain chain;
-            uint32_t x = c;
-            while (isVersion(nodes[x])) {
+            for (uint32_t x = c;; x = nodes[x].children.front()) {
                 chain.members.push_back(x);
-                x = nodes[x].children.front();
+                if (!nodes[x].leaf) chain.end = std::min(chain.end, eff[x]);
+                if (!isVersion(nodes[x])) break;
             }
-            chain.members.push_back(x);
-            ends.push_back(eff[x]);
+            ends.push_back(chain.end);
             chains.push_back(std::move(chain));
         }
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t v = 0; v + 2 < group.positions.size(); v += 3)
-            for (int k = 0; k < 3; ++k)
-                lo[k] = std::min(lo[k], group.positions[v + k]), hi[k] = std::max(hi[k], group.positions[v + k]);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (uint32_t o : group.sources)
+            for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], objectBox[o][k]), hi[k] = std::max(hi[k], objectBox[o][3 + k]);
         double diagonal2 = 0;
-        for (int k = 0; k < 3; ++k) diagonal2 += double(hi[k] - lo[k]) * double(hi[k] - lo[k]);
-        // The floor: the fraction of the diagonal. The chains ending at or below it go into the
-        // bundles; a child whose chain ends higher (an aggregate with a wide fill) stays a child
-        // of the group beside them, drawn apart, rather than holding every bundle above its
-        // error. Where fewer than two chains end that low, the floor rises to the highest end.
+        for (int k = 0; k < 3; ++k) diagonal2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        // The chains ending at or below the floor are bundled; a child whose chain ends higher
+        // (an aggregate with a wide fill) stays a child of the group beside them, drawn apart,
+        // rather than holding every bundle above its error.
         std::sort(ends.begin(), ends.end());
         double floor = settings.bundleMinErrorFraction * std::sqrt(diagonal2);
-        if (!(ends[1] <= floor)) floor = ends.back();
+        if (!(ends[1] <= floor)) {
+            floor = 0;
+            for (double e : ends)
+                if (std::isfinite(e)) floor = std::max(floor, e);
+        }
         const double top = ownError(group);
-        if (!(floor < top)) continue;
+        if (!(floor > 0 && floor < top)) continue;
         for (Chain& chain : chains)
-            if (eff[chain.members.back()] <= floor) plan.chains.push_back(std::move(chain));
+            if (chain.end <= floor) plan.chains.push_back(std::move(chain));
+        if (plan.chains.size() < 2) continue;
+        // Thresholds: where a bundled chain's lightest node changes, that is its nodes' errors
+        // (at most kMaxThresholds of them, evenly spread, for a group of many children).
         std::vector<double> candidates{floor};
         for (const Chain& chain : plan.chains)
             for (uint32_t m : chain.members)
-                if (eff[m] > floor && eff[m] < top) candidates.push_back(eff[m]);
+                if (!nodes[m].leaf && eff[m] > floor && eff[m] < top) candidates.push_back(eff[m]);
         std::sort(candidates.begin(), candidates.end());
         candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+        if (candidates.size() > kMaxThresholds) {
+            std::vector<double> spread;
+            for (size_t j = 0; j < kMaxThresholds; ++j) spread.push_back(candidates[j * candidates.size() / kMaxThresholds]);
+            candidates = std::move(spread);
+        }
         size_t lastTriangles = 0;
         for (double t : candidates) {
             if (int(plan.thresholds.size()) >= settings.bundleCount) break;
             std::vector<uint32_t> pieces;
             size_t triangles = 0;
             for (const Chain& chain : plan.chains) {
-                pieces.push_back(lightestWithin(chain, t, eff, nodes, objects));
-                triangles += triangleCount(nodes[pieces.back()], objects, pieces.back());
+                pieces.push_back(lightestWithin(chain, t, eff, nodes));
+                triangles += nodeTriangleCount(nodes[pieces.back()]);
             }
             if (triangles > settings.bundleMaxTriangles) continue;
             if (!plan.thresholds.empty() && kWorthDenominator * triangles > kWorthNumerator * lastTriangles) continue;
@@ -157,18 +162,18 @@ void addDrawBundles(std::vector<HierarchyNode>& nodes, std::vector<uint32_t>& ro
         }
         if (plan.thresholds.empty()) continue;
         for (const Chain& chain : plan.chains) {
-            size_t j = 0;
-            while (!(eff[chain.members[j]] <= plan.thresholds.front())) ++j;  // the base always qualifies
+            size_t j = 0;  // the highest member within the finest threshold (one is: chain.end <= floor)
+            while (!(eff[chain.members[j]] <= plan.thresholds.front())) ++j;
             plan.newTops.push_back(chain.members[j]);
         }
         planOf[g] = static_cast<uint32_t>(plans.size());
         plans.push_back(std::move(plan));
     }
-    if (plans.empty()) return;
+    if (plans.empty()) return true;
 
-    // Chain nodes above a finest bundle's threshold leave the tree.
-    // An aggregate of one object that gave way to the object's chain is stood for by the
-    // chain's top (nodeOfAggregate): by its new top when that top goes.
+    // Chain nodes above a finest bundle's threshold leave the tree. An aggregate of one object
+    // that gave way to the object's chain is stood for by the chain's top (nodeOfAggregate):
+    // by its new top when that top goes.
     std::vector<char> absorbed(count, 0);
     std::vector<uint32_t> standIn(count, kNoNode);
     std::vector<uint32_t> bundleAbove(count, kNoNode);  // new top -> its group's plan
@@ -182,37 +187,43 @@ void addDrawBundles(std::vector<HierarchyNode>& nodes, std::vector<uint32_t>& ro
             bundleAbove[plans[p].newTops[i]] = p;
         }
 
-    // The bundles' meshes, made before the absorbed nodes go.
+    // The bundles' meshes, made (and spilled) before the absorbed nodes go.
     std::vector<std::vector<HierarchyNode>> bundles(plans.size());
-    for (size_t p = 0; p < plans.size(); ++p) {
-        const Plan& plan = plans[p];
-        const HierarchyNode& group = nodes[plan.group];
-        for (size_t j = 0; j < plan.thresholds.size(); ++j) {
-            HierarchyNode b;
-            b.bundleStep = static_cast<int>(j) + 1;
-            for (const Chain& chain : plan.chains) {
-                const HierarchyNode& end = nodes[chain.members.back()];
-                b.sources.insert(b.sources.end(), end.sources.begin(), end.sources.end());
-                b.exactTriangleCount += end.exactTriangleCount;
+    NodeMesh storage;
+    try {
+        for (size_t p = 0; p < plans.size(); ++p) {
+            const Plan& plan = plans[p];
+            const HierarchyNode& group = nodes[plan.group];
+            for (size_t j = 0; j < plan.thresholds.size(); ++j) {
+                HierarchyNode b;
+                b.bundleStep = static_cast<int>(j) + 1;
+                for (const Chain& chain : plan.chains) {
+                    const HierarchyNode& end = nodes[chain.members.back()];
+                    b.sources.insert(b.sources.end(), end.sources.begin(), end.sources.end());
+                    b.exactTriangleCount += end.exactTriangleCount;
+                }
+                std::sort(b.sources.begin(), b.sources.end());
+                b.delta = group.delta;
+                b.budget = plan.thresholds[j];
+                bool colored = false;
+                for (uint32_t m : plan.pieces[j]) colored = colored || hasColors(nodes[m]);
+                for (uint32_t m : plan.pieces[j]) {
+                    appendMesh(viewNodeMesh(tree, objects, m, storage), colored, b);
+                    const ProxyError& e = nodes[m].error;
+                    b.error.proxyToOriginals = std::max(b.error.proxyToOriginals, e.proxyToOriginals);
+                    b.error.originalsToProxy = std::max(b.error.originalsToProxy, e.originalsToProxy);
+                    b.error.evaluationCount += e.evaluationCount;
+                }
+                // Nothing is measured on the bundle as a whole (a distance found on a part may
+                // be shorter to another part's objects): found 0, the whole bound as the gap.
+                b.error.tolerance = b.error.bound();
+                if (spiller && !spiller->spill(b, plan.group, error)) return false;
+                bundles[p].push_back(std::move(b));
             }
-            std::sort(b.sources.begin(), b.sources.end());
-            b.delta = group.delta;
-            b.budget = plan.thresholds[j];
-            bool colored = false;
-            for (uint32_t m : plan.pieces[j]) colored = colored || hasColors(nodes[m], m, objects);
-            for (uint32_t m : plan.pieces[j]) {
-                appendMesh(nodes[m], m, objects, colored, b);
-                if (nodes[m].leaf) continue;
-                const ProxyError& e = nodes[m].error;
-                b.error.proxyToOriginals = std::max(b.error.proxyToOriginals, e.proxyToOriginals);
-                b.error.originalsToProxy = std::max(b.error.originalsToProxy, e.originalsToProxy);
-                b.error.proxyToOriginalsLower = std::max(b.error.proxyToOriginalsLower, e.proxyToOriginalsLower);
-                b.error.originalsToProxyLower = std::max(b.error.originalsToProxyLower, e.originalsToProxyLower);
-                b.error.tolerance = std::max(b.error.tolerance, e.tolerance);
-                b.error.evaluationCount += e.evaluationCount;
-            }
-            bundles[p].push_back(std::move(b));
         }
+    } catch (const std::runtime_error& e) {  // a spilled mesh that did not read back
+        error = e.what();
+        return false;
     }
 
     // Renumbered: each group's bundles (finest first) just before it.
@@ -243,18 +254,19 @@ void addDrawBundles(std::vector<HierarchyNode>& nodes, std::vector<uint32_t>& ro
         }
         out[at] = std::move(nodes[i]);
     }
-    roots.clear();
+    tree.roots.clear();
     for (uint32_t i = 0; i < next; ++i) {
         out[i].children.clear();
         out[i].parent = parentOf[i];
     }
     for (uint32_t i = 0; i < next; ++i) {  // ascending, so children lists come out sorted
-        if (parentOf[i] == kNoNode) roots.push_back(i);
+        if (parentOf[i] == kNoNode) tree.roots.push_back(i);
         else out[parentOf[i]].children.push_back(i);
     }
-    for (auto& level : nodeOfAggregate)
+    for (auto& level : tree.nodeOfAggregate)
         for (uint32_t& i : level) i = newIndex[absorbed[i] ? standIn[i] : i];
     nodes = std::move(out);
+    return true;
 }
 
 }  // namespace aggrelod::detail

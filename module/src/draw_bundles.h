@@ -5,37 +5,45 @@
 
 #include <aggrelod/hierarchy_nodes.h>
 
+#include "node_mesh_spiller.h"
+
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace aggrelod::detail {
 
 /// Adds bundles (HierarchyNode::bundleStep) below every aggregate of several objects of a
 /// node tree as buildHierarchyNodes puts it together: leaves first (node i = object i), then
-/// every node after its children, meshes in memory (a leaf's may be its object's,
-/// NodeMeshPlace::Kind::Object). Errors are the nodes' own (error.bound()); bounds and
-/// geometric errors are computed afterwards.
+/// every node after its children; meshes anywhere (in the node, its object, nodes.meshFile).
+/// Errors are the nodes' own (error.bound()); bounds and geometric errors are computed
+/// afterwards.
 ///
 /// For an aggregate G of several objects with children c_1..c_k, each the top of a chain of
-/// single children (coarser versions, per-object LODs) ending at a base (an aggregate or a
-/// leaf) whose error (the largest below it) is the chain's end: the floor t_0 is
-/// settings.bundleMinErrorFraction * G's diagonal, and the chains ending at or below it are
-/// bundled (where fewer than two do, t_0 rises to the highest end and every chain is). From
-/// t_0 up to G's own error, bundle B(t) merges, for every bundled chain, its lightest node
-/// whose error is at most t. The bundles kept are the finest one and each coarser one with
-/// at most 19/20 of the triangles of the last kept, at most settings.bundleCount, each of at
-/// most settings.bundleMaxTriangles triangles. They hang as a chain below G, finest lowest,
-/// the bundled children below the finest, the other children beside the chain; the chain
-/// nodes above the finest bundle's threshold leave the tree (their meshes are in the
-/// bundles). A bundle is drawn only where one pixel is at least bundleMinErrorFraction of G's
-/// size, where one error over the bundled children costs about what one per child would.
+/// single children (coarser versions, per-object LODs) ending at an aggregate or a leaf: a
+/// chain's end is the smallest error (the largest on the chain from a node down) of its nodes
+/// other than a leaf (an original is never a part: it need not be closed). The floor t_0 is
+/// settings.bundleMinErrorFraction * the diagonal of G's objects' box, and the chains ending at
+/// or below it are bundled (where fewer than two do, t_0 rises to the highest finite end and
+/// every chain with a finite end is). On thresholds from t_0 up to G's own error (the
+/// bundled chains' nodes' errors, at most 256 of them evenly spread), bundle B(t) merges, for every bundled chain, its lightest node other than a leaf whose error is at
+/// most t. The bundles kept are the finest one and each coarser one with at most 19/20 of the
+/// triangles of the last kept, at most settings.bundleCount, each of at most
+/// settings.bundleMaxTriangles triangles. They hang as a chain below G, finest lowest, the
+/// bundled children's chains below the finest, the other children beside the chain; the
+/// chain nodes above the finest bundle's threshold leave the tree (the bundles stand for
+/// them). Those chain nodes are drawn only where one pixel is at least the floor, so at
+/// least bundleMinErrorFraction of G's size, where one error over the bundled children
+/// costs about what one per child would.
 ///
-/// A bundle's error is the largest of its parts' (each certified against its own objects, so
-/// the bound holds for all of them); its budget is its threshold; its parts may overlap (a
-/// union of closed shells: closed and edge-manifold, not free of self-intersections).
-/// nodeOfAggregate and roots are renumbered; aggregates keep their order. Deterministic.
-void addDrawBundles(std::vector<HierarchyNode>& nodes, std::vector<uint32_t>& roots,
-                    std::vector<std::vector<uint32_t>>& nodeOfAggregate, const std::vector<InputObject>& objects,
-                    const ProxySettings& settings);
+/// A bundle's certified error is the largest of its parts' (each certified against its own
+/// objects, so the bound holds for all of them); its parts may overlap (a union of closed
+/// shells: closed and edge-manifold, not free of self-intersections). Its sources are its
+/// bundled children's objects. nodeOfAggregate and roots are renumbered (an entry on a
+/// removed chain node moves to the highest node left of that chain); aggregates keep their
+/// order. With `spiller`, each bundle's mesh goes to it as soon as it is made. Deterministic.
+/// False with `error` when a mesh cannot be read back or spilled.
+bool addDrawBundles(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const ProxySettings& settings,
+                    NodeMeshSpiller* spiller, std::string& error);
 
 }  // namespace aggrelod::detail

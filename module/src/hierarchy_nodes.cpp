@@ -1482,6 +1482,33 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         }
     }
 
+    // Every mesh made to a spill file now, if asked: the tree is put together and its bounds
+    // computed without them in memory (ProxySettings::meshSpillPath).
+    const bool spilling = !settings.meshSpillPath.empty();
+    detail::NodeMeshSpiller spiller;
+    if (spilling) {
+        bool spilled = spiller.open(settings.meshSpillPath, reloadError);
+        for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
+            HierarchyNode& n = nodes[o];
+            if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
+            n.meshPlace = detail::objectMeshPlace(objects[o]);
+            dropMesh(n);
+        }
+        for (size_t i = objectCount; spilled && i < nodes.size(); ++i) {
+            if (dropped[i]) {
+                dropMesh(nodes[i]);
+                continue;
+            }
+            spilled = spiller.spill(nodes[i], static_cast<uint32_t>(i), reloadError);
+            for (HierarchyNode& c : coarser[i]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(i), reloadError);
+        }
+        for (size_t o = 0; spilled && o < objectCount; ++o)
+            for (HierarchyNode& c : chains[o]) spilled = spilled && spiller.spill(c, static_cast<uint32_t>(o), reloadError);
+        if (!spilled || !spiller.finish(reloadError)) return finish(false);
+        out.meshFile = spiller.file();
+        if (settings.releaseFreedMemory) settings.releaseFreedMemory();
+    }
+
     // The tree again: leaves, per-object chains (object by object, finest first), then each
     // aggregate kept followed by its coarser versions (finest first).
     {
@@ -1543,24 +1570,11 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         nodes = std::move(renumbered);
     }
 
-    // Bundles: the drawn versions of each group's children merged into one draw call.
-    detail::addDrawBundles(nodes, out.roots, out.nodeOfAggregate, objects, settings);
-
-    // Every mesh made to a spill file now, if asked: the bounds are computed without them in
-    // memory (ProxySettings::meshSpillPath).
-    if (!settings.meshSpillPath.empty()) {
-        detail::NodeMeshSpiller spiller;
-        bool spilled = spiller.open(settings.meshSpillPath, reloadError);
-        for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
-            HierarchyNode& n = nodes[o];
-            if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;
-            n.meshPlace = detail::objectMeshPlace(objects[o]);
-            dropMesh(n);
-        }
-        for (size_t i = objectCount; spilled && i < nodes.size(); ++i)
-            spilled = spiller.spill(nodes[i], static_cast<uint32_t>(i), reloadError);
-        if (!spilled || !spiller.finish(reloadError)) return finish(false);
-        out.meshFile = spiller.file();
+    // Bundles: the drawn versions of each group's children merged into one draw call (spilled
+    // as they are made, where the other meshes are).
+    if (!detail::addDrawBundles(out, objects, settings, spilling ? &spiller : nullptr, reloadError)) return finish(false);
+    if (spilling) {
+        if (!spiller.finish(reloadError)) return finish(false);
         if (settings.releaseFreedMemory) settings.releaseFreedMemory();
     }
 

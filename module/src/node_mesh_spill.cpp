@@ -93,6 +93,15 @@ bool NodeMeshSpiller::write(const HierarchyNode& n, uint32_t node, NodeMeshPlace
     place.hasFaceColors = !n.faceColors.empty();
     const size_t bytes[3] = {4 * n.positions.size(), 4 * n.indices.size(), 4 * n.faceColors.size()};
     const void* data[3] = {n.positions.data(), n.indices.data(), n.faceColors.data()};
+    // At the end again: meshes may have been read back in between (the same stream).
+#ifdef _WIN32
+    if (_fseeki64(raw_, static_cast<long long>(offset_), SEEK_SET) != 0) {
+#else
+    if (fseeko(raw_, static_cast<off_t>(offset_), SEEK_SET) != 0) {
+#endif
+        error = file_->path() + ": cannot seek to its end";
+        return false;
+    }
     for (int k = 0; k < 3; ++k)
         if (bytes[k] && std::fwrite(data[k], 1, bytes[k], raw_) != bytes[k]) {
             error = file_->path() + ": write failed (disk full?)";

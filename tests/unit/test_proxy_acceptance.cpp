@@ -301,10 +301,10 @@ std::vector<ProxyUnderTest> nodeProxies(const AcceptanceScene& s) {
                 for (const SolidReport& r : s.baked.hierarchy.solids)
                     if (r.objects == std::vector<uint32_t>{object}) p.expectedShells = shellCount(r.triangles);
         } else {
-            // A bundle: at least as many parts as the aggregate above it has shells.
             const HierarchyNode& a = nodes.nodes[aggregateBelow(nodes, i)];
             p.expectedShells = s.baked.hierarchy.levels[size_t(a.firstLevel)].aggregates[a.aggregateIndex].componentCount;
             p.unionOfParts = n.bundleStep >= 1;
+            if (p.unionOfParts) p.expectedShells = 2;  // a bundle: the parts of at least two children
         }
         out.push_back(std::move(p));
     }

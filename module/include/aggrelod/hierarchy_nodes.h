@@ -48,12 +48,13 @@ struct ProxySettings {
     /// merged into one mesh (the lightest version of each child within a threshold), at
     /// thresholds between the children's errors and the aggregate's, so that a distant group
     /// costs one draw call. Each kept bundle has at most 19/20 of the triangles of the finer
-    /// one. Children that are aggregates with an error above bundleMinErrorFraction of the
-    /// group's diagonal stay apart. 0 = none.
+    /// one. Children whose versions all have errors above bundleMinErrorFraction of the
+    /// group's diagonal (aggregates with wide fills) stay apart. 0 = none.
     int bundleCount = 16;
-    /// Finest bundle threshold as a fraction of the aggregate's diagonal: a bundle is drawn only
-    /// where one pixel is at least this fraction of the group's size, far enough for one error
-    /// over the whole group to cost no more than one per child.
+    /// Finest bundle threshold as a fraction of the diagonal of the aggregate's objects: the
+    /// children's versions that bundles replace are those drawn only where one pixel is at
+    /// least this fraction of the group's size, far enough for one error over the whole group
+    /// to cost about what one per child would.
     double bundleMinErrorFraction = 1.0 / 64;
     /// Most triangles of one bundle (a larger merged mesh is not made).
     size_t bundleMaxTriangles = 65536;
@@ -144,8 +145,9 @@ struct HierarchyNode {
     /// 0 for every other node; j >= 1 for the j-th bundle below an aggregate of several
     /// objects (j rises towards it): the drawn versions of the aggregate's children merged into
     /// one mesh, error between theirs and the aggregate's (ProxySettings::bundleCount). sources
-    /// and delta are the aggregate's, firstLevel and lastLevel are -1. Its shells are its parts'
-    /// and may overlap one another.
+    /// are the bundled children's objects, delta is the aggregate's, firstLevel and lastLevel
+    /// are -1. Its shells are its parts' (closed proxies, never originals) and may overlap one
+    /// another.
     int bundleStep = 0;
     int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
     int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
@@ -182,7 +184,9 @@ struct HierarchyNodes {
     std::vector<HierarchyNode> nodes;
     std::vector<uint32_t> roots;       ///< ascending
     size_t objectCount = 0;
-    /// nodeOfAggregate[k][g]: node standing for levels[k].aggregates[g].
+    /// nodeOfAggregate[k][g]: node standing for levels[k].aggregates[g] (an aggregate of one
+    /// object that gave way to its per-object LOD chain: the chain's top, or the highest node
+    /// of the chain left below a bundle).
     std::vector<std::vector<uint32_t>> nodeOfAggregate;
     /// Work items of the proxies made in this run and read from ProxySettings::cache.
     size_t proxyItemsMade = 0, proxyItemsLoaded = 0;
