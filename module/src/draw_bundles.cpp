@@ -8,6 +8,7 @@
 #include "surface_colors.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
