@@ -28,12 +28,20 @@ struct Chain {
     double end = INFINITY;          ///< the smallest error of a member other than a leaf
 };
 
+/// What a bundle draws for one chain: a node of the chain, or one version of each of the
+/// chain's objects.
+struct Piece {
+    uint32_t node = kNoNode;
+    std::vector<const HierarchyNode*> versions;
+    size_t triangles = 0;
+};
+
 struct Plan {
     uint32_t group = kNoNode;
-    std::vector<Chain> chains;                  ///< the bundled ones
-    std::vector<double> thresholds;             ///< of the bundles kept, finest first
-    std::vector<std::vector<uint32_t>> pieces;  ///< per bundle kept, one node per chain
-    std::vector<uint32_t> newTops;              ///< per chain: its top below the finest bundle
+    std::vector<Chain> chains;               ///< the bundled ones
+    std::vector<double> thresholds;          ///< of the bundles kept, finest first
+    std::vector<std::vector<Piece>> pieces;  ///< per bundle kept, one per chain
+    std::vector<uint32_t> newTops;           ///< per chain: its top below the finest bundle
 };
 
 /// The lightest member of `chain` other than a leaf whose error (eff) is at most t; kNoNode for
@@ -48,6 +56,38 @@ uint32_t lightestWithin(const Chain& chain, double t, const std::vector<double>&
         if (triangles < bestTriangles) best = m, bestTriangles = triangles;
     }
     return best;
+}
+
+/// The lightest version of `versions` whose error is at most t; null for none.
+const HierarchyNode* lightestVersionWithin(const std::vector<HierarchyNode>& versions, double t) {
+    const HierarchyNode* best = nullptr;
+    for (const HierarchyNode& v : versions)
+        if (v.error.bound() <= t && (!best || v.indices.size() < best->indices.size())) best = &v;
+    return best;
+}
+
+/// A chain's part at threshold t: its lightest node within t, or its objects' lightest
+/// versions within t when every object has one and they have fewer triangles in all.
+Piece pieceWithin(const Chain& chain, double t, const std::vector<double>& eff, const std::vector<HierarchyNode>& nodes,
+                  const std::vector<std::vector<HierarchyNode>>& versionsAbove) {
+    Piece piece;
+    piece.node = lightestWithin(chain, t, eff, nodes);
+    piece.triangles = nodeTriangleCount(nodes[piece.node]);
+    if (versionsAbove.empty()) return piece;
+    std::vector<const HierarchyNode*> versions;
+    size_t triangles = 0;
+    for (uint32_t o : nodes[chain.members.back()].sources) {
+        const HierarchyNode* v = lightestVersionWithin(versionsAbove[o], t);
+        if (!v) return piece;
+        versions.push_back(v);
+        triangles += v->indices.size() / 3;
+    }
+    if (triangles < piece.triangles) {
+        piece.node = kNoNode;
+        piece.versions = std::move(versions);
+        piece.triangles = triangles;
+    }
+    return piece;
 }
 
 /// Appends `mesh` (a node's, coloured or not) to `out`; white where it has no colours, when
@@ -69,7 +109,8 @@ bool hasColors(const HierarchyNode& m) {
 }  // namespace
 
 bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& objects, const ProxySettings& settings,
-                    NodeMeshSpiller* spiller, std::string& error) {
+                    const std::vector<std::vector<HierarchyNode>>& versionsAbove, NodeMeshSpiller* spiller,
+                    std::string& error) {
     if (settings.bundleCount <= 0) return true;
     std::vector<HierarchyNode>& nodes = tree.nodes;
     const uint32_t count = static_cast<uint32_t>(nodes.size());
@@ -136,9 +177,14 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         // Thresholds: where a bundled chain's lightest node changes, that is its nodes' errors
         // (at most kMaxThresholds of them, evenly spread, for a group of many children).
         std::vector<double> candidates{floor};
-        for (const Chain& chain : plan.chains)
+        for (const Chain& chain : plan.chains) {
             for (uint32_t m : chain.members)
                 if (!nodes[m].leaf && eff[m] > floor && eff[m] < top) candidates.push_back(eff[m]);
+            if (versionsAbove.empty()) continue;
+            for (uint32_t o : nodes[chain.members.back()].sources)
+                for (const HierarchyNode& v : versionsAbove[o])
+                    if (v.error.bound() > floor && v.error.bound() < top) candidates.push_back(v.error.bound());
+        }
         std::sort(candidates.begin(), candidates.end());
         candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
         if (candidates.size() > kMaxThresholds) {
@@ -149,11 +195,11 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         size_t lastTriangles = 0;
         for (double t : candidates) {
             if (int(plan.thresholds.size()) >= settings.bundleCount) break;
-            std::vector<uint32_t> pieces;
+            std::vector<Piece> pieces;
             size_t triangles = 0;
             for (const Chain& chain : plan.chains) {
-                pieces.push_back(lightestWithin(chain, t, eff, nodes));
-                triangles += nodeTriangleCount(nodes[pieces.back()]);
+                pieces.push_back(pieceWithin(chain, t, eff, nodes, versionsAbove));
+                triangles += pieces.back().triangles;
             }
             if (triangles > settings.bundleMaxTriangles) continue;
             if (!plan.thresholds.empty() && kWorthDenominator * triangles > kWorthNumerator * lastTriangles) continue;
@@ -207,13 +253,20 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 b.delta = group.delta;
                 b.budget = plan.thresholds[j];
                 bool colored = false;
-                for (uint32_t m : plan.pieces[j]) colored = colored || hasColors(nodes[m]);
-                for (uint32_t m : plan.pieces[j]) {
-                    appendMesh(viewNodeMesh(tree, objects, m, storage), colored, b);
-                    const ProxyError& e = nodes[m].error;
+                for (const Piece& piece : plan.pieces[j]) {
+                    if (piece.node != kNoNode) colored = colored || hasColors(nodes[piece.node]);
+                    for (const HierarchyNode* v : piece.versions) colored = colored || !v->faceColors.empty();
+                }
+                const auto addPart = [&](const NodeMeshView& mesh, const ProxyError& e) {
+                    appendMesh(mesh, colored, b);
                     b.error.proxyToOriginals = std::max(b.error.proxyToOriginals, e.proxyToOriginals);
                     b.error.originalsToProxy = std::max(b.error.originalsToProxy, e.originalsToProxy);
                     b.error.evaluationCount += e.evaluationCount;
+                };
+                for (const Piece& piece : plan.pieces[j]) {
+                    if (piece.node != kNoNode) addPart(viewNodeMesh(tree, objects, piece.node, storage), nodes[piece.node].error);
+                    for (const HierarchyNode* v : piece.versions)
+                        addPart(NodeMeshView{v->positions, v->indices, v->faceColors}, v->error);
                 }
                 // Nothing is measured on the bundle as a whole (a distance found on a part may
                 // be shorter to another part's objects): found 0, the whole bound as the gap.

@@ -36,6 +36,13 @@ namespace aggrelod::detail {
 /// least bundleMinErrorFraction of G's size, where one error over the bundled children
 /// costs about what one per child would.
 ///
+/// A bundled chain's part may instead be its objects' own versions: versionsAbove[o] (empty, or
+/// one list per object, each version certified against object o alone) holds the versions of
+/// object o above its per-object LOD chain; at threshold t, where every object of a chain has
+/// one within t, the lightest of each together are the chain's part when they have fewer
+/// triangles than its lightest node within t (a group's versions keep the fill between its
+/// objects, the objects' do not), and their errors are thresholds too.
+///
 /// A bundle's certified error is the largest of its parts' (each certified against its own
 /// objects, so the bound holds for all of them); its parts may overlap (a union of closed
 /// shells: closed and edge-manifold, not free of self-intersections). Its sources are its
@@ -44,6 +51,7 @@ namespace aggrelod::detail {
 /// order. With `spiller`, each bundle's mesh goes to it as soon as it is made. Deterministic.
 /// False with `error` when a mesh cannot be read back or spilled.
 bool addDrawBundles(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const ProxySettings& settings,
-                    NodeMeshSpiller* spiller, std::string& error);
+                    const std::vector<std::vector<HierarchyNode>>& versionsAbove, NodeMeshSpiller* spiller,
+                    std::string& error);
 
 }  // namespace aggrelod::detail

@@ -549,6 +549,31 @@ std::vector<HierarchyNode> chainFromLadder(const VersionLadder& ladder, uint32_t
     return chain;
 }
 
+/// An object's versions for the bundles of the groups holding it (draw_bundles.h): the
+/// coarsest version of its per-object LOD chain `chain` (finest first), then the lightest chain
+/// (lightestChain) through its versions whose error is at least `ceiling` (the chain's) and
+/// below `reach` (the error of the root above it). Ascending by error.
+std::vector<HierarchyNode> versionsAboveChain(const VersionLadder& ladder, const std::vector<HierarchyNode>& chain,
+                                              uint32_t objectIndex, double ceiling, double reach,
+                                              const ProxySettings& settings) {
+    std::vector<HierarchyNode> candidates;
+    for (const Version& v : ladder.versions) {
+        const double e = v.node.error.bound();
+        if (e >= ceiling && e < reach) candidates.push_back(v.node);
+    }
+    std::vector<HierarchyNode> above;
+    if (!chain.empty()) above.push_back(chain.back());
+    for (HierarchyNode& n : lightestChain(std::move(candidates),
+                                          chain.empty() ? ladder.objectTriangles : chain.back().indices.size() / 3,
+                                          settings.objectLodCount))
+        above.push_back(std::move(n));
+    for (HierarchyNode& n : above) {
+        n.sources = {objectIndex};
+        n.exactTriangleCount = ladder.objectTriangles;
+    }
+    return above;
+}
+
 /// Most objects a group may hold for its coarser versions to be tried as unions of its
 /// objects' versions (each union is a chain of exact boolean operations).
 constexpr size_t kUnionMaxObjects = 48;
@@ -1354,9 +1379,20 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // alone (the object with its concavities filled), up to its first aggregate with other
     // objects; those single-object aggregates stay only where the object has no chain.
     std::vector<std::vector<HierarchyNode>> chains(objectCount);
+    // Each object's versions above its chain, up to its root's error: the bundles of its groups
+    // may draw them instead of the groups' own versions (draw_bundles.h).
+    std::vector<std::vector<HierarchyNode>> versionsAbove(share || settings.bundleCount <= 0 ? 0 : objectCount);
+    const auto reachOf = [&](size_t o) {
+        uint32_t top = static_cast<uint32_t>(o);
+        while (nodes[top].parent != kNoNode) top = nodes[top].parent;
+        return top == o ? 0.0 : nodes[top].error.bound();
+    };
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (ladders[o].versions.empty()) return;
         std::vector<HierarchyNode> chain = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceilingOfChain(o), settings);
+        if (!versionsAbove.empty())
+            versionsAbove[o] = versionsAboveChain(ladders[o], chain, static_cast<uint32_t>(o), ceilingOfChain(o), reachOf(o),
+                                                  settings);
         // A ladder read without its exact vertices has given all it can: coarser versions to
         // be made read it again whole, each for itself, so it need not be held beside its chain.
         if (!ladderWhole[o]) ladders[o] = VersionLadder{};
@@ -1364,10 +1400,14 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         if (share) return;  // only whether there is a chain matters to a share
         chains[o] = std::move(chain);
         const detail::SurfaceColorSource colors({&objects[o]});
-        for (HierarchyNode& c : chains[o]) {
-            colors.colorsOf(c.positions, c.indices, c.faceColors);
-            detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
-        }
+        const auto colorAndOrder = [&](std::vector<HierarchyNode>& list) {
+            for (HierarchyNode& c : list) {
+                colors.colorsOf(c.positions, c.indices, c.faceColors);
+                detail::optimizeVertexCache(c.positions, c.indices, c.faceColors);
+            }
+        };
+        colorAndOrder(chains[o]);
+        if (!versionsAbove.empty()) colorAndOrder(versionsAbove[o]);
     });
     std::vector<char> dropped(nodes.size(), 0);
     std::vector<uint32_t> keptSingles;
@@ -1572,7 +1612,9 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
 
     // Bundles: the drawn versions of each group's children merged into one draw call (spilled
     // as they are made, where the other meshes are).
-    if (!detail::addDrawBundles(out, objects, settings, spilling ? &spiller : nullptr, reloadError)) return finish(false);
+    if (!detail::addDrawBundles(out, objects, settings, versionsAbove, spilling ? &spiller : nullptr, reloadError))
+        return finish(false);
+    std::vector<std::vector<HierarchyNode>>().swap(versionsAbove);
     if (spilling) {
         if (!spiller.finish(reloadError)) return finish(false);
         if (settings.releaseFreedMemory) settings.releaseFreedMemory();

@@ -242,6 +242,43 @@ TEST(HierarchyNodes, BundlesDrawADistantGroupInOneCall) {
     }
 }
 
+// Bundles draw the objects' own versions where those are lighter than the group's (whose
+// versions keep the fill between the objects): a group's coarsest bundle has at most 10/9 of
+// the triangles of its objects' lightest enclosing versions within its error (10/9: the
+// chains keep a version only when it is a tenth lighter than the one before), and on the
+// forest it is strictly lighter than the same group's coarsest bundle made without them.
+TEST(HierarchyNodes, BundlesDrawTheObjectsOwnVersionsWhereLighter) {
+    ForestPair f;
+    ASSERT_TRUE(bakeForestPair(f, [](ProxySettings&) {}));
+    const HierarchyNodes& with = f.with;
+    std::vector<std::vector<HierarchyNode>> versions(f.objects.size());
+    for (size_t o = 0; o < f.objects.size(); ++o) versions[o] = enclosingVersions(f.objects[o], nullptr, ProxySettings{});
+
+    size_t checked = 0, sumBundles = 0, sumVersions = 0;
+    for (size_t i = 0; i < with.nodes.size(); ++i) {
+        const HierarchyNode& n = with.nodes[i];
+        if (n.bundleStep == 0 || with.nodes[n.parent].bundleStep != 0) continue;  // a group's coarsest bundle
+        size_t lightest = 0;
+        bool all = true;
+        for (uint32_t o : n.sources) {
+            size_t best = SIZE_MAX;
+            for (const HierarchyNode& v : versions[o])
+                if (v.error.bound() <= n.error.bound()) best = std::min(best, v.indices.size() / 3);
+            all = all && best != SIZE_MAX;
+            lightest += best == SIZE_MAX ? 0 : best;
+        }
+        if (!all) continue;
+        ++checked;
+        sumBundles += n.indices.size() / 3;
+        sumVersions += lightest;
+        EXPECT_LE(9 * (n.indices.size() / 3), 10 * lightest) << "bundle " << i << " of " << n.sources.size() << " objects";
+    }
+    std::printf("forest: %zu groups' coarsest bundles, %zu triangles; their objects' lightest versions within the "
+                "bundles' errors: %zu\n",
+                checked, sumBundles, sumVersions);
+    EXPECT_GT(checked, 10u);
+}
+
 TEST(HierarchyNodes, TreeShapeBoundsAndErrors) {
     const Baked& b = spheres15();
     const auto& nodes = b.nodes.nodes;
