@@ -1257,7 +1257,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
                 extras["delta"] = tinygltf::Value(n.delta);
             } else if (n.bundleStep >= 1) {
                 extras["bundle_step"] = intValue(size_t(n.bundleStep));
-                extras["aggregate_level"] = tinygltf::Value(std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0));
+                extras["aggregate_level"] = tinygltf::Value(std::max(n.bundleLevel, 0));
                 extras["delta"] = tinygltf::Value(n.delta);
             } else {
                 extras["level"] = tinygltf::Value(n.firstLevel);
@@ -1278,7 +1278,8 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
             node.name = name;
             const int material = n.leaf || n.objectLod >= 1
                                      ? (n.leaf ? originalMaterial : 0)
-                                     : std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0);
+                                     : n.bundleStep >= 1 ? std::max(n.bundleLevel, 0)
+                                                         : std::max(nodes.nodes[aggregateBelow(nodes, uint32_t(i))].firstLevel, 0);
             if (n.meshPlace.kind == NodeMeshPlace::Kind::InNode) {
                 node.mesh = glb.addMeshDeferred(name, std::vector<double>(n.positions.begin(), n.positions.end()),
                                                 n.indices, material, &n.faceColors);

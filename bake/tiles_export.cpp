@@ -208,8 +208,8 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
         TileMesh tile;
         const bool objectLod = node.objectLod >= 1;
         // A coarser version takes the level (and tint) of the aggregate it simplifies, a bundle that
-        // of the aggregate above it.
-        const int level = std::max(nodes.nodes[aggregateBelow(nodes, n)].firstLevel, 0);
+        // of the aggregate it was made for.
+        const int level = std::max(node.bundleStep >= 1 ? node.bundleLevel : nodes.nodes[aggregateBelow(nodes, n)].firstLevel, 0);
         tile.name = node.leaf                ? "object_" + objects[n].name
                     : objectLod             ? "node" + std::to_string(n) + "_object_lod" + std::to_string(node.objectLod)
                     : node.coarserStep >= 1 ? "node" + std::to_string(n) + "_coarser" + std::to_string(node.coarserStep)

@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
+#include <utility>
 
 namespace aggrelod::detail {
 namespace {
@@ -20,18 +22,21 @@ constexpr size_t kWorthNumerator = 19, kWorthDenominator = 20;
 /// Most thresholds tried for one group.
 constexpr size_t kMaxThresholds = 256;
 
-double ownError(const HierarchyNode& n) { return n.leaf ? 0.0 : n.error.bound(); }
+/// A member of a chain: a node (below the node count) or a bundle made here (the node count
+/// plus its index in the list of all bundles planned).
+using Member = uint32_t;
 
-/// One child of a group: its chain from the top down to its end (an aggregate or a leaf).
+/// One child of a group: its chain from the top down to its end (an aggregate or a leaf, or
+/// the finest bundle of an aggregate whose children are all bundled).
 struct Chain {
-    std::vector<uint32_t> members;  ///< top first
-    double end = INFINITY;          ///< the smallest error of a member other than a leaf
+    std::vector<Member> members;  ///< top first
+    double end = INFINITY;        ///< the smallest error of a member other than a leaf
 };
 
-/// What a bundle draws for one chain: a node of the chain, or one version of each of the
+/// What a bundle draws for one chain: a member of the chain, or one version of each of the
 /// chain's objects.
 struct Piece {
-    uint32_t node = kNoNode;
+    Member member = kNoNode;
     std::vector<const HierarchyNode*> versions;
     size_t triangles = 0;
 };
@@ -39,23 +44,23 @@ struct Piece {
 struct Plan {
     uint32_t group = kNoNode;
     std::vector<Chain> chains;               ///< the bundled ones
-    std::vector<double> thresholds;          ///< of the bundles kept, finest first
-    std::vector<std::vector<Piece>> pieces;  ///< per bundle kept, one per chain
-    std::vector<uint32_t> newTops;           ///< per chain: its top below the finest bundle
+    std::vector<double> thresholds;          ///< of the bundles planned, finest first
+    std::vector<std::vector<Piece>> pieces;  ///< per bundle planned, one per chain
+    std::vector<ProxyError> errors;          ///< per bundle planned: the largest of its parts'
+    std::vector<Member> newTops;             ///< per chain: its top below the finest bundle
+    uint32_t firstBundle = 0;                ///< index of its finest bundle in the list of all
+    uint32_t kept = 0;                       ///< bundles left in the tree (the finest ones)
 };
 
-/// The lightest member of `chain` other than a leaf whose error (eff) is at most t; kNoNode for
-/// none. Ties: the one nearest the top.
-uint32_t lightestWithin(const Chain& chain, double t, const std::vector<double>& eff,
-                        const std::vector<HierarchyNode>& nodes) {
-    uint32_t best = kNoNode;
-    size_t bestTriangles = SIZE_MAX;
-    for (uint32_t m : chain.members) {
-        if (nodes[m].leaf || !(eff[m] <= t)) continue;
-        const size_t triangles = nodeTriangleCount(nodes[m]);
-        if (triangles < bestTriangles) best = m, bestTriangles = triangles;
-    }
-    return best;
+/// The bundle error of parts: the largest of their bounds, field by field. Nothing is measured
+/// on a bundle as a whole (a distance found on a part may be shorter to another part's
+/// objects): found 0, the whole bound as the gap.
+void addPartError(ProxyError& into, const ProxyError& part) {
+    into.proxyToOriginals = std::max(into.proxyToOriginals, part.proxyToOriginals);
+    into.originalsToProxy = std::max(into.originalsToProxy, part.originalsToProxy);
+    into.evaluationCount += part.evaluationCount;
+    into.tolerance = 0;
+    into.tolerance = into.bound();
 }
 
 /// The lightest version of `versions` whose error is at most t; null for none.
@@ -64,30 +69,6 @@ const HierarchyNode* lightestVersionWithin(const std::vector<HierarchyNode>& ver
     for (const HierarchyNode& v : versions)
         if (v.error.bound() <= t && (!best || v.indices.size() < best->indices.size())) best = &v;
     return best;
-}
-
-/// A chain's part at threshold t: its lightest node within t, or its objects' lightest
-/// versions within t when every object has one and they have fewer triangles in all.
-Piece pieceWithin(const Chain& chain, double t, const std::vector<double>& eff, const std::vector<HierarchyNode>& nodes,
-                  const std::vector<std::vector<HierarchyNode>>& versionsAbove) {
-    Piece piece;
-    piece.node = lightestWithin(chain, t, eff, nodes);
-    piece.triangles = nodeTriangleCount(nodes[piece.node]);
-    if (versionsAbove.empty()) return piece;
-    std::vector<const HierarchyNode*> versions;
-    size_t triangles = 0;
-    for (uint32_t o : nodes[chain.members.back()].sources) {
-        const HierarchyNode* v = lightestVersionWithin(versionsAbove[o], t);
-        if (!v) return piece;
-        versions.push_back(v);
-        triangles += v->indices.size() / 3;
-    }
-    if (triangles < piece.triangles) {
-        piece.node = kNoNode;
-        piece.versions = std::move(versions);
-        piece.triangles = triangles;
-    }
-    return piece;
 }
 
 /// Appends `mesh` (a node's, coloured or not) to `out`; white where it has no colours, when
@@ -106,6 +87,119 @@ bool hasColors(const HierarchyNode& m) {
     return m.meshPlace.kind == NodeMeshPlace::Kind::InNode ? !m.faceColors.empty() : m.meshPlace.hasFaceColors;
 }
 
+/// The bundles of a tree as they are planned: chains, pieces and errors of every group's.
+class Planner {
+public:
+    Planner(const std::vector<HierarchyNode>& nodes, const std::vector<std::vector<HierarchyNode>>& versionsAbove)
+        : nodes_(nodes), versionsAbove_(versionsAbove), count_(static_cast<uint32_t>(nodes.size())), eff_(count_, 0.0) {
+        // Error of a node as the cut sees it: the largest on its subtree (children come first).
+        for (uint32_t i = 0; i < count_; ++i) {
+            eff_[i] = nodes[i].leaf ? 0.0 : nodes[i].error.bound();
+            for (uint32_t c : nodes[i].children) eff_[i] = std::max(eff_[i], eff_[c]);
+        }
+    }
+
+    bool isBundle(Member m) const { return m >= count_; }
+    bool isLeaf(Member m) const { return !isBundle(m) && nodes_[m].leaf; }
+    double eff(Member m) const { return isBundle(m) ? bundleEff_[m - count_] : eff_[m]; }
+    size_t triangles(Member m) const { return isBundle(m) ? bundleTriangles_[m - count_] : nodeTriangleCount(nodes_[m]); }
+    /// The plan and step of bundle member m.
+    std::pair<uint32_t, uint32_t> bundleOf(Member m) const { return bundleAt_[m - count_]; }
+
+    /// Chain from child c of a group down: through coarser versions and per-object LODs, then
+    /// through the bundles of an aggregate whose children are all bundled (planned already:
+    /// children come first), coarsest first.
+    Chain chainFrom(uint32_t c, const std::vector<uint32_t>& planOf, const std::vector<Plan>& plans) const {
+        Chain chain;
+        for (uint32_t x = c;; x = nodes_[x].children.front()) {
+            chain.members.push_back(x);
+            if (!nodes_[x].leaf) chain.end = std::min(chain.end, eff_[x]);
+            const HierarchyNode& n = nodes_[x];
+            if (!n.leaf && (n.objectLod >= 1 || n.coarserStep >= 1) && n.children.size() == 1) continue;
+            if (planOf[x] != kNoNode && plans[planOf[x]].chains.size() == n.children.size()) {
+                const Plan& q = plans[planOf[x]];
+                for (size_t j = q.thresholds.size(); j-- > 0;) {
+                    const Member m = count_ + q.firstBundle + static_cast<uint32_t>(j);
+                    chain.members.push_back(m);
+                    chain.end = std::min(chain.end, eff(m));
+                }
+            }
+            return chain;
+        }
+    }
+
+    /// A chain's part at threshold t: its lightest member other than a leaf within t (ties: the
+    /// one nearest the top), or its objects' lightest versions within t when every object has
+    /// one and they have fewer triangles in all.
+    Piece pieceWithin(const Chain& chain, double t) const {
+        Piece piece;
+        piece.triangles = SIZE_MAX;
+        for (Member m : chain.members) {
+            if (isLeaf(m) || !(eff(m) <= t)) continue;
+            const size_t n = triangles(m);
+            if (n < piece.triangles) piece.member = m, piece.triangles = n;
+        }
+        if (versionsAbove_.empty()) return piece;
+        std::vector<const HierarchyNode*> versions;
+        size_t sum = 0;
+        for (uint32_t o : nodes_[chain.members.front()].sources) {
+            const HierarchyNode* v = lightestVersionWithin(versionsAbove_[o], t);
+            if (!v) return piece;
+            versions.push_back(v);
+            sum += v->indices.size() / 3;
+        }
+        if (sum < piece.triangles) {
+            piece.member = kNoNode;
+            piece.versions = std::move(versions);
+            piece.triangles = sum;
+        }
+        return piece;
+    }
+
+    /// The error of a piece: the largest of its parts' (a bundle member's parts, recursively).
+    ProxyError pieceError(const Piece& piece, const std::vector<Plan>& plans) const {
+        ProxyError e;
+        if (piece.member != kNoNode) {
+            if (isBundle(piece.member)) {
+                const auto [p, j] = bundleOf(piece.member);
+                addPartError(e, plans[p].errors[j]);
+            } else {
+                addPartError(e, nodes_[piece.member].error);
+            }
+        }
+        for (const HierarchyNode* v : piece.versions) addPartError(e, v->error);
+        return e;
+    }
+
+    /// Registers the bundles of plans[p] (its pieces, errors and new tops known).
+    void addBundles(std::vector<Plan>& plans, uint32_t p) {
+        Plan& plan = plans[p];
+        plan.firstBundle = static_cast<uint32_t>(bundleAt_.size());
+        plan.kept = static_cast<uint32_t>(plan.thresholds.size());
+        double below = 0;  // the largest error below the finest bundle: its new tops'
+        for (Member m : plan.newTops) below = std::max(below, eff(m));
+        for (uint32_t j = 0; j < plan.thresholds.size(); ++j) {
+            below = std::max(below, plan.errors[j].bound());
+            bundleEff_.push_back(below);
+            size_t n = 0;
+            for (const Piece& piece : plan.pieces[j]) n += piece.triangles;
+            bundleTriangles_.push_back(n);
+            bundleAt_.push_back({p, j});
+        }
+    }
+
+    uint32_t count() const { return count_; }
+
+private:
+    const std::vector<HierarchyNode>& nodes_;
+    const std::vector<std::vector<HierarchyNode>>& versionsAbove_;
+    uint32_t count_;
+    std::vector<double> eff_;
+    std::vector<double> bundleEff_;
+    std::vector<size_t> bundleTriangles_;
+    std::vector<std::pair<uint32_t, uint32_t>> bundleAt_;
+};
+
 }  // namespace
 
 bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& objects, const ProxySettings& settings,
@@ -114,15 +208,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
     if (settings.bundleCount <= 0) return true;
     std::vector<HierarchyNode>& nodes = tree.nodes;
     const uint32_t count = static_cast<uint32_t>(nodes.size());
-    // Error of a node as the cut sees it: the largest on its subtree (children come first).
-    std::vector<double> eff(count, 0.0);
-    for (uint32_t i = 0; i < count; ++i) {
-        eff[i] = ownError(nodes[i]);
-        for (uint32_t c : nodes[i].children) eff[i] = std::max(eff[i], eff[c]);
-    }
-    const auto isVersion = [&](const HierarchyNode& n) {
-        return !n.leaf && (n.objectLod >= 1 || n.coarserStep >= 1) && n.children.size() == 1;
-    };
+    Planner planner(nodes, versionsAbove);
     // Each object's box, for its groups' diagonals (a group's proxy may be out of memory).
     std::vector<std::array<double, 6>> objectBox(objects.size());
     for (size_t o = 0; o < objects.size(); ++o) {
@@ -133,8 +219,13 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 b[k] = std::min(b[k], objects[o].positions[v + k]), b[3 + k] = std::max(b[3 + k], objects[o].positions[v + k]);
     }
 
+    // Plans, children first. A member above a chain's new top leaves the tree: a node
+    // (absorbed, stood in for by the new top), or a bundle of a group whose chain this is
+    // (that group keeps only its bundles up to the new top, and leaves the tree itself).
     std::vector<Plan> plans;
     std::vector<uint32_t> planOf(count, kNoNode);
+    std::vector<char> absorbed(count, 0);
+    std::vector<Member> standIn(count, kNoNode);
     for (uint32_t g = 0; g < count; ++g) {
         const HierarchyNode& group = nodes[g];
         if (group.leaf || group.objectLod != 0 || group.coarserStep != 0 || group.sources.size() < 2 ||
@@ -145,14 +236,8 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         std::vector<Chain> chains;
         std::vector<double> ends;  // ascending, below
         for (uint32_t c : group.children) {
-            Chain chain;
-            for (uint32_t x = c;; x = nodes[x].children.front()) {
-                chain.members.push_back(x);
-                if (!nodes[x].leaf) chain.end = std::min(chain.end, eff[x]);
-                if (!isVersion(nodes[x])) break;
-            }
-            ends.push_back(chain.end);
-            chains.push_back(std::move(chain));
+            chains.push_back(planner.chainFrom(c, planOf, plans));
+            ends.push_back(chains.back().end);
         }
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (uint32_t o : group.sources)
@@ -169,21 +254,24 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
             for (double e : ends)
                 if (std::isfinite(e)) floor = std::max(floor, e);
         }
-        const double top = ownError(group);
+        const double top = group.error.bound();
         if (!(floor > 0 && floor < top)) continue;
         for (Chain& chain : chains)
             if (chain.end <= floor) plan.chains.push_back(std::move(chain));
         if (plan.chains.size() < 2) continue;
-        // Thresholds: where a bundled chain's lightest node changes, that is its nodes' errors
-        // (at most kMaxThresholds of them, evenly spread, for a group of many children).
+        // Thresholds: where a bundled chain's lightest part changes, that is its members' and
+        // its objects' versions' errors (at most kMaxThresholds of them, evenly spread, for a
+        // group of many children).
         std::vector<double> candidates{floor};
+        const auto candidate = [&](double e) {
+            if (e > floor && e < top) candidates.push_back(e);
+        };
         for (const Chain& chain : plan.chains) {
-            for (uint32_t m : chain.members)
-                if (!nodes[m].leaf && eff[m] > floor && eff[m] < top) candidates.push_back(eff[m]);
+            for (Member m : chain.members)
+                if (!planner.isLeaf(m)) candidate(planner.eff(m));
             if (versionsAbove.empty()) continue;
-            for (uint32_t o : nodes[chain.members.back()].sources)
-                for (const HierarchyNode& v : versionsAbove[o])
-                    if (v.error.bound() > floor && v.error.bound() < top) candidates.push_back(v.error.bound());
+            for (uint32_t o : nodes[chain.members.front()].sources)
+                for (const HierarchyNode& v : versionsAbove[o]) candidate(v.error.bound());
         }
         std::sort(candidates.begin(), candidates.end());
         candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
@@ -198,79 +286,93 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
             std::vector<Piece> pieces;
             size_t triangles = 0;
             for (const Chain& chain : plan.chains) {
-                pieces.push_back(pieceWithin(chain, t, eff, nodes, versionsAbove));
+                pieces.push_back(planner.pieceWithin(chain, t));
                 triangles += pieces.back().triangles;
             }
             if (triangles > settings.bundleMaxTriangles) continue;
             if (!plan.thresholds.empty() && kWorthDenominator * triangles > kWorthNumerator * lastTriangles) continue;
+            ProxyError e;
+            for (const Piece& piece : pieces) addPartError(e, planner.pieceError(piece, plans));
             plan.thresholds.push_back(t);
             plan.pieces.push_back(std::move(pieces));
+            plan.errors.push_back(e);
             lastTriangles = triangles;
         }
         if (plan.thresholds.empty()) continue;
         for (const Chain& chain : plan.chains) {
             size_t j = 0;  // the highest member within the finest threshold (one is: chain.end <= floor)
-            while (!(eff[chain.members[j]] <= plan.thresholds.front())) ++j;
-            plan.newTops.push_back(chain.members[j]);
+            while (!(planner.eff(chain.members[j]) <= plan.thresholds.front())) ++j;
+            const Member newTop = chain.members[j];
+            plan.newTops.push_back(newTop);
+            for (size_t k = 0; k < j; ++k) {
+                const Member m = chain.members[k];
+                if (!planner.isBundle(m)) {
+                    absorbed[m] = 1;
+                    standIn[m] = newTop;
+                } else {  // a bundle above the new top: its group keeps those below only
+                    const auto [q, step] = planner.bundleOf(m);
+                    plans[q].kept = std::min(plans[q].kept, step);
+                }
+            }
         }
         planOf[g] = static_cast<uint32_t>(plans.size());
         plans.push_back(std::move(plan));
+        planner.addBundles(plans, planOf[g]);
     }
     if (plans.empty()) return true;
-
-    // Chain nodes above a finest bundle's threshold leave the tree. An aggregate of one object
-    // that gave way to the object's chain is stood for by the chain's top (nodeOfAggregate):
-    // by its new top when that top goes.
-    std::vector<char> absorbed(count, 0);
-    std::vector<uint32_t> standIn(count, kNoNode);
-    std::vector<uint32_t> bundleAbove(count, kNoNode);  // new top -> its group's plan
+    std::vector<uint32_t> bundleAbove(count, kNoNode);  // new top (a node) -> the plan whose finest bundle is its parent
+    std::vector<uint32_t> bundleAboveBundle;           // per bundle: the same for a bundle that is a new top
+    bundleAboveBundle.assign(plans.back().firstBundle + plans.back().thresholds.size(), kNoNode);
     for (uint32_t p = 0; p < plans.size(); ++p)
-        for (size_t i = 0; i < plans[p].chains.size(); ++i) {
-            for (uint32_t m : plans[p].chains[i].members) {
-                if (m == plans[p].newTops[i]) break;
-                absorbed[m] = 1;
-                standIn[m] = plans[p].newTops[i];
-            }
-            bundleAbove[plans[p].newTops[i]] = p;
-        }
+        for (Member m : plans[p].newTops) (planner.isBundle(m) ? bundleAboveBundle[m - count] : bundleAbove[m]) = p;
 
-    // The bundles' meshes, made (and spilled) before the absorbed nodes go.
-    std::vector<std::vector<HierarchyNode>> bundles(plans.size());
+    // Materializes a piece into bundle b: each node part's mesh, a bundle member's parts
+    // recursively, each version.
     NodeMesh storage;
+    std::function<bool(const Piece&)> pieceHasColors = [&](const Piece& piece) {
+        for (const HierarchyNode* v : piece.versions)
+            if (!v->faceColors.empty()) return true;
+        if (piece.member == kNoNode) return false;
+        if (!planner.isBundle(piece.member)) return hasColors(nodes[piece.member]);
+        const auto [q, j] = planner.bundleOf(piece.member);
+        for (const Piece& sub : plans[q].pieces[j])
+            if (pieceHasColors(sub)) return true;
+        return false;
+    };
+    std::function<void(const Piece&, bool, HierarchyNode&)> appendPiece = [&](const Piece& piece, bool colored,
+                                                                               HierarchyNode& b) {
+        if (piece.member != kNoNode) {
+            if (planner.isBundle(piece.member)) {
+                const auto [q, j] = planner.bundleOf(piece.member);
+                for (const Piece& sub : plans[q].pieces[j]) appendPiece(sub, colored, b);
+            } else {
+                appendMesh(viewNodeMesh(tree, objects, piece.member, storage), colored, b);
+            }
+        }
+        for (const HierarchyNode* v : piece.versions) appendMesh(NodeMeshView{v->positions, v->indices, v->faceColors}, colored, b);
+    };
+    // The bundles left in the tree, made (and spilled) before the absorbed nodes go.
+    std::vector<std::vector<HierarchyNode>> bundles(plans.size());
     try {
         for (size_t p = 0; p < plans.size(); ++p) {
             const Plan& plan = plans[p];
             const HierarchyNode& group = nodes[plan.group];
-            for (size_t j = 0; j < plan.thresholds.size(); ++j) {
+            for (size_t j = 0; j < plan.kept; ++j) {
                 HierarchyNode b;
                 b.bundleStep = static_cast<int>(j) + 1;
+                b.bundleLevel = group.firstLevel;
                 for (const Chain& chain : plan.chains) {
-                    const HierarchyNode& end = nodes[chain.members.back()];
-                    b.sources.insert(b.sources.end(), end.sources.begin(), end.sources.end());
-                    b.exactTriangleCount += end.exactTriangleCount;
+                    const HierarchyNode& chainTop = nodes[chain.members.front()];
+                    b.sources.insert(b.sources.end(), chainTop.sources.begin(), chainTop.sources.end());
+                    b.exactTriangleCount += chainTop.exactTriangleCount;
                 }
                 std::sort(b.sources.begin(), b.sources.end());
                 b.delta = group.delta;
                 b.budget = plan.thresholds[j];
+                b.error = plan.errors[j];
                 bool colored = false;
-                for (const Piece& piece : plan.pieces[j]) {
-                    if (piece.node != kNoNode) colored = colored || hasColors(nodes[piece.node]);
-                    for (const HierarchyNode* v : piece.versions) colored = colored || !v->faceColors.empty();
-                }
-                const auto addPart = [&](const NodeMeshView& mesh, const ProxyError& e) {
-                    appendMesh(mesh, colored, b);
-                    b.error.proxyToOriginals = std::max(b.error.proxyToOriginals, e.proxyToOriginals);
-                    b.error.originalsToProxy = std::max(b.error.originalsToProxy, e.originalsToProxy);
-                    b.error.evaluationCount += e.evaluationCount;
-                };
-                for (const Piece& piece : plan.pieces[j]) {
-                    if (piece.node != kNoNode) addPart(viewNodeMesh(tree, objects, piece.node, storage), nodes[piece.node].error);
-                    for (const HierarchyNode* v : piece.versions)
-                        addPart(NodeMeshView{v->positions, v->indices, v->faceColors}, v->error);
-                }
-                // Nothing is measured on the bundle as a whole (a distance found on a part may
-                // be shorter to another part's objects): found 0, the whole bound as the gap.
-                b.error.tolerance = b.error.bound();
+                for (const Piece& piece : plan.pieces[j]) colored = colored || pieceHasColors(piece);
+                for (const Piece& piece : plan.pieces[j]) appendPiece(piece, colored, b);
                 if (spiller && !spiller->spill(b, plan.group, error)) return false;
                 bundles[p].push_back(std::move(b));
             }
@@ -280,32 +382,35 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         return false;
     }
 
-    // Renumbered: each group's bundles (finest first) just before it.
-    std::vector<uint32_t> newIndex(count, kNoNode);
+    // Renumbered: each group's bundles left (finest first) just before it (its descendants,
+    // the new tops below them included, come before it), also where the group itself goes.
+    std::vector<uint32_t> newIndex(count, kNoNode), bundleIndex(bundleAboveBundle.size(), kNoNode);
     uint32_t next = 0;
     for (uint32_t i = 0; i < count; ++i) {
-        if (absorbed[i]) continue;
-        if (planOf[i] != kNoNode) next += static_cast<uint32_t>(bundles[planOf[i]].size());
-        newIndex[i] = next++;
+        if (planOf[i] != kNoNode) {
+            const Plan& plan = plans[planOf[i]];
+            for (uint32_t j = 0; j < plan.kept; ++j) bundleIndex[plan.firstBundle + j] = next++;
+        }
+        if (!absorbed[i]) newIndex[i] = next++;
     }
+    const auto indexOf = [&](Member m) { return planner.isBundle(m) ? bundleIndex[m - count] : newIndex[m]; };
     std::vector<HierarchyNode> out(next);
     std::vector<uint32_t> parentOf(next, kNoNode);
     for (uint32_t i = 0; i < count; ++i) {
-        if (absorbed[i]) continue;
-        const uint32_t at = newIndex[i];
-        if (bundleAbove[i] != kNoNode) {
-            parentOf[at] = newIndex[plans[bundleAbove[i]].group] - static_cast<uint32_t>(bundles[bundleAbove[i]].size());
-        } else if (nodes[i].parent != kNoNode) {
-            parentOf[at] = newIndex[nodes[i].parent];
-        }
         if (planOf[i] != kNoNode) {
-            std::vector<HierarchyNode>& chain = bundles[planOf[i]];
-            const uint32_t first = at - static_cast<uint32_t>(chain.size());
-            for (size_t j = 0; j < chain.size(); ++j) {
-                out[first + j] = std::move(chain[j]);
-                parentOf[first + j] = first + static_cast<uint32_t>(j) + 1;  // the last one's: the group
+            const Plan& plan = plans[planOf[i]];
+            for (uint32_t j = 0; j < plan.kept; ++j) {
+                const uint32_t at = bundleIndex[plan.firstBundle + j];
+                out[at] = std::move(bundles[planOf[i]][j]);
+                if (j + 1 < plan.kept) parentOf[at] = at + 1;
+                else if (!absorbed[i]) parentOf[at] = newIndex[i];
+                else parentOf[at] = bundleIndex[plans[bundleAboveBundle[plan.firstBundle + j]].firstBundle];
             }
         }
+        if (absorbed[i]) continue;
+        const uint32_t at = newIndex[i];
+        if (bundleAbove[i] != kNoNode) parentOf[at] = bundleIndex[plans[bundleAbove[i]].firstBundle];
+        else if (nodes[i].parent != kNoNode) parentOf[at] = newIndex[nodes[i].parent];
         out[at] = std::move(nodes[i]);
     }
     tree.roots.clear();
@@ -318,7 +423,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         else out[parentOf[i]].children.push_back(i);
     }
     for (auto& level : tree.nodeOfAggregate)
-        for (uint32_t& i : level) i = newIndex[absorbed[i] ? standIn[i] : i];
+        for (uint32_t& i : level) i = absorbed[i] ? indexOf(standIn[i]) : newIndex[i];
     nodes = std::move(out);
     return true;
 }

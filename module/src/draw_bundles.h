@@ -20,21 +20,25 @@ namespace aggrelod::detail {
 /// afterwards.
 ///
 /// For an aggregate G of several objects with children c_1..c_k, each the top of a chain of
-/// single children (coarser versions, per-object LODs) ending at an aggregate or a leaf: a
-/// chain's end is the smallest error (the largest on the chain from a node down) of its nodes
-/// other than a leaf (an original is never a part: it need not be closed). The floor t_0 is
-/// settings.bundleMinErrorFraction * the diagonal of G's objects' box, and the chains ending at
-/// or below it are bundled (where fewer than two do, t_0 rises to the highest finite end and
-/// every chain with a finite end is). On thresholds from t_0 up to G's own error (the
-/// bundled chains' nodes' errors, at most 256 of them evenly spread), bundle B(t) merges, for every bundled chain, its lightest node other than a leaf whose error is at
-/// most t. The bundles kept are the finest one and each coarser one with at most 19/20 of the
-/// triangles of the last kept, at most settings.bundleCount, each of at most
-/// settings.bundleMaxTriangles triangles. They hang as a chain below G, finest lowest, the
-/// bundled children's chains below the finest, the other children beside the chain; the
-/// chain nodes above the finest bundle's threshold leave the tree (the bundles stand for
-/// them). Those chain nodes are drawn only where one pixel is at least the floor, so at
-/// least bundleMinErrorFraction of G's size, where one error over the bundled children
-/// costs about what one per child would.
+/// single children (coarser versions, per-object LODs) ending at a leaf or at an aggregate; an
+/// aggregate whose children are all bundled (planned first: children come first) continues
+/// the chain through its own bundles, coarsest first, down to its finest. A chain's end is
+/// the smallest error (the largest on the chain from a member down) of its members other
+/// than a leaf (an original is never a part: it need not be closed). The floor t_0 is
+/// settings.bundleMinErrorFraction * the diagonal of G's objects' box, and the chains ending
+/// at or below it are bundled (where fewer than two do, t_0 rises to the highest finite end
+/// and every chain with a finite end is). On thresholds from t_0 up to G's own error (the
+/// bundled chains' members' errors, at most 256 of them evenly spread), bundle B(t) merges,
+/// for every bundled chain, its lightest member other than a leaf whose error is at most t
+/// (a bundle member: its parts). The bundles kept are the finest one and each coarser one
+/// with at most 19/20 of the triangles of the last kept, at most settings.bundleCount, each
+/// of at most settings.bundleMaxTriangles triangles. They hang as a chain below G, finest
+/// lowest, the bundled children's chains below the finest, the other children beside the
+/// chain; the chain members above the finest bundle's threshold leave the tree (the bundles
+/// stand for them): nodes, and also a child aggregate with its bundles above that threshold,
+/// so that its finer bundles hang below G's finest. Those members are drawn only where one
+/// pixel is at least the floor, so at least bundleMinErrorFraction of G's size, where one
+/// error over the bundled children costs about what one per child would.
 ///
 /// A bundled chain's part may instead be its objects' own versions: versionsAbove[o] (empty, or
 /// one list per object, each version certified against object o alone) holds the versions of
@@ -47,7 +51,7 @@ namespace aggrelod::detail {
 /// objects, so the bound holds for all of them); its parts may overlap (a union of closed
 /// shells: closed and edge-manifold, not free of self-intersections). Its sources are its
 /// bundled children's objects. nodeOfAggregate and roots are renumbered (an entry on a
-/// removed chain node moves to the highest node left of that chain); aggregates keep their
+/// removed chain node moves to the highest member left of that chain); aggregates keep their
 /// order. With `spiller`, each bundle's mesh goes to it as soon as it is made. Deterministic.
 /// False with `error` when a mesh cannot be read back or spilled.
 bool addDrawBundles(HierarchyNodes& nodes, const std::vector<InputObject>& objects, const ProxySettings& settings,

@@ -194,8 +194,7 @@ bool exportHierarchyNodes(const HierarchyNodes& nodes, const std::vector<InputOb
         b.level = n.leaf ? runtime::kLeafLevel
                   : n.objectLod >= 1 ? runtime::kObjectLodLevel
                   : n.coarserStep >= 1 ? runtime::kCoarserLevel
-                  : n.bundleStep >= 1  ? runtime::kBundleLevelFlag |
-                                            static_cast<uint32_t>(nodes.nodes[aggregateBelow(nodes, static_cast<uint32_t>(i))].firstLevel)
+                  : n.bundleStep >= 1  ? runtime::kBundleLevelFlag | static_cast<uint32_t>(n.bundleLevel)
                                        : static_cast<uint32_t>(n.firstLevel);
         b.delta = static_cast<float>(n.delta);
         // Float-representable by construction (hierarchy_nodes.h): the casts are exact.

@@ -30,6 +30,19 @@ bool rayInRange(const float o[3], const float d[3], float maxDistance) {
 }
 }  // namespace
 
+namespace {
+/// Whether bundle `node` of level k stands for its level-k aggregate: that aggregate gave way
+/// to the bundles of a group above (the bundle's parent is neither a bundle of level k nor an
+/// aggregate of level k).
+bool bundleStandsForItsAggregate(const RuntimeFile& file, uint32_t node) {
+    const uint32_t level = file.node(node).level;
+    const uint32_t parent = file.node(node).parent;
+    if (parent == kNoIndex) return true;
+    const uint32_t above = file.node(parent).level;
+    return !(above == level || above == (level & ~kBundleLevelFlag));
+}
+}  // namespace
+
 void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out) {
     out.clear();
     // Leaves are finest, then the per-object LODs, then level 0: rank(leaf) = -2,
@@ -43,6 +56,8 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
     auto rank = [&](uint32_t node) -> int64_t {
         if (file.isLeaf(node)) return -2;
         if (file.isObjectLod(node)) return wanted == -1 ? -1 : std::numeric_limits<int64_t>::max();
+        if (file.isBundle(node) && bundleStandsForItsAggregate(file, node))
+            return rankOf(file.node(node).level & ~kBundleLevelFlag);
         if (file.isCoarser(node) || file.isBundle(node)) return std::numeric_limits<int64_t>::max();  // passed through
         return rankOf(file.node(node).level);
     };
@@ -61,9 +76,11 @@ void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& 
 
 std::vector<uint32_t> levelsOf(const RuntimeFile& file) {
     std::vector<uint32_t> levels;
-    for (uint32_t i = 0; i < file.nodeCount(); ++i)
+    for (uint32_t i = 0; i < file.nodeCount(); ++i) {
+        if (file.isBundle(i) && bundleStandsForItsAggregate(file, i)) levels.push_back(file.node(i).level & ~kBundleLevelFlag);
         if (!file.isLeaf(i) && !file.isObjectLod(i) && !file.isCoarser(i) && !file.isBundle(i))
             levels.push_back(file.node(i).level);
+    }
     std::sort(levels.begin(), levels.end());
     levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
     return levels;

@@ -238,38 +238,55 @@ TEST(RuntimeCollision, CutAtLevelRanksPerObjectLodsBetweenLeavesAndLevelZero) {
 }
 
 // Bundles are not a level: levelsOf leaves them out and a cut at a level passes through them.
+// A bundle below its own aggregate is passed through by a cut at a level; a bundle whose
+// aggregate gave way to the bundles of a group above stands for that aggregate at its level.
 TEST(RuntimeCollision, CutAtLevelPassesThroughBundles) {
-    BuildArrays p = makeSyntheticHierarchy(200, 7);
-    std::vector<uint8_t> plainBytes, bundledBytes;
+    const BuildArrays p = makeSyntheticHierarchy(200, 7);
     std::string error;
+    std::vector<uint8_t> plainBytes;
     ASSERT_TRUE(writeRuntimeFile(p, plainBytes, error)) << error;
-    const auto rankOf = [](uint32_t level) { return level == kLeafLevel ? -4 : 2 * int64_t(level); };
-    std::vector<uint32_t> bundled;
-    for (uint32_t i = 0; i < p.nodes.size(); ++i) {  // as RuntimeFormat.BundleLevelsAreAcceptedBetweenTheirLevels
-        NodeRecord& n = p.nodes[i];
-        if (n.level == kLeafLevel || n.level >= kMaxAggregateLevel || n.level == 0) continue;
-        bool fits = true;
-        for (uint32_t c = n.firstChild; c < n.firstChild + n.childCount; ++c)
-            fits = fits && rankOf(p.nodes[p.childIndices[c]].level) < 2 * int64_t(n.level) - 1;
-        if (!fits) continue;
-        n.level |= kBundleLevelFlag;
-        bundled.push_back(i);
-    }
-    ASSERT_FALSE(bundled.empty());
-    ASSERT_TRUE(writeRuntimeFile(p, bundledBytes, error)) << error;
-    RuntimeFile plain, bundles;
+    RuntimeFile plain;
     ASSERT_EQ(RuntimeFile::openMemory(plainBytes.data(), plainBytes.size(), plain, error), FileStatus::Ok) << error;
-    ASSERT_EQ(RuntimeFile::openMemory(bundledBytes.data(), bundledBytes.size(), bundles, error), FileStatus::Ok) << error;
-    for (uint32_t k : levelsOf(bundles)) EXPECT_FALSE(isBundleLevel(k));
-    for (uint32_t k : levelsOf(plain)) {
-        std::vector<uint32_t> cut;
-        cutAtLevel(bundles, k, cut);
-        size_t covered = 0;
-        for (uint32_t n : cut) {
-            EXPECT_FALSE(bundles.isBundle(n)) << "level " << k << " node " << n;
-            covered += bundles.sources(n).size;
+    const auto rankOf = [](uint32_t level) { return level == kLeafLevel ? -4 : 2 * int64_t(level); };
+    // Nodes that can be a bundle of level k (every child ranks below 2k - 1), k = the node's
+    // parent's level (a bundle below its aggregate) or the node's own (standing for it).
+    const auto relabel = [&](bool ownLevel, BuildArrays& q) {
+        size_t count = 0;
+        for (uint32_t i = static_cast<uint32_t>(q.nodes.size()); i-- > 0;) {  // parents first
+            NodeRecord& n = q.nodes[i];
+            if (n.level == kLeafLevel || n.level >= kMaxAggregateLevel || n.parent == kNoIndex) continue;
+            const uint32_t k = ownLevel ? n.level : p.nodes[n.parent].level;
+            if (k == 0 || k >= kMaxAggregateLevel) continue;
+            bool fits = true;
+            for (uint32_t c = n.firstChild; c < n.firstChild + n.childCount; ++c)
+                fits = fits && rankOf(p.nodes[p.childIndices[c]].level) < 2 * int64_t(k) - 1;
+            if (!fits || (!ownLevel && isBundleLevel(q.nodes[n.parent].level))) continue;
+            n.level = kBundleLevelFlag | k;
+            ++count;
         }
-        EXPECT_EQ(covered, bundles.objectCount()) << "level " << k;
+        return count;
+    };
+    for (bool ownLevel : {false, true}) {
+        BuildArrays q = p;
+        ASSERT_GT(relabel(ownLevel, q), 0u);
+        std::vector<uint8_t> bytes;
+        ASSERT_TRUE(writeRuntimeFile(q, bytes, error)) << error;
+        RuntimeFile bundles;
+        ASSERT_EQ(RuntimeFile::openMemory(bytes.data(), bytes.size(), bundles, error), FileStatus::Ok) << error;
+        if (ownLevel) EXPECT_EQ(levelsOf(bundles), levelsOf(plain));  // each level stood for
+        for (uint32_t k : levelsOf(bundles)) EXPECT_FALSE(isBundleLevel(k));
+        for (uint32_t k : levelsOf(plain)) {
+            std::vector<uint32_t> cut, plainCut;
+            cutAtLevel(bundles, k, cut);
+            cutAtLevel(plain, k, plainCut);
+            if (ownLevel) EXPECT_EQ(cut, plainCut) << "level " << k;  // the bundles stand where their aggregates stood
+            size_t covered = 0;
+            for (uint32_t n : cut) {
+                if (!ownLevel) EXPECT_FALSE(bundles.isBundle(n)) << "level " << k << " node " << n;
+                covered += bundles.sources(n).size;
+            }
+            EXPECT_EQ(covered, bundles.objectCount()) << "level " << k;
+        }
     }
 }
 

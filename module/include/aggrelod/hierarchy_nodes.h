@@ -147,8 +147,10 @@ struct HierarchyNode {
     /// one mesh, error between theirs and the aggregate's (ProxySettings::bundleCount). sources
     /// are the bundled children's objects, delta is the aggregate's, firstLevel and lastLevel
     /// are -1. Its shells are its parts' (closed proxies, never originals) and may overlap one
-    /// another.
+    /// another. An aggregate whose children are all bundled may give way to the bundles of the
+    /// group above: its finer bundles then hang below that group's finest.
     int bundleStep = 0;
+    int bundleLevel = -1;              ///< bundles: the first level of the aggregate they were made for
     int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
     int lastLevel = -1;                ///<   this aggregate stands for; -1 for leaves
     uint32_t aggregateIndex = 0;       ///< index in levels[firstLevel].aggregates (aggregates only)

@@ -29,11 +29,14 @@ struct CollisionHit {
 /// finer than level 0. kLeafLevel gives the originals; kObjectLodLevel the coarsest
 /// per-object LOD of each object (its leaf when it has none); a level k >= 0 never gives a
 /// per-object LOD node (they hang below the level-0 aggregates; the walk would pass through
-/// one to its leaf).
+/// one to its leaf). Coarser versions and bundles are passed through, except the coarsest
+/// bundle left of a level-k aggregate that gave way to the bundles of a group above (its
+/// parent is a bundle of another level): it stands for that aggregate at level k.
 /// `out` is resized to the cut (node indices, increasing).
 void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out);
 
-/// Aggregate levels present in the file, increasing (neither kLeafLevel nor kObjectLodLevel).
+/// Aggregate levels present in the file (by their aggregates, or by bundles standing for them:
+/// cutAtLevel), increasing (neither kLeafLevel nor kObjectLodLevel).
 std::vector<uint32_t> levelsOf(const RuntimeFile& file);
 
 /// An Embree scene over a cut: the cut's node meshes merged into one Embree geometry (rebuilt,

@@ -62,13 +62,15 @@ constexpr uint32_t kCoarserLevel = 0xFFFDu;
 /// Aggregate levels are < kMaxAggregateLevel; larger values other than the two above and the
 /// bundle levels below are refused.
 constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
-/// Level of a bundle: kBundleLevelFlag | k, k the level of the aggregate above its chain of
-/// bundles (k < kMaxAggregateLevel). A bundle is the drawn versions of that aggregate's
-/// children merged into one mesh, so that a distant group costs one draw call: same objects,
-/// error between the children's and the aggregate's. It ranks between levels k - 1 and k; a
-/// bundle may stand under another of the same level. No level of its own: a cut at a level
-/// passes through it (cutAtLevel), levelsOf does not list it; selection by screen-space error
-/// draws it.
+/// Level of a bundle: kBundleLevelFlag | k, k the level of the aggregate it was made for
+/// (k < kMaxAggregateLevel). A bundle is the drawn versions of that aggregate's children
+/// merged into one mesh, so that a distant group costs one draw call: same objects, error
+/// between the children's and the aggregate's. The bundles of an aggregate form a chain below
+/// it; an aggregate whose children are all bundled may give way to the bundles of a group
+/// above, its finer bundles then hang below that group's finest. A bundle ranks between levels
+/// k - 1 and k; a bundle may stand under another of the same level. No level of its own: a cut
+/// at a level passes through it (cutAtLevel) unless it stands for an aggregate that gave way,
+/// levelsOf lists no level for it otherwise; selection by screen-space error draws it.
 constexpr uint32_t kBundleLevelFlag = 0x10000u;
 /// True for a bundle's level (kBundleLevelFlag | k with k < kMaxAggregateLevel).
 constexpr bool isBundleLevel(uint32_t level) {

@@ -102,8 +102,8 @@ public:
     bool isObjectLod(uint32_t node) const { return nodes_.data[node].level == kObjectLodLevel; }
     /// A coarser version of the aggregate below it (level kCoarserLevel), not a level of its own.
     bool isCoarser(uint32_t node) const { return nodes_.data[node].level == kCoarserLevel; }
-    /// A bundle (level kBundleLevelFlag | k): the drawn versions of the aggregate above it
-    /// merged into one mesh, not a level of its own.
+    /// A bundle (level kBundleLevelFlag | k): the drawn versions of a level-k aggregate's
+    /// children merged into one mesh, not a level of its own.
     bool isBundle(uint32_t node) const { return isBundleLevel(nodes_.data[node].level); }
     /// The whole source-object array (NodeRecord::firstSource indexes it).
     Span<uint32_t> allSourceObjects() const { return sourceObjects_; }
