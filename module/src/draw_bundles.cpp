@@ -67,7 +67,7 @@ void addPartError(ProxyError& into, const ProxyError& part) {
 const HierarchyNode* lightestVersionWithin(const std::vector<HierarchyNode>& versions, double t) {
     const HierarchyNode* best = nullptr;
     for (const HierarchyNode& v : versions)
-        if (v.error.bound() <= t && (!best || v.indices.size() < best->indices.size())) best = &v;
+        if (v.error.bound() <= t && (!best || nodeTriangleCount(v) < nodeTriangleCount(*best))) best = &v;
     return best;
 }
 
@@ -146,7 +146,7 @@ public:
             const HierarchyNode* v = lightestVersionWithin(versionsAbove_[o], t);
             if (!v) return piece;
             versions.push_back(v);
-            sum += v->indices.size() / 3;
+            sum += nodeTriangleCount(*v);
         }
         if (sum < piece.triangles) {
             piece.member = kNoNode;
@@ -331,7 +331,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
     NodeMesh storage;
     std::function<bool(const Piece&)> pieceHasColors = [&](const Piece& piece) {
         for (const HierarchyNode* v : piece.versions)
-            if (!v->faceColors.empty()) return true;
+            if (hasColors(*v)) return true;
         if (piece.member == kNoNode) return false;
         if (!planner.isBundle(piece.member)) return hasColors(nodes[piece.member]);
         const auto [q, j] = planner.bundleOf(piece.member);
@@ -349,7 +349,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 appendMesh(viewNodeMesh(tree, objects, piece.member, storage), colored, b);
             }
         }
-        for (const HierarchyNode* v : piece.versions) appendMesh(NodeMeshView{v->positions, v->indices, v->faceColors}, colored, b);
+        for (const HierarchyNode* v : piece.versions) appendMesh(viewDetachedNodeMesh(tree, *v, storage), colored, b);
     };
     // The bundles left in the tree, made (and spilled) before the absorbed nodes go.
     std::vector<std::vector<HierarchyNode>> bundles(plans.size());

@@ -41,8 +41,8 @@ namespace aggrelod::detail {
 /// error over the bundled children costs about what one per child would.
 ///
 /// A bundled chain's part may instead be its objects' own versions: versionsAbove[o] (empty, or
-/// one list per object, each version certified against object o alone) holds the versions of
-/// object o above its per-object LOD chain; at threshold t, where every object of a chain has
+/// one list per object, each version certified against object o alone, its mesh in the node or
+/// in nodes.meshFile) holds the versions of object o above its per-object LOD chain; at threshold t, where every object of a chain has
 /// one within t, the lightest of each together are the chain's part when they have fewer
 /// triangles than its lightest node within t (a group's versions keep the fill between its
 /// objects, the objects' do not), and their errors are thresholds too.

@@ -554,8 +554,7 @@ std::vector<HierarchyNode> chainFromLadder(const VersionLadder& ladder, uint32_t
 /// (lightestChain) through its versions whose error is at least `ceiling` (the chain's) and
 /// below `reach` (the error of the root above it). Ascending by error.
 std::vector<HierarchyNode> versionsAboveChain(const VersionLadder& ladder, const std::vector<HierarchyNode>& chain,
-                                              uint32_t objectIndex, double ceiling, double reach,
-                                              const ProxySettings& settings) {
+                                              double ceiling, double reach, const ProxySettings& settings) {
     std::vector<HierarchyNode> candidates;
     for (const Version& v : ladder.versions) {
         const double e = v.node.error.bound();
@@ -567,10 +566,6 @@ std::vector<HierarchyNode> versionsAboveChain(const VersionLadder& ladder, const
                                           chain.empty() ? ladder.objectTriangles : chain.back().indices.size() / 3,
                                           settings.objectLodCount))
         above.push_back(std::move(n));
-    for (HierarchyNode& n : above) {
-        n.sources = {objectIndex};
-        n.exactTriangleCount = ladder.objectTriangles;
-    }
     return above;
 }
 
@@ -1387,12 +1382,16 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         while (nodes[top].parent != kNoNode) top = nodes[top].parent;
         return top == o ? 0.0 : nodes[top].error.bound();
     };
+    // Spilling, they go to the spill file at once: they would otherwise stay in memory through
+    // the largest moment of the stage, when every other mesh is made and not yet spilled.
+    const bool spilling = !settings.meshSpillPath.empty();
+    detail::NodeMeshSpiller spiller;
+    if (spilling && !versionsAbove.empty() && !spiller.open(settings.meshSpillPath, reloadError)) return finish(false);
     detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
         if (ladders[o].versions.empty()) return;
         std::vector<HierarchyNode> chain = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceilingOfChain(o), settings);
         if (!versionsAbove.empty())
-            versionsAbove[o] = versionsAboveChain(ladders[o], chain, static_cast<uint32_t>(o), ceilingOfChain(o), reachOf(o),
-                                                  settings);
+            versionsAbove[o] = versionsAboveChain(ladders[o], chain, ceilingOfChain(o), reachOf(o), settings);
         // A ladder read without its exact vertices has given all it can: coarser versions to
         // be made read it again whole, each for itself, so it need not be held beside its chain.
         if (!ladderWhole[o]) ladders[o] = VersionLadder{};
@@ -1409,6 +1408,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         colorAndOrder(chains[o]);
         if (!versionsAbove.empty()) colorAndOrder(versionsAbove[o]);
     });
+    if (spiller.file())
+        for (size_t o = 0; o < versionsAbove.size(); ++o)
+            for (HierarchyNode& v : versionsAbove[o])
+                if (!spiller.spill(v, static_cast<uint32_t>(o), reloadError)) return finish(false);
     std::vector<char> dropped(nodes.size(), 0);
     std::vector<uint32_t> keptSingles;
     for (uint32_t i : singleNodes) {
@@ -1524,10 +1527,8 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
 
     // Every mesh made to a spill file now, if asked: the tree is put together and its bounds
     // computed without them in memory (ProxySettings::meshSpillPath).
-    const bool spilling = !settings.meshSpillPath.empty();
-    detail::NodeMeshSpiller spiller;
     if (spilling) {
-        bool spilled = spiller.open(settings.meshSpillPath, reloadError);
+        bool spilled = spiller.file() || spiller.open(settings.meshSpillPath, reloadError);
         for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
             HierarchyNode& n = nodes[o];
             if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;

@@ -180,6 +180,35 @@ bool spillNodeMeshes(HierarchyNodes& nodes, const std::vector<InputObject>& obje
     return true;
 }
 
+namespace {
+
+/// A mesh at `place` in nodes.meshFile (`name` for messages).
+bool readFromSpillFile(const HierarchyNodes& nodes, const NodeMeshPlace& place, const std::string& name, NodeMesh& out,
+                       std::string& error) {
+    if (!nodes.meshFile) {
+        error = name + ": its mesh was spilled, but the spill file is gone";
+        return false;
+    }
+    out.positions.resize(3 * size_t(place.vertexCount));
+    out.indices.resize(3 * size_t(place.triangleCount));
+    out.faceColors.resize(place.hasFaceColors ? 4 * size_t(place.triangleCount) : 0);
+    if (!nodes.meshFile->read(place.offset, out.positions.data(), 4 * out.positions.size(), out.indices.data(),
+                              4 * out.indices.size(), out.faceColors.data(), 4 * out.faceColors.size())) {
+        error = nodes.meshFile->path() + ": " + name + "'s mesh cannot be read back";
+        out = NodeMesh{};
+        return false;
+    }
+    for (uint32_t v : out.indices)
+        if (v >= place.vertexCount) {
+            error = nodes.meshFile->path() + ": " + name + "'s mesh read back is damaged";
+            out = NodeMesh{};
+            return false;
+        }
+    return true;
+}
+
+}  // namespace
+
 bool readNodeMesh(const HierarchyNodes& nodes, const std::vector<InputObject>& objects, uint32_t node, NodeMesh& out,
                   std::string& error) {
     out = NodeMesh{};
@@ -207,28 +236,8 @@ bool readNodeMesh(const HierarchyNodes& nodes, const std::vector<InputObject>& o
             if (place.hasFaceColors) out.faceColors = o.triangleColors;
             return true;
         }
-        case NodeMeshPlace::Kind::File: {
-            if (!nodes.meshFile) {
-                error = "node " + std::to_string(node) + ": its mesh was spilled, but the spill file is gone";
-                return false;
-            }
-            out.positions.resize(3 * size_t(place.vertexCount));
-            out.indices.resize(3 * size_t(place.triangleCount));
-            out.faceColors.resize(place.hasFaceColors ? 4 * size_t(place.triangleCount) : 0);
-            if (!nodes.meshFile->read(place.offset, out.positions.data(), 4 * out.positions.size(), out.indices.data(),
-                                      4 * out.indices.size(), out.faceColors.data(), 4 * out.faceColors.size())) {
-                error = nodes.meshFile->path() + ": node " + std::to_string(node) + "'s mesh cannot be read back";
-                out = NodeMesh{};
-                return false;
-            }
-            for (uint32_t v : out.indices)
-                if (v >= place.vertexCount) {
-                    error = nodes.meshFile->path() + ": node " + std::to_string(node) + "'s mesh read back is damaged";
-                    out = NodeMesh{};
-                    return false;
-                }
-            return true;
-        }
+        case NodeMeshPlace::Kind::File:
+            return readFromSpillFile(nodes, place, "node " + std::to_string(node), out, error);
     }
     error = "node " + std::to_string(node) + ": unknown mesh place";
     return false;
@@ -244,5 +253,18 @@ NodeMeshView viewNodeMesh(const HierarchyNodes& nodes, const std::vector<InputOb
     if (!readNodeMesh(nodes, objects, node, storage, error)) throw std::runtime_error(error);
     return {storage.positions, storage.indices, storage.faceColors};
 }
+
+namespace detail {
+
+NodeMeshView viewDetachedNodeMesh(const HierarchyNodes& nodes, const HierarchyNode& n, NodeMesh& storage) {
+    if (n.meshPlace.kind == NodeMeshPlace::Kind::InNode) return {n.positions, n.indices, n.faceColors};
+    std::string error = "a mesh kept out of the tree refers to an object";
+    if (n.meshPlace.kind != NodeMeshPlace::Kind::File ||
+        !readFromSpillFile(nodes, n.meshPlace, "a mesh kept out of the tree", storage, error))
+        throw std::runtime_error(error);
+    return {storage.positions, storage.indices, storage.faceColors};
+}
+
+}  // namespace detail
 
 }  // namespace aggrelod

@@ -16,6 +16,10 @@ namespace aggrelod::detail {
 /// object's counts, coloured where it has per-triangle colours.
 NodeMeshPlace objectMeshPlace(const InputObject& object);
 
+/// The mesh of a node that is not in nodes.nodes (a version kept aside), in the node or in
+/// nodes.meshFile (read back into `storage`). Throws std::runtime_error when it cannot be read.
+NodeMeshView viewDetachedNodeMesh(const HierarchyNodes& nodes, const HierarchyNode& n, NodeMesh& storage);
+
 class NodeMeshSpiller {
 public:
     /// A new spill file at `path` (removed when the last holder of file() goes).
