@@ -28,9 +28,7 @@ bool rayInRange(const float o[3], const float d[3], float maxDistance) {
         if (!(std::fabs(o[k]) <= kLimit) || !(std::fabs(d[k]) <= kLimit)) return false;
     return maxDistance >= 0;  // +inf allowed, NaN not
 }
-}  // namespace
 
-namespace {
 /// Whether bundle `node` of level k stands for its level-k aggregate: that aggregate gave way
 /// to the bundles of a group above (the bundle's parent is neither a bundle of level k nor an
 /// aggregate of level k).
