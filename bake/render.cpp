@@ -197,8 +197,13 @@ bool RenderScene::open(const std::string& path, std::string& error) {
         panel.level = level;
         runtime::cutAtLevel(file_, level, panel.nodes);
         double delta = 0;
-        for (uint32_t n : panel.nodes)
-            if (!file_.isLeaf(n) && file_.node(n).level == level) delta = file_.node(n).delta;
+        for (uint32_t n : panel.nodes) {
+            // The level's aggregates, or bundles standing for those that gave way (the cut
+            // passes through every other bundle).
+            const uint32_t l = file_.node(n).level;
+            if (!file_.isLeaf(n) && (l == level || (runtime::isBundleLevel(l) && (l & ~runtime::kBundleLevelFlag) == level)))
+                delta = file_.node(n).delta;
+        }
         panel.label = "LEVEL " + std::to_string(level) + "  DELTA " + formatDelta(delta);
         panels_.push_back(std::move(panel));
     }

@@ -188,8 +188,6 @@ public:
         }
     }
 
-    uint32_t count() const { return count_; }
-
 private:
     const std::vector<HierarchyNode>& nodes_;
     const std::vector<std::vector<HierarchyNode>>& versionsAbove_;
@@ -320,11 +318,10 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         planner.addBundles(plans, planOf[g]);
     }
     if (plans.empty()) return true;
-    std::vector<uint32_t> bundleAbove(count, kNoNode);  // new top (a node) -> the plan whose finest bundle is its parent
-    std::vector<uint32_t> bundleAboveBundle;           // per bundle: the same for a bundle that is a new top
-    bundleAboveBundle.assign(plans.back().firstBundle + plans.back().thresholds.size(), kNoNode);
+    const size_t allBundles = plans.back().firstBundle + plans.back().thresholds.size();
+    std::vector<uint32_t> planAbove(count + allBundles, kNoNode);  // per new top: the plan whose finest bundle is its parent
     for (uint32_t p = 0; p < plans.size(); ++p)
-        for (Member m : plans[p].newTops) (planner.isBundle(m) ? bundleAboveBundle[m - count] : bundleAbove[m]) = p;
+        for (Member m : plans[p].newTops) planAbove[m] = p;
 
     // Materializes a piece into bundle b: each node part's mesh, a bundle member's parts
     // recursively, each version.
@@ -384,7 +381,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
 
     // Renumbered: each group's bundles left (finest first) just before it (its descendants,
     // the new tops below them included, come before it), also where the group itself goes.
-    std::vector<uint32_t> newIndex(count, kNoNode), bundleIndex(bundleAboveBundle.size(), kNoNode);
+    std::vector<uint32_t> newIndex(count, kNoNode), bundleIndex(allBundles, kNoNode);
     uint32_t next = 0;
     for (uint32_t i = 0; i < count; ++i) {
         if (planOf[i] != kNoNode) {
@@ -404,12 +401,12 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 out[at] = std::move(bundles[planOf[i]][j]);
                 if (j + 1 < plan.kept) parentOf[at] = at + 1;
                 else if (!absorbed[i]) parentOf[at] = newIndex[i];
-                else parentOf[at] = bundleIndex[plans[bundleAboveBundle[plan.firstBundle + j]].firstBundle];
+                else parentOf[at] = bundleIndex[plans[planAbove[count + plan.firstBundle + j]].firstBundle];
             }
         }
         if (absorbed[i]) continue;
         const uint32_t at = newIndex[i];
-        if (bundleAbove[i] != kNoNode) parentOf[at] = bundleIndex[plans[bundleAbove[i]].firstBundle];
+        if (planAbove[i] != kNoNode) parentOf[at] = bundleIndex[plans[planAbove[i]].firstBundle];
         else if (nodes[i].parent != kNoNode) parentOf[at] = newIndex[nodes[i].parent];
         out[at] = std::move(nodes[i]);
     }

@@ -549,10 +549,10 @@ std::vector<HierarchyNode> chainFromLadder(const VersionLadder& ladder, uint32_t
     return chain;
 }
 
-/// An object's versions for the bundles of the groups holding it (draw_bundles.h): the
-/// coarsest version of its per-object LOD chain `chain` (finest first), then the lightest chain
-/// (lightestChain) through its versions whose error is at least `ceiling` (the chain's) and
-/// below `reach` (the error of the root above it). Ascending by error.
+/// An object's versions above its per-object LOD chain `chain` (finest first), for the bundles
+/// of the groups holding it (draw_bundles.h): the lightest chain (lightestChain) through its
+/// versions whose error is at least `ceiling` (the chain's) and below `reach` (the error of the
+/// root above it). Ascending by error.
 std::vector<HierarchyNode> versionsAboveChain(const VersionLadder& ladder, const std::vector<HierarchyNode>& chain,
                                               double ceiling, double reach, const ProxySettings& settings) {
     std::vector<HierarchyNode> candidates;
@@ -560,13 +560,8 @@ std::vector<HierarchyNode> versionsAboveChain(const VersionLadder& ladder, const
         const double e = v.node.error.bound();
         if (e >= ceiling && e < reach) candidates.push_back(v.node);
     }
-    std::vector<HierarchyNode> above;
-    if (!chain.empty()) above.push_back(chain.back());
-    for (HierarchyNode& n : lightestChain(std::move(candidates),
-                                          chain.empty() ? ladder.objectTriangles : chain.back().indices.size() / 3,
-                                          settings.objectLodCount))
-        above.push_back(std::move(n));
-    return above;
+    return lightestChain(std::move(candidates), chain.empty() ? ladder.objectTriangles : chain.back().indices.size() / 3,
+                         settings.objectLodCount);
 }
 
 /// Most objects a group may hold for its coarser versions to be tried as unions of its
@@ -1374,8 +1369,9 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // alone (the object with its concavities filled), up to its first aggregate with other
     // objects; those single-object aggregates stay only where the object has no chain.
     std::vector<std::vector<HierarchyNode>> chains(objectCount);
-    // Each object's versions above its chain, up to its root's error: the bundles of its groups
-    // may draw them instead of the groups' own versions (draw_bundles.h).
+    // Each object's versions above its chain, up to its root's error, and its chain's coarsest:
+    // the bundles of its groups may draw them instead of the groups' own versions
+    // (draw_bundles.h).
     std::vector<std::vector<HierarchyNode>> versionsAbove(share || settings.bundleCount <= 0 ? 0 : objectCount);
     const auto reachOf = [&](size_t o) {
         uint32_t top = static_cast<uint32_t>(o);
@@ -1406,7 +1402,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             }
         };
         colorAndOrder(chains[o]);
-        if (!versionsAbove.empty()) colorAndOrder(versionsAbove[o]);
+        if (versionsAbove.empty()) return;
+        colorAndOrder(versionsAbove[o]);
+        // The chain's coarsest version first: bundles may draw it too (coloured once, copied).
+        if (!chains[o].empty()) versionsAbove[o].insert(versionsAbove[o].begin(), chains[o].back());
     });
     if (spiller.file())
         for (size_t o = 0; o < versionsAbove.size(); ++o)

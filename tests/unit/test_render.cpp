@@ -207,6 +207,8 @@ TEST(Render, SheetHasOnePanelPerLevel) {
         render::RenderScene scene;
         ASSERT_TRUE(scene.open(c.input.string(), message)) << message;
         EXPECT_EQ(scene.panels().size(), c.panels) << c.input;
+        for (const render::Panel& p : scene.panels())  // every level's delta, also where bundles stand for it
+            if (p.label.rfind("LEVEL ", 0) == 0 && p.level >= 1) EXPECT_NE(p.label.substr(p.label.size() - 7), "DELTA 0") << p.label;
         const fs::path out = dir / (c.input.stem().string() + ".png");
         const auto r = runProgram({AGGRELOD_CLI, "render", c.input.string(), "--sheet", "--size", "64x48", "--columns",
                                    "3", "-o", out.string()},
