@@ -2,7 +2,8 @@
 // aggrelod reproduce-planning: the paper's motion-planning experiment (Section 4.3, Fig. 7) as a
 // command. On the five 2D environments (aggregated here, 6 automatic levels) and on the 3D
 // forest, village and a 1000-object random scene (baked with `aggrelod bake`, 8 automatic
-// levels), seeded random start / goal pairs free for the originals; each pair planned with the
+// levels, without bundles: a group's bundle may stand for it at its level, and the planner
+// wants the aggregates there), seeded random start / goal pairs free for the originals; each pair planned with the
 // same OMPL LazyPRM on the originals, with the hierarchy, and at each fixed level. Writes
 // planning.md, planning.csv and one Fig. 7-style picture per environment (the first query,
 // hierarchy strategy). Table contents depend on timing (time-limited planning); the queries,
@@ -187,7 +188,7 @@ int runReproducePlanning(const ReproducePlanningOptions& o) {
                 }
                 if (!o.quiet) std::fprintf(stderr, "reproduce-planning: baking %s (%zu objects)\n", env.name.c_str(), objs.size());
                 const std::string cmd = quoteShell(self.string()) + " bake " + quoteShell(glb.string()) + " -o " +
-                                        quoteShell(dir.string()) + " --quiet";
+                                        quoteShell(dir.string()) + " --bundles 0 --quiet";
                 if (std::system(cmd.c_str()) != 0 || !fs::exists(aglod)) {
                     std::fprintf(stderr, "aggrelod: error: %s: the bake failed\n", env.name.c_str());
                     return 3;

@@ -17,8 +17,10 @@
 namespace aggrelod::detail {
 namespace {
 
-/// A kept bundle is lighter than the finer one kept before it by at least this share.
-constexpr size_t kWorthNumerator = 19, kWorthDenominator = 20;
+/// A kept bundle that holds no more children than the finer one kept before it has at most
+/// this share of its triangles (as the per-object chains: denser chains use up
+/// ProxySettings::bundleCount before the coarse end, where a distant group is drawn).
+constexpr size_t kWorthNumerator = 9, kWorthDenominator = 10;
 /// Most thresholds tried for one group.
 constexpr size_t kMaxThresholds = 256;
 
@@ -44,10 +46,11 @@ struct Piece {
 struct Plan {
     uint32_t group = kNoNode;
     std::vector<Chain> chains;               ///< the bundled ones
+    std::vector<uint32_t> joins;             ///< per chain: the finest bundle holding it
     std::vector<double> thresholds;          ///< of the bundles planned, finest first
-    std::vector<std::vector<Piece>> pieces;  ///< per bundle planned, one per chain
+    std::vector<std::vector<Piece>> pieces;  ///< per bundle planned, one per chain (empty before it joins)
     std::vector<ProxyError> errors;          ///< per bundle planned: the largest of its parts'
-    std::vector<Member> newTops;             ///< per chain: its top below the finest bundle
+    std::vector<Member> newTops;             ///< per chain: its top below the bundle it joins
     uint32_t firstBundle = 0;                ///< index of its finest bundle in the list of all
     uint32_t kept = 0;                       ///< bundles left in the tree (the finest ones)
 };
@@ -106,19 +109,24 @@ public:
     /// The plan and step of bundle member m.
     std::pair<uint32_t, uint32_t> bundleOf(Member m) const { return bundleAt_[m - count_]; }
 
-    /// Chain from child c of a group down: through coarser versions and per-object LODs, then
-    /// through the bundles of an aggregate whose children are all bundled (planned already:
-    /// children come first), coarsest first.
+    /// Chain from child c of a group down: through coarser versions, per-object LODs and
+    /// aggregates of one child, then through the bundles of an aggregate whose children all
+    /// joined its bundles (planned already: children come first), coarsest first.
     Chain chainFrom(uint32_t c, const std::vector<uint32_t>& planOf, const std::vector<Plan>& plans) const {
         Chain chain;
         for (uint32_t x = c;; x = nodes_[x].children.front()) {
             chain.members.push_back(x);
             if (!nodes_[x].leaf) chain.end = std::min(chain.end, eff_[x]);
             const HierarchyNode& n = nodes_[x];
-            if (!n.leaf && (n.objectLod >= 1 || n.coarserStep >= 1) && n.children.size() == 1) continue;
+            // An aggregate of several objects with one child holds the same objects as that
+            // child (the next finer level's aggregate): the chain goes on through it.
+            if (!n.leaf && (n.objectLod >= 1 || n.coarserStep >= 1 || n.sources.size() >= 2) && n.children.size() == 1)
+                continue;
             if (planOf[x] != kNoNode && plans[planOf[x]].chains.size() == n.children.size()) {
                 const Plan& q = plans[planOf[x]];
-                for (size_t j = q.thresholds.size(); j-- > 0;) {
+                // Down to the finest bundle that holds every child: those below hold some only.
+                const uint32_t whole = *std::max_element(q.joins.begin(), q.joins.end());
+                for (size_t j = q.thresholds.size(); j-- > whole;) {
                     const Member m = count_ + q.firstBundle + static_cast<uint32_t>(j);
                     chain.members.push_back(m);
                     chain.end = std::min(chain.end, eff(m));
@@ -171,14 +179,15 @@ public:
         return e;
     }
 
-    /// Registers the bundles of plans[p] (its pieces, errors and new tops known).
+    /// Registers the bundles of plans[p] (its pieces, errors, joins and new tops known).
     void addBundles(std::vector<Plan>& plans, uint32_t p) {
         Plan& plan = plans[p];
         plan.firstBundle = static_cast<uint32_t>(bundleAt_.size());
         plan.kept = static_cast<uint32_t>(plan.thresholds.size());
-        double below = 0;  // the largest error below the finest bundle: its new tops'
-        for (Member m : plan.newTops) below = std::max(below, eff(m));
+        double below = 0;  // the largest error below bundle j: the finer bundle's, its new tops'
         for (uint32_t j = 0; j < plan.thresholds.size(); ++j) {
+            for (size_t c = 0; c < plan.chains.size(); ++c)
+                if (plan.joins[c] == j) below = std::max(below, eff(plan.newTops[c]));
             below = std::max(below, plan.errors[j].bound());
             bundleEff_.push_back(below);
             size_t n = 0;
@@ -242,21 +251,18 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
             for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], objectBox[o][k]), hi[k] = std::max(hi[k], objectBox[o][3 + k]);
         double diagonal2 = 0;
         for (int k = 0; k < 3; ++k) diagonal2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-        // The chains ending at or below the floor are bundled; a child whose chain ends higher
-        // (an aggregate with a wide fill) stays a child of the group beside them, drawn apart,
-        // rather than holding every bundle above its error.
+        // The finest bundle holds the chains ending at or below the floor (at least two); a
+        // chain that ends higher (an aggregate with a wide fill) joins the first bundle whose
+        // threshold reaches its end, and its child stays beside the finer bundles, drawn
+        // apart, rather than holding every bundle above its error.
         std::sort(ends.begin(), ends.end());
-        double floor = settings.bundleMinErrorFraction * std::sqrt(diagonal2);
-        if (!(ends[1] <= floor)) {
-            floor = 0;
-            for (double e : ends)
-                if (std::isfinite(e)) floor = std::max(floor, e);
-        }
+        const double floor = std::max(settings.bundleMinErrorFraction * std::sqrt(diagonal2), ends[1]);
         const double top = group.error.bound();
         if (!(floor > 0 && floor < top)) continue;
         for (Chain& chain : chains)
-            if (chain.end <= floor) plan.chains.push_back(std::move(chain));
+            if (chain.end < top) plan.chains.push_back(std::move(chain));
         if (plan.chains.size() < 2) continue;
+        const size_t finite = plan.chains.size();
         // Thresholds: where a bundled chain's lightest part changes, that is its members' and
         // its objects' versions' errors (at most kMaxThresholds of them, evenly spread, for a
         // group of many children).
@@ -278,28 +284,56 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
             for (size_t j = 0; j < kMaxThresholds; ++j) spread.push_back(candidates[j * candidates.size() / kMaxThresholds]);
             candidates = std::move(spread);
         }
-        size_t lastTriangles = 0;
+        // A bundle is kept when it holds more chains than the last one kept (an eighth of them
+        // more, or all: each join saves draw calls, but the bundles are few) or is lighter
+        // enough.
+        const size_t joinStep = std::max<size_t>(1, finite / 8);
+        size_t lastTriangles = 0, lastJoined = 0;
         for (double t : candidates) {
             if (int(plan.thresholds.size()) >= settings.bundleCount) break;
-            std::vector<Piece> pieces;
-            size_t triangles = 0;
-            for (const Chain& chain : plan.chains) {
-                pieces.push_back(planner.pieceWithin(chain, t));
-                triangles += pieces.back().triangles;
+            std::vector<Piece> pieces(plan.chains.size());
+            size_t triangles = 0, joined = 0;
+            for (size_t c = 0; c < plan.chains.size(); ++c) {
+                if (!(plan.chains[c].end <= t)) continue;
+                pieces[c] = planner.pieceWithin(plan.chains[c], t);
+                triangles += pieces[c].triangles;
+                ++joined;
             }
-            if (triangles > settings.bundleMaxTriangles) continue;
-            if (!plan.thresholds.empty() && kWorthDenominator * triangles > kWorthNumerator * lastTriangles) continue;
+            if (joined < 2 || triangles > settings.bundleMaxTriangles) continue;
+            const bool more = plan.thresholds.empty() || joined >= lastJoined + joinStep ||
+                              (joined == finite && lastJoined < finite);
+            if (!more && kWorthDenominator * triangles > kWorthNumerator * lastTriangles) continue;
             ProxyError e;
             for (const Piece& piece : pieces) addPartError(e, planner.pieceError(piece, plans));
             plan.thresholds.push_back(t);
             plan.pieces.push_back(std::move(pieces));
             plan.errors.push_back(e);
             lastTriangles = triangles;
+            lastJoined = joined;
         }
         if (plan.thresholds.empty()) continue;
-        for (const Chain& chain : plan.chains) {
-            size_t j = 0;  // the highest member within the finest threshold (one is: chain.end <= floor)
-            while (!(planner.eff(chain.members[j]) <= plan.thresholds.front())) ++j;
+        // The chains that joined no bundle kept stay children of the group, beside the bundles.
+        {
+            Plan joinedOnly;
+            joinedOnly.group = plan.group;
+            joinedOnly.thresholds = plan.thresholds;
+            joinedOnly.errors = plan.errors;
+            joinedOnly.pieces.resize(plan.pieces.size());
+            for (size_t c = 0; c < plan.chains.size(); ++c) {
+                uint32_t j = 0;
+                while (j < plan.thresholds.size() && !(plan.chains[c].end <= plan.thresholds[j])) ++j;
+                if (j == plan.thresholds.size()) continue;
+                joinedOnly.chains.push_back(std::move(plan.chains[c]));
+                joinedOnly.joins.push_back(j);
+                for (size_t b = 0; b < plan.pieces.size(); ++b) joinedOnly.pieces[b].push_back(std::move(plan.pieces[b][c]));
+            }
+            plan = std::move(joinedOnly);
+        }
+        for (size_t c = 0; c < plan.chains.size(); ++c) {
+            const Chain& chain = plan.chains[c];
+            const double threshold = plan.thresholds[plan.joins[c]];
+            size_t j = 0;  // the highest member within the threshold of the bundle it joins (one is: chain.end)
+            while (!(planner.eff(chain.members[j]) <= threshold)) ++j;
             const Member newTop = chain.members[j];
             plan.newTops.push_back(newTop);
             for (size_t k = 0; k < j; ++k) {
@@ -319,9 +353,11 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
     }
     if (plans.empty()) return true;
     const size_t allBundles = plans.back().firstBundle + plans.back().thresholds.size();
-    std::vector<uint32_t> planAbove(count + allBundles, kNoNode);  // per new top: the plan whose finest bundle is its parent
+    // Per new top: the bundle it joins (its parent), as an index in the list of all bundles.
+    std::vector<uint32_t> bundleAbove(count + allBundles, kNoNode);
     for (uint32_t p = 0; p < plans.size(); ++p)
-        for (Member m : plans[p].newTops) planAbove[m] = p;
+        for (size_t c = 0; c < plans[p].newTops.size(); ++c)
+            bundleAbove[plans[p].newTops[c]] = plans[p].firstBundle + plans[p].joins[c];
 
     // Materializes a piece into bundle b: each node part's mesh, a bundle member's parts
     // recursively, each version.
@@ -358,8 +394,9 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 HierarchyNode b;
                 b.bundleStep = static_cast<int>(j) + 1;
                 b.bundleLevel = group.firstLevel;
-                for (const Chain& chain : plan.chains) {
-                    const HierarchyNode& chainTop = nodes[chain.members.front()];
+                for (size_t c = 0; c < plan.chains.size(); ++c) {
+                    if (plan.joins[c] > j) continue;
+                    const HierarchyNode& chainTop = nodes[plan.chains[c].members.front()];
                     b.sources.insert(b.sources.end(), chainTop.sources.begin(), chainTop.sources.end());
                     b.exactTriangleCount += chainTop.exactTriangleCount;
                 }
@@ -401,12 +438,12 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 out[at] = std::move(bundles[planOf[i]][j]);
                 if (j + 1 < plan.kept) parentOf[at] = at + 1;
                 else if (!absorbed[i]) parentOf[at] = newIndex[i];
-                else parentOf[at] = bundleIndex[plans[planAbove[count + plan.firstBundle + j]].firstBundle];
+                else parentOf[at] = bundleIndex[bundleAbove[count + plan.firstBundle + j]];
             }
         }
         if (absorbed[i]) continue;
         const uint32_t at = newIndex[i];
-        if (planAbove[i] != kNoNode) parentOf[at] = bundleIndex[plans[planAbove[i]].firstBundle];
+        if (bundleAbove[i] != kNoNode) parentOf[at] = bundleIndex[bundleAbove[i]];
         else if (nodes[i].parent != kNoNode) parentOf[at] = newIndex[nodes[i].parent];
         out[at] = std::move(nodes[i]);
     }

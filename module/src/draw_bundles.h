@@ -20,25 +20,27 @@ namespace aggrelod::detail {
 /// afterwards.
 ///
 /// For an aggregate G of several objects with children c_1..c_k, each the top of a chain of
-/// single children (coarser versions, per-object LODs) ending at a leaf or at an aggregate; an
-/// aggregate whose children are all bundled (planned first: children come first) continues
-/// the chain through its own bundles, coarsest first, down to its finest. A chain's end is
-/// the smallest error (the largest on the chain from a member down) of its members other
-/// than a leaf (an original is never a part: it need not be closed). The floor t_0 is
-/// settings.bundleMinErrorFraction * the diagonal of G's objects' box, and the chains ending
-/// at or below it are bundled (where fewer than two do, t_0 rises to the highest finite end
-/// and every chain with a finite end is). On thresholds from t_0 up to G's own error (the
-/// bundled chains' members' errors, at most 256 of them evenly spread), bundle B(t) merges,
-/// for every bundled chain, its lightest member other than a leaf whose error is at most t
-/// (a bundle member: its parts). The bundles kept are the finest one and each coarser one
-/// with at most 19/20 of the triangles of the last kept, at most settings.bundleCount, each
-/// of at most settings.bundleMaxTriangles triangles. They hang as a chain below G, finest
-/// lowest, the bundled children's chains below the finest, the other children beside the
-/// chain; the chain members above the finest bundle's threshold leave the tree (the bundles
-/// stand for them): nodes, and also a child aggregate with its bundles above that threshold,
-/// so that its finer bundles hang below G's finest. Those members are drawn only where one
-/// pixel is at least the floor, so at least bundleMinErrorFraction of G's size, where one
-/// error over the bundled children costs about what one per child would.
+/// single children (coarser versions, per-object LODs, aggregates of several objects with one
+/// child: the same objects' aggregate one level finer) ending at a leaf or at an aggregate; an
+/// aggregate whose children all joined its bundles (planned first: children come first)
+/// continues the chain through its own bundles, coarsest first, down to the finest that holds
+/// every child. A chain's end is the smallest error (the largest on the chain from a member
+/// down) of its members other than a leaf (an original is never a part: it need not be
+/// closed). The floor t_0 is the larger of settings.bundleMinErrorFraction * the diagonal of
+/// G's objects' box and the second smallest end. On thresholds from t_0 up to G's own error
+/// (the chains' members' errors, at most 256 of them evenly spread), bundle B(t) merges, for
+/// every chain ending at or below t, its lightest member other than a leaf whose error is at
+/// most t (a bundle member: its parts). The bundles kept are the finest one and each coarser
+/// one that holds more chains than the last kept (an eighth of G's chains more, or all of
+/// them) or has at most 9/10 of its triangles, at most settings.bundleCount, each of at most
+/// settings.bundleMaxTriangles triangles. They hang as a chain below G, finest lowest; a
+/// chain hangs below the finest bundle holding it (the bundle it joins), the chains that
+/// join none beside the bundles, below G. The chain members above the threshold of the
+/// bundle a chain joins leave the tree (the bundles stand for them): nodes, and also a child
+/// aggregate with its bundles above that threshold, so that its finer bundles hang below the
+/// bundle of G it joins. Those members are drawn only where one pixel is at least the floor,
+/// so at least bundleMinErrorFraction of G's size, where one error over the bundled children
+/// costs about what one per child would.
 ///
 /// A bundled chain's part may instead be its objects' own versions: versionsAbove[o] (empty, or
 /// one list per object, each version certified against object o alone, its mesh in the node or

@@ -108,8 +108,8 @@ std::unique_ptr<BakedScene> bakeScene(const std::string& label, const fs::path& 
     return s;
 }
 
-enum class SceneId { Spheres15, Chess, TruckTown };
-const char* const kSceneDirNames[] = {"spheres15", "chess", "truck_town"};
+enum class SceneId { Spheres15, Chess, TruckTown, Forest };
+const char* const kSceneDirNames[] = {"spheres15", "chess", "truck_town", "forest"};
 
 BakedScene& scene(SceneId id) {
     static std::map<SceneId, std::unique_ptr<BakedScene>> cache;
@@ -125,6 +125,9 @@ BakedScene& scene(SceneId id) {
     } else if (id == SceneId::Chess) {
         EXPECT_TRUE(io::writeObjectsGlb(samples::makeChessBoard(1), (dir / "in.glb").string(), error)) << error;
         slot = bakeScene("chess", dir / "in.glb", dir, {"--function", "constant"}, {});
+    } else if (id == SceneId::Forest) {
+        EXPECT_TRUE(io::writeObjectsGlb(samples::makeForest(1), (dir / "in.glb").string(), error)) << error;
+        slot = bakeScene("forest", dir / "in.glb", dir, {}, {});
     } else {
         const fs::path town = sharedData("3d/truck_town/town_model.gltf");
         const std::string ground = "^(OuterGroundMesh|GrassMesh|RoadMesh)$";
@@ -437,7 +440,7 @@ TEST(RuntimeScenes, ValidCutForRandomCameras) {
 // drawn proxy within tau and the cover exact, and the incremental selection equals the full one.
 TEST(RuntimeScenes, DrawCostsNeverDrawMoreThanThePlainRule) {
     size_t lighter = 0, skipped = 0;
-    for (SceneId id : {SceneId::Spheres15, SceneId::Chess, SceneId::TruckTown}) {
+    for (SceneId id : {SceneId::Spheres15, SceneId::Chess, SceneId::TruckTown, SceneId::Forest}) {
         BakedScene& s = scene(id);
         if (s.problem.rfind("absent", 0) == 0) continue;
         ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
@@ -491,6 +494,32 @@ TEST(RuntimeScenes, DrawCostsNeverDrawMoreThanThePlainRule) {
             const double withCosts = cost(costed), without = cost(plain);
             EXPECT_LE(withCosts, without) << s.label << " camera " << camera;
             lighter += withCosts < without;
+        }
+        // And where a skipped node is just within tau (the plain rule draws it, or a node below
+        // its parent), looking at it along each axis: the cut with costs is never heavier, and
+        // lighter where the plain rule drew that node.
+        for (uint32_t node = 0; node < f.nodeCount(); ++node) {
+            if (!costed.skipsNode(node)) continue;
+            const runtime::NodeRecord& r = f.node(node);
+            for (int axis = 0; axis < 3; ++axis) {
+                runtime::Camera c;
+                c.fovY = float(60 * M_PI / 180);
+                c.viewportHeight = 1080.0f;
+                double near = r.sphereRadius, far = r.sphereRadius + 1e6 * (r.geometricError + r.sphereRadius);
+                for (int step = 0; step < 60; ++step) {  // the distance where its error is 0.99 px
+                    const double mid = 0.5 * (near + far);
+                    for (int k = 0; k < 3; ++k) c.position[k] = r.sphereCenter[k] + float(k == axis ? mid : 0.0);
+                    (costed.screenSpaceErrorOf(node, c) > 0.99f ? near : far) = mid;
+                }
+                for (int k = 0; k < 3; ++k) c.position[k] = r.sphereCenter[k] + float(k == axis ? far : 0.0);
+                costed.selectFull(c, settings);
+                plain.selectFull(c, settings);
+                const double withCosts = cost(costed), without = cost(plain);
+                EXPECT_LE(withCosts, without) << s.label << " node " << node << " axis " << axis;
+                const bool drawn = std::find(plain.cut().begin(), plain.cut().end(), node) != plain.cut().end();
+                if (drawn) EXPECT_LT(withCosts, without) << s.label << " node " << node << " axis " << axis;
+                lighter += withCosts < without;
+            }
         }
         // With hysteresis, along a flight from far to near and back: incremental = full.
         runtime::Selector flightFull(f), flightIncremental(f);

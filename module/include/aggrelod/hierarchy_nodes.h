@@ -47,15 +47,16 @@ struct ProxySettings {
     /// Most bundles below one aggregate of several objects: its children's drawn versions
     /// merged into one mesh (the lightest version of each child within a threshold), at
     /// thresholds between the children's errors and the aggregate's, so that a distant group
-    /// costs one draw call. Each kept bundle has at most 19/20 of the triangles of the finer
-    /// one. Children whose versions all have errors above bundleMinErrorFraction of the
-    /// group's diagonal (aggregates with wide fills) stay apart. 0 = none.
+    /// costs one draw call. Each kept bundle has at most 9/10 of the triangles of the finer
+    /// one, or holds more children: a child whose versions all have errors above the finest
+    /// threshold (an aggregate with a wide fill) joins the first bundle whose threshold
+    /// reaches its finest version, and stays apart below it. 0 = none.
     int bundleCount = 16;
     /// Finest bundle threshold as a fraction of the diagonal of the aggregate's objects: the
     /// children's versions that bundles replace are those drawn only where one pixel is at
     /// least this fraction of the group's size, far enough for one error over the whole group
     /// to cost about what one per child would.
-    double bundleMinErrorFraction = 1.0 / 64;
+    double bundleMinErrorFraction = 1.0 / 128;
     /// Most triangles of one bundle (a larger merged mesh is not made).
     size_t bundleMaxTriangles = 65536;
     /// Most vertices of the few-faced convex polytopes that enclose a one-shell proxy's
@@ -145,10 +146,11 @@ struct HierarchyNode {
     /// 0 for every other node; j >= 1 for the j-th bundle below an aggregate of several
     /// objects (j rises towards it): the drawn versions of the aggregate's children merged into
     /// one mesh, error between theirs and the aggregate's (ProxySettings::bundleCount). sources
-    /// are the bundled children's objects, delta is the aggregate's, firstLevel and lastLevel
-    /// are -1. Its shells are its parts' (closed proxies, never originals) and may overlap one
-    /// another. An aggregate whose children are all bundled may give way to the bundles of the
-    /// group above: its finer bundles then hang below that group's finest.
+    /// are the objects of the children it holds (all or some: a coarser bundle may hold more),
+    /// delta is the aggregate's, firstLevel and lastLevel are -1. Its shells are its parts'
+    /// (closed proxies, never originals) and may overlap one another. An aggregate whose
+    /// children all joined its bundles may give way to the bundles of the group above: its
+    /// finer bundles then hang below the bundle of that group it joins.
     int bundleStep = 0;
     int bundleLevel = -1;              ///< bundles: the first level of the aggregate they were made for
     int firstLevel = -1;               ///< levels [firstLevel, lastLevel] of the Hierarchy3D
@@ -188,7 +190,8 @@ struct HierarchyNodes {
     size_t objectCount = 0;
     /// nodeOfAggregate[k][g]: node standing for levels[k].aggregates[g] (an aggregate of one
     /// object that gave way to its per-object LOD chain: the chain's top, or the highest node
-    /// of the chain left below a bundle).
+    /// of the chain left below a bundle; an aggregate that gave way to the bundles of a group
+    /// above: the highest node left of its chain, often one of its own bundles).
     std::vector<std::vector<uint32_t>> nodeOfAggregate;
     /// Work items of the proxies made in this run and read from ProxySettings::cache.
     size_t proxyItemsMade = 0, proxyItemsLoaded = 0;
