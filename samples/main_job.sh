@@ -31,6 +31,7 @@ for sample in forest village chess; do
   build/samples/aggrelod_make_sample "$sample" --seed 1 -o "out/$sample.glb"
   build/bake/aggrelod bake "out/$sample.glb" -o "out/$sample" --quiet
   build/bake/aggrelod render "out/$sample/scene.aglod" --sheet -o "out/$sample/sheet.png"
+  build/bake/aggrelod render "out/$sample/levels.glb" --sheet -o "out/$sample/levels.png" --quiet
 done
 
 # The paper's 2D evaluation: five environments, tables and figures.
@@ -42,5 +43,6 @@ echo
 echo "Wrote out/spheres15/levels.glb (one node per aggregate per level), proxies.glb (the runtime"
 echo "tree as glTF), scene.aglod (the runtime file), stats.json, tiles/ (3D Tiles) and sheet.png"
 echo "(a render of every level); out/forest/, out/village/ and out/chess/ hold the same for the"
-echo "other samples. View the tiles with: node samples/web/serve.mjs --tileset out/spheres15/tiles"
+echo "other samples, and levels.png (every level's exact aggregates). View the tiles with:"
+echo "node samples/web/serve.mjs --tileset out/spheres15/tiles"
 echo "(then open http://127.0.0.1:8080/)"
