@@ -17,9 +17,10 @@
 namespace aggrelod::detail {
 namespace {
 
-/// A kept bundle that holds no more children than the finer one kept before it has at most
-/// this share of its triangles (as the per-object chains: denser chains use up
-/// ProxySettings::bundleCount before the coarse end, where a distant group is drawn).
+/// A kept bundle that does not hold enough more children than the finer one kept before it
+/// (see addDrawBundles) has at most this share of its triangles (as the per-object chains:
+/// denser chains use up ProxySettings::bundleCount before the coarse end, where a distant
+/// group is drawn).
 constexpr size_t kWorthNumerator = 9, kWorthDenominator = 10;
 /// Most thresholds tried for one group.
 constexpr size_t kMaxThresholds = 256;
@@ -29,7 +30,8 @@ constexpr size_t kMaxThresholds = 256;
 using Member = uint32_t;
 
 /// One child of a group: its chain from the top down to its end (an aggregate or a leaf, or
-/// the finest bundle of an aggregate whose children are all bundled).
+/// the finest bundle that holds every child of an aggregate whose children all joined its
+/// bundles).
 struct Chain {
     std::vector<Member> members;  ///< top first
     double end = INFINITY;        ///< the smallest error of a member other than a leaf

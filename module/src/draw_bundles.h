@@ -27,12 +27,13 @@ namespace aggrelod::detail {
 /// every child. A chain's end is the smallest error (the largest on the chain from a member
 /// down) of its members other than a leaf (an original is never a part: it need not be
 /// closed). The floor t_0 is the larger of settings.bundleMinErrorFraction * the diagonal of
-/// G's objects' box and the second smallest end. On thresholds from t_0 up to G's own error
+/// G's objects' box and the second smallest end; only the chains ending below G's own error
+/// can join. On thresholds from t_0 up to G's own error
 /// (the chains' members' errors, at most 256 of them evenly spread), bundle B(t) merges, for
 /// every chain ending at or below t, its lightest member other than a leaf whose error is at
 /// most t (a bundle member: its parts). The bundles kept are the finest one and each coarser
-/// one that holds more chains than the last kept (an eighth of G's chains more, or all of
-/// them) or has at most 9/10 of its triangles, at most settings.bundleCount, each of at most
+/// one that holds more chains than the last kept (an eighth of the chains that can join
+/// more, at least one, or all of them) or has at most 9/10 of its triangles, at most settings.bundleCount, each of at most
 /// settings.bundleMaxTriangles triangles. They hang as a chain below G, finest lowest; a
 /// chain hangs below the finest bundle holding it (the bundle it joins), the chains that
 /// join none beside the bundles, below G. The chain members above the threshold of the
@@ -51,8 +52,8 @@ namespace aggrelod::detail {
 ///
 /// A bundle's certified error is the largest of its parts' (each certified against its own
 /// objects, so the bound holds for all of them); its parts may overlap (a union of closed
-/// shells: closed and edge-manifold, not free of self-intersections). Its sources are its
-/// bundled children's objects. nodeOfAggregate and roots are renumbered (an entry on a
+/// shells: closed and edge-manifold, not free of self-intersections). Its sources are the
+/// objects of the chains it holds. nodeOfAggregate and roots are renumbered (an entry on a
 /// removed chain node moves to the highest member left of that chain); aggregates keep their
 /// order. With `spiller`, each bundle's mesh goes to it as soon as it is made. Deterministic.
 /// False with `error` when a mesh cannot be read back or spilled.

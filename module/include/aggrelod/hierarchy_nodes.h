@@ -52,10 +52,11 @@ struct ProxySettings {
     /// threshold (an aggregate with a wide fill) joins the first bundle whose threshold
     /// reaches its finest version, and stays apart below it. 0 = none.
     int bundleCount = 16;
-    /// Finest bundle threshold as a fraction of the diagonal of the aggregate's objects: the
-    /// children's versions that bundles replace are those drawn only where one pixel is at
-    /// least this fraction of the group's size, far enough for one error over the whole group
-    /// to cost about what one per child would.
+    /// Lowest bundle threshold as a fraction of the diagonal of the aggregate's objects (the
+    /// finest bundle sits there, or higher where fewer than two children have versions that
+    /// fine): the children's versions that bundles replace are those drawn only where one
+    /// pixel is at least this fraction of the group's size, far enough for one error over the
+    /// whole group to cost about what one per child would.
     double bundleMinErrorFraction = 1.0 / 128;
     /// Most triangles of one bundle (a larger merged mesh is not made).
     size_t bundleMaxTriangles = 65536;
