@@ -5,6 +5,7 @@
 // keeps every guarantee of its parts.
 #include "draw_bundles.h"
 
+#include "node_tree.h"
 #include "surface_colors.h"
 
 #include <algorithm>
@@ -314,23 +315,22 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
             lastJoined = joined;
         }
         if (plan.thresholds.empty()) continue;
-        // The chains that joined no bundle kept stay children of the group, beside the bundles.
-        {
-            Plan joinedOnly;
-            joinedOnly.group = plan.group;
-            joinedOnly.thresholds = plan.thresholds;
-            joinedOnly.errors = plan.errors;
-            joinedOnly.pieces.resize(plan.pieces.size());
-            for (size_t c = 0; c < plan.chains.size(); ++c) {
-                uint32_t j = 0;
-                while (j < plan.thresholds.size() && !(plan.chains[c].end <= plan.thresholds[j])) ++j;
-                if (j == plan.thresholds.size()) continue;
-                joinedOnly.chains.push_back(std::move(plan.chains[c]));
-                joinedOnly.joins.push_back(j);
-                for (size_t b = 0; b < plan.pieces.size(); ++b) joinedOnly.pieces[b].push_back(std::move(plan.pieces[b][c]));
+        // Each chain joins the finest bundle kept that reaches its end; those that join none stay
+        // children of the group, beside the bundles (dropped from the plan, kept in order).
+        size_t joining = 0;
+        for (size_t c = 0; c < plan.chains.size(); ++c) {
+            uint32_t j = 0;
+            while (j < plan.thresholds.size() && !(plan.chains[c].end <= plan.thresholds[j])) ++j;
+            if (j == plan.thresholds.size()) continue;
+            if (joining != c) {  // (a vector moved onto itself would be emptied)
+                plan.chains[joining] = std::move(plan.chains[c]);
+                for (std::vector<Piece>& pieces : plan.pieces) pieces[joining] = std::move(pieces[c]);
             }
-            plan = std::move(joinedOnly);
+            plan.joins.push_back(j);
+            ++joining;
         }
+        plan.chains.resize(joining);
+        for (std::vector<Piece>& pieces : plan.pieces) pieces.resize(joining);
         for (size_t c = 0; c < plan.chains.size(); ++c) {
             const Chain& chain = plan.chains[c];
             const double threshold = plan.thresholds[plan.joins[c]];
@@ -449,15 +449,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         else if (nodes[i].parent != kNoNode) parentOf[at] = newIndex[nodes[i].parent];
         out[at] = std::move(nodes[i]);
     }
-    tree.roots.clear();
-    for (uint32_t i = 0; i < next; ++i) {
-        out[i].children.clear();
-        out[i].parent = parentOf[i];
-    }
-    for (uint32_t i = 0; i < next; ++i) {  // ascending, so children lists come out sorted
-        if (parentOf[i] == kNoNode) tree.roots.push_back(i);
-        else out[parentOf[i]].children.push_back(i);
-    }
+    linkByParents(out, parentOf, tree.roots);
     for (auto& level : tree.nodeOfAggregate)
         for (uint32_t& i : level) i = absorbed[i] ? indexOf(standIn[i]) : newIndex[i];
     nodes = std::move(out);

@@ -11,6 +11,7 @@
 #include "conservative_simplify.h"
 #include "convex_hull.h"
 #include "draw_bundles.h"
+#include "node_tree.h"
 #include "hierarchy_serialize.h"
 #include "mesh_optimize.h"
 #include "mesh_preparation.h"
@@ -1596,15 +1597,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             if (!dropped[i]) hang(coarser[i], newIndex[i], newIndex[i] + 1, keptParent(static_cast<uint32_t>(i)));
         for (size_t i = 0; i < nodes.size(); ++i)
             if (i < objectCount || !dropped[i]) renumbered[newIndex[i]] = std::move(nodes[i]);
-        out.roots.clear();
-        for (uint32_t i = 0; i < next; ++i) {
-            renumbered[i].children.clear();
-            renumbered[i].parent = parentOf[i];
-        }
-        for (uint32_t i = 0; i < next; ++i) {  // ascending, so children lists come out sorted
-            if (parentOf[i] == kNoNode) out.roots.push_back(i);
-            else renumbered[parentOf[i]].children.push_back(i);
-        }
+        detail::linkByParents(renumbered, parentOf, out.roots);
         for (auto& level : out.nodeOfAggregate)
             for (uint32_t& i : level) i = newIndex[i];
         nodes = std::move(renumbered);
