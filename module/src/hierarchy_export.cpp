@@ -163,13 +163,21 @@ bool exportHierarchyNodes(const HierarchyNodes& nodes, const std::vector<InputOb
         error = "the hierarchy is too large for the runtime file (more than 2^32 nodes, vertices or indices)";
         return false;
     }
-    // The render meshes are made a batch at a time: only one batch of them is held.
+    // The render meshes are made a batch at a time: only one batch of them is held. A batch
+    // ends at 1024 nodes or 2^20 triangles, so that a run of large meshes (bundles) is not held
+    // a thousand at a time.
     std::vector<RenderMesh> meshes;
-    const size_t batch = 1024;
+    const size_t batchNodes = 1024, batchTriangles = size_t(1) << 20;
+    size_t batchStart = 0, batchEnd = 0;
     for (size_t i = 0; i < nodes.nodes.size(); ++i) {
         const HierarchyNode& n = nodes.nodes[i];
-        if (i % batch == 0) {
-            const size_t count = std::min(batch, nodes.nodes.size() - i);
+        if (i == batchEnd) {
+            batchStart = i;
+            size_t triangles = nodeTriangleCount(nodes.nodes[batchEnd++]);
+            while (batchEnd < nodes.nodes.size() && batchEnd - batchStart < batchNodes &&
+                   triangles + nodeTriangleCount(nodes.nodes[batchEnd]) <= batchTriangles)
+                triangles += nodeTriangleCount(nodes.nodes[batchEnd++]);
+            const size_t count = batchEnd - batchStart;
             meshes.assign(count, RenderMesh{});
             std::vector<std::string> failed(count);
             detail::parallelFor(count, threadCount, [&](size_t k) {
@@ -188,7 +196,7 @@ bool exportHierarchyNodes(const HierarchyNodes& nodes, const std::vector<InputOb
                     return false;
                 }
         }
-        RenderMesh& mesh = meshes[i % batch];
+        RenderMesh& mesh = meshes[i - batchStart];
         runtime::NodeRecord b;
         b.parent = n.parent == kNoNode ? runtime::kNoIndex : n.parent;
         b.level = n.leaf ? runtime::kLeafLevel

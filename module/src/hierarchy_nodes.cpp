@@ -32,6 +32,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 
 namespace aggrelod {
@@ -715,6 +716,10 @@ struct WorkItems {
     std::function<void(size_t, std::vector<uint32_t>&)> meshes;
     /// Optional: drops item j's result once it is in the cache, where nothing after needs it.
     std::function<void(size_t)> release;
+    /// Optional: called once item j is read, or made and stored (after release), from the
+    /// thread that did it: what follows from it alone is done at once (and its meshes leave
+    /// memory) instead of once every item is there.
+    std::function<void(size_t)> done;
     std::function<std::string(size_t)> name;
     /// Optional: a relative estimate of make(j)'s time. The items are made largest first, so
     /// that the last ones to finish are small ones (the results do not depend on the order).
@@ -1153,6 +1158,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 if (memo.load(keys[j], bytes) && items.read(j, bytes)) {
                     ++memo.loaded;
                     if (items.release) items.release(j);  // as for one made: nothing after needs it
+                    if (items.done) items.done(j);
                     return;
                 }
             }
@@ -1201,6 +1207,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                 memo.store(keys[j], bytes);
                 if (items.release) items.release(j);
             }
+            if (items.done) items.done(j);
         }, [&](size_t done) {
             if (settings.progress)
                 settings.progress("proxies", progressFrom + (progressTo - progressFrom) * double(done) / double(toMake.size()));
@@ -1335,37 +1342,6 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     const auto ceilingOfChain = [&](size_t o) {
         return firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
     };
-    std::vector<std::string> ladderKeys(memo.on() ? objectCount : 0, std::string("-"));
-    {
-        WorkItems items;
-        items.work = [&](size_t o) {
-            if (!hasLadder(o)) return Work::Skip;
-            return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
-        };
-        items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
-        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) {
-            if (!readLadder(bytes, ladders[o], false)) return false;
-            // A share of phase 2 needs only whether the object has a chain (the groups' errors
-            // are read by now): known at once, the ladder need not wait for all the others.
-            if (share && share->phase == 2) {
-                chained[o] = !chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceilingOfChain(o), settings).empty();
-                ladders[o] = VersionLadder{};
-            }
-            return true;
-        };
-        items.make = [&](size_t o) {
-            ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
-            ladderWhole[o] = 1;
-        };
-        items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
-        items.objects = [](size_t o, std::vector<char>& needed) { needed[o] = 1; };
-        items.name = [&](size_t o) { return "the versions of object '" + objects[o].name + "'"; };
-        items.cost = [&](size_t o) { return double(objects[o].indices.size() / 3); };
-        if (share && share->phase == 1) items.release = [&](size_t o) { ladders[o] = VersionLadder{}; };
-        if (!runItems(objectCount, items, 0.5, 0.75)) return finish(false);
-    }
-    if (share && share->phase == 1) return finish(true);
-
     // Per-object LOD chains. An object's chain stands in for the aggregates of that object
     // alone (the object with its concavities filled), up to its first aggregate with other
     // objects; those single-object aggregates stay only where the object has no chain.
@@ -1379,12 +1355,26 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         while (nodes[top].parent != kNoNode) top = nodes[top].parent;
         return top == o ? 0.0 : nodes[top].error.bound();
     };
-    // Spilling, they go to the spill file at once: they would otherwise stay in memory through
-    // the largest moment of the stage, when every other mesh is made and not yet spilled.
-    const bool spilling = !settings.meshSpillPath.empty();
+    // Spilling, every mesh goes to the spill file as soon as nothing in this stage needs it
+    // in memory any more (an object's chain and versions once made, an aggregate's proxy and
+    // coarser versions once those are made or read): held until the end, the meshes of a
+    // large world would be most of the stage's peak. The order of the places in the file
+    // follows the threads; only this stage and the writers read them.
+    const bool spilling = !settings.meshSpillPath.empty() && !share;
     detail::NodeMeshSpiller spiller;
-    if (spilling && !versionsAbove.empty() && !spiller.open(settings.meshSpillPath, reloadError)) return finish(false);
-    detail::parallelFor(objectCount, settings.threadCount, [&](size_t o) {
+    if (spilling && !spiller.open(settings.meshSpillPath, reloadError)) return finish(false);
+    std::mutex spillErrorMutex;
+    std::atomic<bool> spillFailed{false};
+    const auto spillNow = [&](HierarchyNode& n, uint32_t node) {
+        if (!spilling || spillFailed) return;
+        std::string error;
+        if (spiller.spill(n, node, error)) return;
+        std::lock_guard<std::mutex> lock(spillErrorMutex);
+        if (!spillFailed.exchange(true)) reloadError = error;
+    };
+    // An object's chain and versions from its ladder, as soon as the ladder is made or read:
+    // the ladders of a large world are not all held at once.
+    const auto finishObject = [&](size_t o) {
         if (ladders[o].versions.empty()) return;
         std::vector<HierarchyNode> chain = chainFromLadder(ladders[o], static_cast<uint32_t>(o), ceilingOfChain(o), settings);
         if (!versionsAbove.empty())
@@ -1403,15 +1393,39 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             }
         };
         colorAndOrder(chains[o]);
-        if (versionsAbove.empty()) return;
-        colorAndOrder(versionsAbove[o]);
-        // The chain's coarsest version first: bundles may draw it too (coloured once, copied).
-        if (!chains[o].empty()) versionsAbove[o].insert(versionsAbove[o].begin(), chains[o].back());
-    });
-    if (spiller.file())
-        for (size_t o = 0; o < versionsAbove.size(); ++o)
-            for (HierarchyNode& v : versionsAbove[o])
-                if (!spiller.spill(v, static_cast<uint32_t>(o), reloadError)) return finish(false);
+        if (!versionsAbove.empty()) {
+            colorAndOrder(versionsAbove[o]);
+            // The chain's coarsest version first: bundles may draw it too (coloured once, copied).
+            if (!chains[o].empty()) versionsAbove[o].insert(versionsAbove[o].begin(), chains[o].back());
+            for (HierarchyNode& v : versionsAbove[o]) spillNow(v, static_cast<uint32_t>(o));
+        }
+        for (HierarchyNode& c : chains[o]) spillNow(c, static_cast<uint32_t>(o));
+    };
+    std::vector<std::string> ladderKeys(memo.on() ? objectCount : 0, std::string("-"));
+    {
+        WorkItems items;
+        items.work = [&](size_t o) {
+            if (!hasLadder(o)) return Work::Skip;
+            return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
+        };
+        items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
+        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) {
+            return readLadder(bytes, ladders[o], false);
+        };
+        items.make = [&](size_t o) {
+            ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+            ladderWhole[o] = 1;
+        };
+        if (!(share && share->phase == 1)) items.done = finishObject;  // the groups' errors are known by now
+        items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
+        items.objects = [](size_t o, std::vector<char>& needed) { needed[o] = 1; };
+        items.name = [&](size_t o) { return "the versions of object '" + objects[o].name + "'"; };
+        items.cost = [&](size_t o) { return double(objects[o].indices.size() / 3); };
+        if (share && share->phase == 1) items.release = [&](size_t o) { ladders[o] = VersionLadder{}; };
+        if (!runItems(objectCount, items, 0.5, 0.75) || spillFailed) return finish(false);
+    }
+    if (share && share->phase == 1) return finish(true);
+
     std::vector<char> dropped(nodes.size(), 0);
     std::vector<uint32_t> keptSingles;
     for (uint32_t i : singleNodes) {
@@ -1458,7 +1472,13 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             return memo.coarserKey(nodeKeys[i], aggregateOf(nodes[i]).componentCount, ceilingOf(nodes[i]), nodes[i].sources,
                                    ladderKeys);
         };
+        // An aggregate's proxy and its coarser versions are done with once these are made or read.
+        const auto spillAggregate = [&](uint32_t i) {
+            spillNow(nodes[i], i);
+            for (HierarchyNode& c : coarser[i]) spillNow(c, i);
+        };
         items.read = [&](size_t j, const std::vector<uint8_t>& bytes) { return readCoarser(bytes, coarser[keptAggregates[j]]); };
+        items.done = [&](size_t j) { spillAggregate(keptAggregates[j]); };
         items.make = [&](size_t j) {
             const uint32_t i = keptAggregates[j];
             const HierarchyNode& n = nodes[i];
@@ -1506,7 +1526,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         items.name = [&](size_t j) { return "the coarser versions of node " + std::to_string(keptAggregates[j]); };
         items.cost = [&](size_t j) { return aggregateWork(nodes[keptAggregates[j]]); };
         if (share) items.release = [&](size_t j) { coarser[keptAggregates[j]] = {}; };  // a share keeps nothing
-        if (!runItems(keptAggregates.size(), items, 0.85, 1.0)) return finish(false);
+        if (!runItems(keptAggregates.size(), items, 0.85, 1.0) || spillFailed) return finish(false);
     }
     // Nothing after measures against the originals or unites versions: what was held for that
     // goes before the tree is put together again (on a large world, a good part of the peak).
@@ -1528,7 +1548,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     // Every mesh made to a spill file now, if asked: the tree is put together and its bounds
     // computed without them in memory (ProxySettings::meshSpillPath).
     if (spilling) {
-        bool spilled = spiller.file() || spiller.open(settings.meshSpillPath, reloadError);
+        bool spilled = true;
         for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's
             HierarchyNode& n = nodes[o];
             if (n.meshPlace.kind != NodeMeshPlace::Kind::InNode || n.indices.empty()) continue;

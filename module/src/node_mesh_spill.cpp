@@ -30,6 +30,9 @@ public:
 
     const std::string& path() const { return path_; }
 
+    /// Reads and appends share one stream: NodeMeshSpiller::write holds this lock too.
+    std::mutex& lock() const { return mutex_; }
+
     bool read(uint64_t offset, void* a, size_t aBytes, void* b, size_t bBytes, void* c, size_t cBytes) const {
         std::lock_guard<std::mutex> lock(mutex_);
 #if defined(_WIN32)
@@ -85,6 +88,9 @@ bool NodeMeshSpiller::write(const HierarchyNode& n, uint32_t node, NodeMeshPlace
                 " face colour values for " + std::to_string(n.indices.size() / 3) + " triangles";
         return false;
     }
+    // Several threads may spill at once (the proxies stage spills each item as it is made):
+    // the place is taken and written under the file's lock.
+    std::lock_guard<std::mutex> lock(file_->lock());
     place = NodeMeshPlace{};
     place.kind = NodeMeshPlace::Kind::File;
     place.offset = offset_;
@@ -123,6 +129,7 @@ bool NodeMeshSpiller::spill(HierarchyNode& n, uint32_t node, std::string& error)
 }
 
 bool NodeMeshSpiller::finish(std::string& error) {
+    std::lock_guard<std::mutex> lock(file_->lock());
     if (std::fflush(raw_) != 0) {
         error = file_->path() + ": write failed (disk full?)";
         return false;

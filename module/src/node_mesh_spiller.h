@@ -25,6 +25,8 @@ public:
     /// A new spill file at `path` (removed when the last holder of file() goes).
     bool open(const std::string& path, std::string& error);
     /// Appends node n's mesh (index `node`, for messages) and gives its place; n is unchanged.
+    /// write, spill and finish may be called from several threads at once (the places then
+    /// follow the order of the calls; nothing but this file's readers sees them).
     bool write(const HierarchyNode& n, uint32_t node, NodeMeshPlace& place, std::string& error);
     /// write, then n's vectors emptied and its place set (an empty mesh, or one already out,
     /// stays as it is).
