@@ -125,13 +125,15 @@ TEST(GlbWrite, SpilledNodeMeshesGiveTheSameFiles) {
     }
     EXPECT_GT(inFile, 3u);
 
-    // The proxies stage spilling as it goes (leaves by reference or copied, meshes to a spill
-    // file once all made): the same nodes, every mesh out of memory and read back the same.
+    // The proxies stage spilling as it goes (leaves by reference or copied, each mesh to a
+    // spill file once nothing in the stage needs it, from one thread or from two at once):
+    // the same nodes, every mesh out of memory and read back the same.
     HierarchyNodes built;
     for (const bool byReference : {false, true}) {
         built = HierarchyNodes{};
         ProxySettings spilling = proxySettings;
         spilling.leavesByReference = byReference;
+        spilling.threadCount = byReference ? 2 : 1;
         spilling.meshSpillPath = (dir / "built.spill").string();
         bool released = false;
         spilling.releaseFreedMemory = [&] { released = true; };
