@@ -640,6 +640,7 @@ bool SceneReader::addPrimitive(int node, int meshIndex, int primIndex, const Mat
     }
     const size_t firstTriangle = object.indices.size() / 3;
     object.colors.resize(4 * firstTriangle, 1.0f);  // earlier primitives without colour data
+    object.colors.reserve(object.colors.size() + 4 * (tri.size() / 3));  // no doubling slack kept for the bake
     for (size_t t = 0; t < tri.size(); t += 3) {
         for (int c = 0; c < 4; ++c) {
             double v = factor[c];
