@@ -24,6 +24,7 @@
 //          [--objects 400] [--triangles 200000] [--levels 8] [--threads 2] [--elevation 25]
 //          [--data DIR (holds 3d/truck_town/town_model.gltf)] [--breakdown (the cut by node kind)]
 //          [--bundles N (ProxySettings::bundleCount; 0: none, as before bundles; default: the bake's)]
+//          [--draw-call-cost T (triangles one draw call is worth to the selector, setDrawCosts; default 16)]
 //        bench_lod_budget --cut-for FILE.aglod --cameras FRAMES.csv   (the cut per given camera,
 //          see lod_budget_cut_for.h)
 #include "acceptance_scenes.h"
@@ -68,6 +69,7 @@ struct Options {
     uint32_t seed = 1;
     int objects = 400, triangles = 200000, levels = 8, threads = 2;
     int bundles = -1;  ///< -1: the bake's default
+    float drawCallCost = runtime::Selector::kDefaultTrianglesPerDrawCall;  ///< --draw-call-cost
     double elevationDegrees = 25;
     bool breakdown = false;
     std::string data = AGGRELOD_SHARED_DATA;
@@ -316,7 +318,7 @@ bool runScene(const Options& o, const std::string& name) {
     runtime::Selector selector(file);
     std::vector<uint32_t> originalTriangles(objects.size());
     for (size_t i = 0; i < objects.size(); ++i) originalTriangles[i] = uint32_t(objects[i].indices.size() / 3);
-    selector.setDrawCosts(originalTriangles.data(), runtime::Selector::kDefaultTrianglesPerDrawCall);
+    selector.setDrawCosts(originalTriangles.data(), o.drawCallCost);
     runtime::SelectionSettings settings;
     settings.pixelTolerance = kTau;
     settings.coarsenRatio = 1.0f;
@@ -505,6 +507,7 @@ int main(int argc, char** argv) {
         else if (arg == "--levels") o.levels = std::atoi(value);
         else if (arg == "--threads") o.threads = std::atoi(value);
         else if (arg == "--bundles") o.bundles = std::atoi(value);
+        else if (arg == "--draw-call-cost") o.drawCallCost = float(std::atof(value));
         else if (arg == "--elevation") o.elevationDegrees = std::atof(value);
         else if (arg == "--data") o.data = value;
         else if (arg == "--cut-for") cutFor = value;
