@@ -1545,8 +1545,9 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         }
     }
 
-    // Every mesh made to a spill file now, if asked: the tree is put together and its bounds
-    // computed without them in memory (ProxySettings::meshSpillPath).
+    // Spilling, whatever is still in memory goes now (most meshes went when done with; a
+    // leaf's copy gives way to its object): the tree is put together and its bounds computed
+    // without them in memory (ProxySettings::meshSpillPath).
     if (spilling) {
         bool spilled = true;
         for (size_t o = 0; spilled && o < objectCount; ++o) {  // a leaf's copy is its object's

@@ -77,10 +77,12 @@ struct ProxySettings {
     /// or viewNodeMesh, the objects kept alive) instead of holding a copy of their triangles:
     /// a world's originals are not held twice. Everything else is the same.
     bool leavesByReference = false;
-    /// When not empty: the nodes' meshes go to a new spill file at this path as soon as they
-    /// are all made, before the tree is put together and its bounds computed (as
-    /// spillNodeMeshes would do afterwards; HierarchyNodes::meshFile holds it), so that a
-    /// large world's node meshes are not held through those steps. Everything else is the same.
+    /// When not empty: the nodes' meshes go to a new spill file at this path, each as soon as
+    /// nothing in the stage needs it in memory (an object's per-object LOD versions once its
+    /// ladder is made or read, an aggregate's proxy and coarser versions once those are), and
+    /// the rest before the tree is put together and its bounds computed (as spillNodeMeshes
+    /// would do afterwards; HierarchyNodes::meshFile holds it), so that a large world's node
+    /// meshes are never all held at once. Everything else is the same, for every thread count.
     std::string meshSpillPath;
     /// Optional: called once the meshes are in the spill file (meshSpillPath), so that the
     /// caller can hand the freed pages back to the system (the allocator may keep them; the
