@@ -578,7 +578,7 @@ int runBake(BakeOptions o) {
     const bool ok = lean || (o.tileSize.empty() ? buildHierarchy3D(scene.objects, settings, hierarchy)
                                                 : buildTiledHierarchy3D(scene.objects, settings, tiling, hierarchy, &tiled));
     // Write: the whole set into a fresh temporary folder, then switched in (OutputSet). Begun
-    // before the proxies, whose meshes wait in it from the moment they are all made; declared
+    // before the proxies, whose meshes wait in it from the moment each is done with; declared
     // before the nodes, which close their spill file first.
     const fs::path outDir(o.outDir);
     std::optional<io::OutputSet> set;
