@@ -1409,19 +1409,19 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
         };
         items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
-        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) {
-            return readLadder(bytes, ladders[o], false);
-        };
+        items.read = [&](size_t o, const std::vector<uint8_t>& bytes) { return readLadder(bytes, ladders[o], false); };
         items.make = [&](size_t o) {
             ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
             ladderWhole[o] = 1;
         };
-        if (!(share && share->phase == 1)) items.done = finishObject;  // the groups' errors are known by now
         items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
         items.objects = [](size_t o, std::vector<char>& needed) { needed[o] = 1; };
         items.name = [&](size_t o) { return "the versions of object '" + objects[o].name + "'"; };
         items.cost = [&](size_t o) { return double(objects[o].indices.size() / 3); };
+        // Phase 1 of a share only stores the ladders; otherwise each object's chain follows from
+        // its ladder at once (the groups' errors, its ceiling, are known by now).
         if (share && share->phase == 1) items.release = [&](size_t o) { ladders[o] = VersionLadder{}; };
+        else items.done = finishObject;
         if (!runItems(objectCount, items, 0.5, 0.75) || spillFailed) return finish(false);
     }
     if (share && share->phase == 1) return finish(true);
