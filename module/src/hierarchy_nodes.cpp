@@ -20,6 +20,7 @@
 #include "proxy_error.h"
 #include "solidify.h"
 #include "surface_colors.h"
+#include "surface_shell.h"
 
 #include <aggrelod/disjoint_sets.h>
 #include <aggrelod/hierarchy_nodes.h>
@@ -457,6 +458,45 @@ struct VersionLadder {
     }
 };
 
+/// Offset and smallest cavity of the solid made for a support surface's versions, as
+/// fractions of its box diagonal: the bake's default for a model's wrap (docs/real-art.md).
+constexpr double kSupportSolidOffsetFraction = 0.004;
+constexpr double kSupportSolidAlphaFraction = 0.015;
+
+/// A closed solid containing an open surface that has no solid from the bake (a support
+/// surface, in no model): the surface thickened by half the offset on each side where it
+/// allows it (surface_shell.h), else its alpha wrap (solidify.h). `reach`: how far the
+/// solid's surface may lie from the object's (world units). False when neither gives a valid
+/// closed solid. Deterministic.
+bool supportSolid(const detail::PreparedObject& surface, double diagonal, std::vector<double>& positions,
+                  std::vector<uint32_t>& triangles, double& reach) {
+    const double offset = kSupportSolidOffsetFraction * diagonal;
+    const double alpha = std::max(kSupportSolidAlphaFraction * diagonal, 2 * offset);
+    const auto valid = [&] {
+        InputObject solid;
+        solid.positions = positions;
+        solid.indices = triangles;
+        detail::PreparedObject check;
+        std::vector<Diagnostic> ignored;
+        detail::prepareObject(solid, 0.0, check, ignored);
+        return check.validSolid() && check.positions.size() == positions.size() &&
+               check.triangles.size() == triangles.size();
+    };
+    std::string why;
+    if (detail::thickenSurface(surface.positions, surface.triangles, offset / 2, offset, alpha, positions, triangles, why) &&
+        valid()) {
+        reach = offset;
+        return true;
+    }
+    if (detail::alphaWrap(surface.positions, surface.triangles, alpha, offset, positions, triangles, why) && valid()) {
+        reach = alpha;  // a wrap fills cavities narrower than alpha
+        return true;
+    }
+    positions.clear();
+    triangles.clear();
+    return false;
+}
+
 /// Per-object versions (docs/design.md §2.6): conservative simplifications of one object at
 /// error targets sqrt(2) apart, from a thousandth of its diagonal up to its diagonal, and for
 /// an object of one shell the coarsest enclosing polytope of its convex hull that fits each
@@ -464,9 +504,10 @@ struct VersionLadder {
 /// its budget (twice its target). An object that is not a closed solid is simplified from
 /// `standIn`, the watertight solid that contains it alone (its alpha wrap), when there is one:
 /// whatever encloses that solid encloses the object, and errors are still certified against
-/// the object itself. Empty for such an object without a solid of its own.
+/// the object itself. A support surface (`support`) without a stand-in is simplified from a
+/// solid made for it here (supportSolid). Empty for any other such object.
 VersionLadder objectLadder(const InputObject& object, const detail::PreparedOriginal& original,
-                           const SolidReport* standIn, const ProxySettings& settings) {
+                           const SolidReport* standIn, bool support, const ProxySettings& settings) {
     VersionLadder ladder;
     ladder.objectTriangles = object.indices.size() / 3;
     if (settings.objectLodCount <= 0) return ladder;
@@ -480,12 +521,20 @@ VersionLadder objectLadder(const InputObject& object, const detail::PreparedOrig
     const std::vector<double>* basePositions = &prepared.positions;
     const std::vector<uint32_t>* baseTriangles = &prepared.triangles;
     double finest = kChainFinestFraction * diagonal;
-    if (!prepared.validSolid()) {
-        if (!standIn || !standIn->closedManifold || standIn->triangles.empty()) return ladder;
+    std::vector<double> ownSolidPositions;
+    std::vector<uint32_t> ownSolidTriangles;
+    if (!prepared.validSolid() && standIn && standIn->closedManifold && !standIn->triangles.empty()) {
         basePositions = &standIn->positions;
         baseTriangles = &standIn->triangles;
         // No version can be closer to the object than its solid is.
         finest = std::max(finest, 0.5 * std::max(standIn->distanceSolidToOriginal, standIn->distanceOriginalToSolid));
+    } else if (!prepared.validSolid()) {
+        double reach = 0;
+        if (!support || !prepared.usable || !supportSolid(prepared, diagonal, ownSolidPositions, ownSolidTriangles, reach))
+            return ladder;
+        basePositions = &ownSolidPositions;
+        baseTriangles = &ownSolidTriangles;
+        finest = std::max(finest, 0.5 * reach);
     }
     std::vector<double> targets;  // ascending
     for (double t = finest; t < diagonal; t *= kChainRatio) targets.push_back(t);
@@ -766,10 +815,11 @@ public:
         for (uint32_t o : n.sources) h.text(objectKeys[o]);
         return h.hex();
     }
-    std::string ladderKey(const std::string& objectKey, const SolidReport* standIn) const {
+    std::string ladderKey(const std::string& objectKey, const SolidReport* standIn, bool support) const {
         detail::ContentHash h = start('l');
         h.text(objectKey);
         h.u64(standIn != nullptr);
+        if (support) h.text("support");  // versions from a solid made for the surface (supportSolid)
         if (standIn) {
             h.values(standIn->positions);
             h.values(standIn->triangles);
@@ -1038,16 +1088,19 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
     std::vector<HierarchyNode>& nodes = out.nodes;
     nodes.resize(objectCount);
     std::vector<char> leafHasGeometry(objectCount, 0);
+    std::vector<char> support(objectCount, 0);  // support surfaces: root leaves with versions of their own
+    for (uint32_t o : hierarchy.supportObjects)
+        if (o < objectCount) support[o] = 1;
     for (size_t o = 0; o < objectCount; ++o) {
         HierarchyNode& n = nodes[o];
         n.leaf = true;
         n.sources = {static_cast<uint32_t>(o)};
         n.exactTriangleCount = objects[o].indices.size() / 3;
-        // A left-out object keeps its leaf (a root) without geometry.
-        const bool inHierarchy = levelCount > 0 && groupOf[0][o] != kNoNode;
-        const bool finite = std::all_of(objects[o].positions.begin(), objects[o].positions.end(),
-                                        [](double x) { return std::isfinite(x); });
-        leafHasGeometry[o] = inHierarchy && finite;
+        // Every object an engine can draw keeps its mesh, those in no level too (support
+        // surfaces, flat or open objects left out): a root leaf, drawn from the runtime file
+        // alone. An object with a non-finite coordinate keeps its leaf without geometry.
+        leafHasGeometry[o] = std::all_of(objects[o].positions.begin(), objects[o].positions.end(),
+                                         [](double x) { return std::isfinite(x); });
         if (leafHasGeometry[o] && !share && settings.leavesByReference) {
             n.meshPlace = detail::objectMeshPlace(objects[o]);
         } else if (leafHasGeometry[o] && !share) {
@@ -1242,7 +1295,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         for (uint32_t o : n.sources) t += double(objects[o].indices.size() / 3);
         return t;
     };
-    const auto hasLadder = [&](size_t o) { return nodes[o].parent != kNoNode && leafHasGeometry[o]; };
+    const auto hasLadder = [&](size_t o) { return (nodes[o].parent != kNoNode || support[o]) && leafHasGeometry[o]; };
     const auto finish = [&](bool ok) {
         if (!ok) error = !reloadError.empty() ? reloadError
                          : "the cache holds no result for " + missing + ": run the proxies' phase 1 first";
@@ -1339,8 +1392,16 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         while (up != kNoNode && nodes[up].sources.size() == 1) up = nodes[up].parent;
         firstGroup[o] = up;
     }
+    // A support surface, in no group, is drawn no coarser than the coarsest level's
+    // aggregates: its chain stops below their largest error.
+    double coarsestLevelError = levelCount ? 0.0 : INFINITY;
+    if (levelCount)
+        for (uint32_t node : out.nodeOfAggregate[levelCount - 1])
+            if (nodes[node].sources.size() > 1) coarsestLevelError = std::max(coarsestLevelError, nodes[node].error.bound());
+    if (!(coarsestLevelError > 0)) coarsestLevelError = INFINITY;  // no group at the top
     const auto ceilingOfChain = [&](size_t o) {
-        return firstGroup[o] == kNoNode ? INFINITY : nodes[firstGroup[o]].error.bound();
+        if (firstGroup[o] != kNoNode) return nodes[firstGroup[o]].error.bound();
+        return support[o] ? coarsestLevelError : INFINITY;
     };
     // Per-object LOD chains. An object's chain stands in for the aggregates of that object
     // alone (the object with its concavities filled), up to its first aggregate with other
@@ -1408,10 +1469,10 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
             if (!hasLadder(o)) return Work::Skip;
             return phaseOne ? mine(groupNodes.size() + o) : Work::LoadOnly;
         };
-        items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o]); };
+        items.key = [&](size_t o) { return ladderKeys[o] = memo.ladderKey(objectKeys[o], standInOf[o], support[o]); };
         items.read = [&](size_t o, const std::vector<uint8_t>& bytes) { return readLadder(bytes, ladders[o], false); };
         items.make = [&](size_t o) {
-            ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+            ladders[o] = objectLadder(objects[o], prepared[o], standInOf[o], support[o], settings);
             ladderWhole[o] = 1;
         };
         items.write = [&](size_t o, std::vector<uint8_t>& bytes) { writeLadder(ladders[o], bytes); };
@@ -1505,7 +1566,7 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
                     VersionLadder& whole = reread.emplace_back();
                     std::vector<uint8_t> bytes;
                     if (!(memo.on() && memo.load(ladderKeys[o], bytes) && readLadder(bytes, whole, true)))
-                        whole = objectLadder(objects[o], prepared[o], standInOf[o], settings);
+                        whole = objectLadder(objects[o], prepared[o], standInOf[o], support[o], settings);
                     ladder = &whole;
                 }
                 sourceLadders.push_back(ladder->versions.empty() ? nullptr : ladder);
@@ -1732,14 +1793,14 @@ bool buildProxyShare(const Hierarchy3D& hierarchy, const std::vector<InputObject
 }
 
 std::vector<HierarchyNode> enclosingVersions(const InputObject& object, const SolidReport* standIn,
-                                             const ProxySettings& settings) {
+                                             const ProxySettings& settings, bool support) {
     detail::PreparedOriginal original;
     try {
         detail::prepareOriginal(object, original);
     } catch (const std::invalid_argument&) {  // a non-finite coordinate or an index out of range
         return {};
     }
-    VersionLadder ladder = objectLadder(object, original, standIn, settings);
+    VersionLadder ladder = objectLadder(object, original, standIn, support, settings);
     std::vector<HierarchyNode> out;
     for (Version& v : ladder.versions) out.push_back(std::move(v.node));
     return out;

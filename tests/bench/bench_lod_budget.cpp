@@ -295,19 +295,19 @@ bool runScene(const Options& o, const std::string& name) {
                 "targets down to %.3g; chains built and measured in %.2f s\n",
                 chainLevels, double(chainLevels) / double(objects.size()), openLevels, finest, chainSeconds);
     // (b'): every object's enclosing versions, as the bake makes them (an open object's from
-    // the solid standing in for it alone); support surfaces and objects left out are drawn
-    // as they are, as in the cut.
+    // the solid standing in for it alone, a support surface's from a thin solid made for it);
+    // objects left out are drawn as they are, as in the cut.
     std::vector<const SolidReport*> standIn(objects.size(), nullptr);
     for (const SolidReport& r : b.hierarchy.solids)
         if (r.objects.size() == 1 && r.objects.front() < objects.size()) standIn[r.objects.front()] = &r;
-    std::vector<char> asGiven(objects.size(), 0);
-    for (uint32_t i : b.hierarchy.supportObjects) asGiven[i] = 1;
+    std::vector<char> asGiven(objects.size(), 0), support(objects.size(), 0);
+    for (uint32_t i : b.hierarchy.supportObjects) support[i] = 1;
     for (uint32_t i : b.hierarchy.leftOutObjects) asGiven[i] = 1;
     std::vector<std::vector<ChainLevel>> enclosing(objects.size());
     ProxySettings versionSettings;
     detail::parallelFor(objects.size(), o.threads, [&](size_t i) {
         if (asGiven[i]) return;
-        for (const HierarchyNode& v : enclosingVersions(objects[i], standIn[i], versionSettings))
+        for (const HierarchyNode& v : enclosingVersions(objects[i], standIn[i], versionSettings, support[i] != 0))
             enclosing[i].push_back({v.indices.size() / 3, v.error.bound(), true});
     });
 

@@ -298,9 +298,11 @@ ProxyError measureProxyError(const std::vector<float>& proxyPositions,
 /// contains the object (or `standIn`, the closed solid that stands in for an object that is
 /// not one: its SolidReport, or null) and carries its certified error (world units) in
 /// `error`; `positions`, `indices` and `budget` are filled, the tree fields are not.
-/// Ascending by error. Empty for an object that is not a closed solid and has no stand-in, or
-/// that has a non-finite coordinate or an index out of range. Deterministic, single thread.
+/// Ascending by error. A support surface (`support`, Hierarchy3D::supportObjects) that is not
+/// a closed solid is simplified from a thin solid made for it, as the bake does. Empty for an
+/// other object that is not a closed solid and has no stand-in, or for one that has a
+/// non-finite coordinate or an index out of range. Deterministic, single thread.
 std::vector<HierarchyNode> enclosingVersions(const InputObject& object, const SolidReport* standIn,
-                                             const ProxySettings& settings);
+                                             const ProxySettings& settings, bool support = false);
 
 }  // namespace aggrelod
