@@ -1198,7 +1198,7 @@ bool writeProxiesGlb(const HierarchyNodes& nodes, const std::vector<InputObject>
         int levelCount = 0;
         bool anyColours = false;
         for (const HierarchyNode& n : nodes.nodes) {
-            levelCount = std::max(levelCount, n.lastLevel + 1);
+            levelCount = std::max({levelCount, n.lastLevel + 1, n.bundleLevel + 1});  // the roots' bundles: a level above
             anyColours = anyColours || !n.faceColors.empty() || n.meshPlace.hasFaceColors;
         }
         for (int k = 0; k < levelCount; ++k) {

@@ -202,7 +202,7 @@ bool writeTileset(const HierarchyNodes& nodes, const std::vector<InputObject>& o
         return false;
     }
     int levelCount = 0;
-    for (const HierarchyNode& n : nodes.nodes) levelCount = std::max(levelCount, n.lastLevel + 1);
+    for (const HierarchyNode& n : nodes.nodes) levelCount = std::max({levelCount, n.lastLevel + 1, n.bundleLevel + 1});
     for (uint32_t n : writer.contentNodes()) {
         const HierarchyNode& node = nodes.nodes[n];
         TileMesh tile;

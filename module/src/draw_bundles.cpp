@@ -217,6 +217,38 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                     std::string& error) {
     if (settings.bundleCount <= 0) return true;
     std::vector<HierarchyNode>& nodes = tree.nodes;
+    // A tree of several roots (support surfaces beside the hierarchy, groups the coarsest level
+    // never joined) has its roots bundled too, so that the whole scene far away costs one draw
+    // call: they are planned as the children of a group made for this (last: children come
+    // first), the scene group, at the level above the coarsest. It has no mesh and leaves the
+    // tree afterwards: its coarsest bundle becomes a root, the roots that join none stay roots.
+    uint32_t sceneGroup = kNoNode;
+    if (tree.roots.size() >= 2 && !tree.nodeOfAggregate.empty()) {
+        std::vector<double> eff(nodes.size(), 0.0);  // the largest error on each subtree
+        for (size_t i = 0; i < nodes.size(); ++i) {
+            eff[i] = nodes[i].leaf ? 0.0 : nodes[i].error.bound();
+            for (uint32_t c : nodes[i].children) eff[i] = std::max(eff[i], eff[c]);
+        }
+        HierarchyNode scene;
+        scene.children = tree.roots;
+        for (uint32_t r : tree.roots) {
+            scene.sources.insert(scene.sources.end(), nodes[r].sources.begin(), nodes[r].sources.end());
+            scene.exactTriangleCount += nodes[r].exactTriangleCount;
+            scene.error.proxyToOriginals = std::max(scene.error.proxyToOriginals, eff[r]);
+            scene.delta = std::max(scene.delta, nodes[r].delta);
+        }
+        std::sort(scene.sources.begin(), scene.sources.end());
+        scene.firstLevel = scene.lastLevel = static_cast<int>(tree.nodeOfAggregate.size());
+        sceneGroup = static_cast<uint32_t>(nodes.size());
+        for (uint32_t r : tree.roots) nodes[r].parent = sceneGroup;
+        nodes.push_back(std::move(scene));
+    }
+    // The scene group out again, where nothing was planned at all.
+    const auto dropSceneGroup = [&] {
+        if (sceneGroup == kNoNode) return;
+        for (uint32_t r : nodes[sceneGroup].children) nodes[r].parent = kNoNode;
+        nodes.pop_back();
+    };
     const uint32_t count = static_cast<uint32_t>(nodes.size());
     Planner planner(nodes, versionsAbove);
     // Each object's box, for its groups' diagonals (a group's proxy may be out of memory).
@@ -353,7 +385,10 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
         plans.push_back(std::move(plan));
         planner.addBundles(plans, planOf[g]);
     }
-    if (plans.empty()) return true;
+    if (plans.empty()) {
+        dropSceneGroup();
+        return true;
+    }
     const size_t allBundles = plans.back().firstBundle + plans.back().thresholds.size();
     // Per new top: the bundle it joins (its parent), as an index in the list of all bundles.
     std::vector<uint32_t> bundleAbove(count + allBundles, kNoNode);
@@ -421,6 +456,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
     // Renumbered: each group's bundles left (finest first) just before it (its descendants,
     // the new tops below them included, come before it), also where the group itself goes.
     std::vector<uint32_t> newIndex(count, kNoNode), bundleIndex(allBundles, kNoNode);
+    if (sceneGroup != kNoNode) absorbed[sceneGroup] = 1;  // its bundles, if any, stand for it
     uint32_t next = 0;
     for (uint32_t i = 0; i < count; ++i) {
         if (planOf[i] != kNoNode) {
@@ -439,6 +475,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
                 const uint32_t at = bundleIndex[plan.firstBundle + j];
                 out[at] = std::move(bundles[planOf[i]][j]);
                 if (j + 1 < plan.kept) parentOf[at] = at + 1;
+                else if (i == sceneGroup) parentOf[at] = kNoNode;
                 else if (!absorbed[i]) parentOf[at] = newIndex[i];
                 else parentOf[at] = bundleIndex[bundleAbove[count + plan.firstBundle + j]];
             }

@@ -50,6 +50,13 @@ namespace aggrelod::detail {
 /// triangles than its lightest node within t (a group's versions keep the fill between its
 /// objects, the objects' do not), and their errors are thresholds too.
 ///
+/// A tree of several roots (support surfaces beside the hierarchy, groups the coarsest level
+/// never joined) has its roots bundled the same way, as the children of a scene group made for
+/// this at the level above the coarsest (bundleLevel = nodeOfAggregate.size(), error the
+/// largest of its roots'): the scene group has no mesh and is not kept; its coarsest bundle is
+/// a root, and the roots that join no bundle stay roots. So the whole scene far away costs one
+/// draw call too.
+///
 /// A bundle's certified error is the largest of its parts' (each certified against its own
 /// objects, so the bound holds for all of them); its parts may overlap (a union of closed
 /// shells: closed and edge-manifold, not free of self-intersections). Its sources are the

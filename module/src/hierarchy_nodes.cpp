@@ -1274,10 +1274,9 @@ bool buildNodes(const Hierarchy3D& hierarchy, const std::vector<InputObject>& ob
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         if (leafHasGeometry[o])
             for (size_t i = 0; i + 2 < objects[o].positions.size(); i += 3) growBox(lo, hi, &objects[o].positions[i]);
-        for (int k = 0; k < 3; ++k) {
-            objectBox[o][k] = lo[k], objectBox[o][3 + k] = hi[k];
-            worldLo[k] = std::min(worldLo[k], lo[k]), worldHi[k] = std::max(worldHi[k], hi[k]);
-        }
+        for (int k = 0; k < 3; ++k) objectBox[o][k] = lo[k], objectBox[o][3 + k] = hi[k];
+        if (support[o]) continue;  // the world of the objects that are aggregated
+        for (int k = 0; k < 3; ++k) worldLo[k] = std::min(worldLo[k], lo[k]), worldHi[k] = std::max(worldHi[k], hi[k]);
     }
     const auto centreOf = [&](const HierarchyNode& n) {
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -1807,7 +1806,8 @@ std::vector<HierarchyNode> enclosingVersions(const InputObject& object, const So
 }
 
 uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node) {
-    while (nodes.nodes[node].bundleStep >= 1) node = nodes.nodes[node].parent;
+    // A scene bundle (the roots' bundles, draw_bundles.h) has no aggregate above: the root itself.
+    while (nodes.nodes[node].bundleStep >= 1 && nodes.nodes[node].parent != kNoNode) node = nodes.nodes[node].parent;
     while (nodes.nodes[node].coarserStep >= 1) node = nodes.nodes[node].children.front();
     return node;
 }

@@ -51,7 +51,8 @@ typedef struct aglod_collision aglod_collision;
 /** Level of a coarser version of an aggregate (one child: that aggregate or a finer version). */
 #define AGLOD_COARSER_LEVEL 0xFFFDu
 /** Flag of a bundle's level, AGLOD_BUNDLE_LEVEL_FLAG | k (k: the level of the aggregate it was
- * made for): that aggregate's children's drawn versions merged into one mesh (one draw call). */
+ * made for; the number of levels for the bundles of a bake's several roots): that aggregate's
+ * children's drawn versions merged into one mesh (one draw call). */
 #define AGLOD_BUNDLE_LEVEL_FLAG 0x10000u
 #define AGLOD_NO_INDEX 0xFFFFFFFFu
 

@@ -31,11 +31,12 @@ bool rayInRange(const float o[3], const float d[3], float maxDistance) {
 
 /// Whether bundle `node` of level k stands for its level-k aggregate: that aggregate gave way
 /// to the bundles of a group above (the bundle's parent is neither a bundle of level k nor an
-/// aggregate of level k).
+/// aggregate of level k). A root bundle (the bundles of a bake's several roots) stands for
+/// none.
 bool bundleStandsForItsAggregate(const RuntimeFile& file, uint32_t node) {
     const uint32_t level = file.node(node).level;
     const uint32_t parent = file.node(node).parent;
-    if (parent == kNoIndex) return true;
+    if (parent == kNoIndex) return false;
     const uint32_t above = file.node(parent).level;
     return !(above == level || above == (level & ~kBundleLevelFlag));
 }

@@ -300,11 +300,12 @@ std::vector<ProxyUnderTest> nodeProxies(const AcceptanceScene& s) {
             if (!prepared.validSolid())
                 for (const SolidReport& r : s.baked.hierarchy.solids)
                     if (r.objects == std::vector<uint32_t>{object}) p.expectedShells = shellCount(r.triangles);
+        } else if (n.bundleStep >= 1) {  // a bundle: the parts of at least two children (or roots)
+            p.unionOfParts = true;
+            p.expectedShells = 2;
         } else {
             const HierarchyNode& a = nodes.nodes[aggregateBelow(nodes, i)];
             p.expectedShells = s.baked.hierarchy.levels[size_t(a.firstLevel)].aggregates[a.aggregateIndex].componentCount;
-            p.unionOfParts = n.bundleStep >= 1;
-            if (p.unionOfParts) p.expectedShells = 2;  // a bundle: the parts of at least two children
         }
         out.push_back(std::move(p));
     }

@@ -43,6 +43,7 @@ struct BakedScene {
     fs::path dir;
     std::vector<InputObject> originals;           ///< as the bake read them (same order)
     std::vector<std::vector<InputObject>> levels; ///< exact aggregates per level, from levels.glb
+    std::vector<char> support;                    ///< per original: a support surface (in no level)
     runtime::RuntimeFile file;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double center[3] = {0, 0, 0};
@@ -79,7 +80,10 @@ std::unique_ptr<BakedScene> bakeScene(const std::string& label, const fs::path& 
         s->problem = error;
         return s;
     }
+    s->support.assign(s->originals.size(), 0);
     for (InputObject& o : levels.objects) {  // names "level<k>_group<g>"; support surfaces are not levels
+        if (o.name.rfind("support_", 0) == 0)
+            for (size_t i = 0; i < s->originals.size(); ++i) s->support[i] |= "support_" + s->originals[i].name == o.name;
         if (o.name.rfind("level", 0) != 0) continue;
         const size_t k = std::stoul(o.name.substr(5, o.name.find('_') - 5));
         if (s->levels.size() <= k) s->levels.resize(k + 1);
@@ -208,12 +212,10 @@ void checkConservative(BakedScene& s, size_t hitsPerLevel, ConservativeFigures& 
     std::vector<uint32_t> leafOf(s.originals.size(), runtime::kNoIndex);
     for (uint32_t i = 0; i < f.nodeCount(); ++i)
         if (f.node(i).level == runtime::kLeafLevel) leafOf[f.sources(i)[0]] = i;
-    // Objects in the levels: their leaf has an aggregate above it. A support surface is in
-    // none: its own versions stand for it at every level, and it has no exact aggregate.
+    // A support surface is in no level: its own versions stand for it at every level, and it
+    // has no exact aggregate.
     std::vector<char> inLevels(s.originals.size(), 0);
-    for (size_t o = 0; o < s.originals.size(); ++o)
-        for (uint32_t up = f.node(leafOf[o]).parent; up != runtime::kNoIndex && !inLevels[o]; up = f.node(up).parent)
-            inLevels[o] = f.node(up).level < levelCount;
+    for (size_t o = 0; o < s.originals.size(); ++o) inLevels[o] = !s.support[o];
     const double diameter = 2 * s.radius;
     // Tolerance: the exact aggregates keep the objects' own facets (or, for an open object
     // stood in by its convex hull, the hull's facets through its vertices), re-triangulated
@@ -443,6 +445,47 @@ TEST(RuntimeScenes, ValidCutForRandomCameras) {
                     "fresh); cuts with proxies %zu, with originals %zu, mixed %zu; mean cut %.1f of %u nodes\n",
                     s.label.c_str(), withProxies, withOriginals, mixed, double(totalCut) / 1000, f.nodeCount());
         EXPECT_GT(mixed, 0u) << s.label << ": no camera gave a cut mixing proxies and originals; the test would be weak";
+    }
+}
+
+// A scene whose hierarchy has a support surface beside it (truck_town's racetrack): the
+// surface is in the runtime file with its mesh and its own certified versions, and the
+// roots are bundled, so that the whole scene far away is one draw call.
+TEST(RuntimeScenes, SupportSurfaceIsDrawnAndBundledWithTheScene) {
+    BakedScene& s = scene(SceneId::TruckTown);
+    if (s.problem.rfind("absent", 0) == 0) GTEST_SKIP() << s.problem;
+    ASSERT_TRUE(s.ok) << s.label << ": " << s.problem;
+    const runtime::RuntimeFile& f = s.file;
+    size_t supports = 0;
+    for (uint32_t i = 0; i < f.nodeCount(); ++i) {
+        if (!f.isLeaf(i) || !s.support[f.sources(i)[0]]) continue;
+        ++supports;
+        const InputObject& o = s.originals[f.sources(i)[0]];
+        EXPECT_EQ(f.triangles(i).size, o.indices.size()) << o.name << ": the leaf does not carry the surface";
+        EXPECT_GT(f.node(i).sphereRadius, 0.0f) << o.name;
+        ASSERT_NE(f.node(i).parent, runtime::kNoIndex) << o.name << ": no versions of its own";
+        EXPECT_TRUE(f.isObjectLod(f.node(i).parent)) << o.name;
+    }
+    EXPECT_EQ(supports, 1u) << "truck_town's racetrack is its support surface";
+    ASSERT_EQ(f.roots().size, 1u) << "the hierarchy and the support surface are bundled under one root";
+    EXPECT_TRUE(f.isBundle(f.roots()[0]));
+    EXPECT_EQ(f.sources(f.roots()[0]).size, f.objectCount());
+    // At 16 scene diameters (1080 px, 60 degrees, 1 px), every azimuth: one node.
+    runtime::Selector selector(f);
+    runtime::SelectionSettings settings;
+    settings.pixelTolerance = 1.0f;
+    for (int az = 0; az < 8; ++az) {
+        runtime::Camera c;
+        const double phi = 2 * M_PI * az / 8, r = 16 * 2 * s.radius;
+        c.position[0] = float(s.center[0] + r * std::cos(phi));
+        c.position[1] = float(s.center[1]);
+        c.position[2] = float(s.center[2] + r * std::sin(phi));
+        c.fovY = float(60 * M_PI / 180);
+        c.viewportHeight = 1080.0f;
+        selector.reset();
+        selector.selectFull(c, settings);
+        EXPECT_EQ(selector.cut().size, 1u) << "azimuth " << az;
+        EXPECT_EQ(selector.originalObjects().size, 0u) << "azimuth " << az;
     }
 }
 

@@ -275,8 +275,8 @@ NodeMeshView viewNodeMesh(const HierarchyNodes& nodes, const std::vector<InputOb
 
 /// The aggregate node that coarser version `node` simplifies (the end of its chain of single
 /// children); for a bundle, the aggregate above its chain of bundles (for the bundles of an
-/// aggregate that gave way to a group above, that group's: their own level is bundleLevel);
-/// `node` itself otherwise.
+/// aggregate that gave way to a group above, that group's: their own level is bundleLevel;
+/// for the bundles of a tree's roots, the root, a bundle); `node` itself otherwise.
 /// `node` < nodes.nodes.size().
 uint32_t aggregateBelow(const HierarchyNodes& nodes, uint32_t node);
 

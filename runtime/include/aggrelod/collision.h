@@ -31,7 +31,8 @@ struct CollisionHit {
 /// per-object LOD node (they hang below the level-0 aggregates; the walk would pass through
 /// one to its leaf). Coarser versions and bundles are passed through, except the coarsest
 /// bundle left of a level-k aggregate that gave way to the bundles of a group above (its
-/// parent is a bundle of another level): it stands for that aggregate at level k.
+/// parent is a bundle of another level): it stands for that aggregate at level k. A root
+/// bundle (the bundles of a bake's several roots) stands for none.
 /// `out` is resized to the cut (node indices, increasing).
 void cutAtLevel(const RuntimeFile& file, uint32_t level, std::vector<uint32_t>& out);
 

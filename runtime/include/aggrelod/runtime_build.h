@@ -67,10 +67,13 @@ constexpr uint32_t kMaxAggregateLevel = 0xFF00u;
 /// merged into one mesh, so that a distant group costs one draw call: same objects, error
 /// between the children's and the aggregate's. The bundles of an aggregate form a chain below
 /// it; an aggregate whose children are all bundled may give way to the bundles of a group
-/// above, its finer bundles then hang below that group's finest. A bundle ranks between levels
-/// k - 1 and k; a bundle may stand under another of the same level. No level of its own: a cut
-/// at a level passes through it (cutAtLevel) unless it stands for an aggregate that gave way,
-/// levelsOf lists no level for it otherwise; selection by screen-space error draws it.
+/// above, its finer bundles then hang below that group's finest. The roots of a bake with
+/// several (support surfaces beside the hierarchy) are bundled the same way, at k = the number
+/// of aggregate levels: the coarsest such bundle is a root and stands for no aggregate. A
+/// bundle ranks between levels k - 1 and k; a bundle may stand under another of the same
+/// level. No level of its own: a cut at a level passes through it (cutAtLevel) unless it
+/// stands for an aggregate that gave way, levelsOf lists no level for it otherwise; selection
+/// by screen-space error draws it.
 constexpr uint32_t kBundleLevelFlag = 0x10000u;
 /// True for a bundle's level (kBundleLevelFlag | k with k < kMaxAggregateLevel).
 constexpr bool isBundleLevel(uint32_t level) {

@@ -103,7 +103,7 @@ public:
     /// A coarser version of the aggregate below it (level kCoarserLevel), not a level of its own.
     bool isCoarser(uint32_t node) const { return nodes_.data[node].level == kCoarserLevel; }
     /// A bundle (level kBundleLevelFlag | k): the drawn versions of a level-k aggregate's
-    /// children merged into one mesh, not a level of its own.
+    /// children (or of a bake's several roots) merged into one mesh, not a level of its own.
     bool isBundle(uint32_t node) const { return isBundleLevel(nodes_.data[node].level); }
     /// The whole source-object array (NodeRecord::firstSource indexes it).
     Span<uint32_t> allSourceObjects() const { return sourceObjects_; }
