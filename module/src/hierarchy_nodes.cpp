@@ -434,6 +434,10 @@ std::vector<HierarchyNode> lightestChain(std::vector<HierarchyNode> candidates, 
 /// Error targets of per-object LOD chains: a geometric series sqrt(2) apart, from this
 /// fraction of the object's box diagonal up.
 constexpr double kChainFinestFraction = 1.0 / 1024;
+/// The same for a support surface. It spans at least half the scene, so from a camera one
+/// scene radius from it one pixel (1080 px, 60 degrees) is 1/1000 to 1/2000 of its diagonal,
+/// which a version made for a quarter of that (its budget is twice its target) fits.
+constexpr double kSupportChainFinestFraction = 1.0 / 4096;
 /// An object's versions are measured this many times further (ProxySettings::
 /// maxRefinementsPerDirection) than other proxies: on a large object the bound stops far
 /// above the distance found (truck_town's racetrack: 0.37 against 0.22), which refuses finer
@@ -505,7 +509,8 @@ bool supportSolid(const detail::PreparedObject& surface, double diagonal, std::v
 }
 
 /// Per-object versions (docs/design.md §2.6): conservative simplifications of one object at
-/// error targets sqrt(2) apart, from a thousandth of its diagonal up to its diagonal, and for
+/// error targets sqrt(2) apart, from a thousandth of its diagonal (a support surface's: a
+/// four-thousandth) up to its diagonal, and for
 /// an object of one shell the coarsest enclosing polytope of its convex hull that fits each
 /// target. A candidate counts when it does not intersect itself and its certified error fits
 /// its budget (twice its target). An object that is not a closed solid is simplified from
@@ -527,7 +532,7 @@ VersionLadder objectLadder(const InputObject& object, const detail::PreparedOrig
     detail::prepareObject(object, 1e-14 * diagonal * diagonal, prepared, ignored);
     const std::vector<double>* basePositions = &prepared.positions;
     const std::vector<uint32_t>* baseTriangles = &prepared.triangles;
-    double finest = kChainFinestFraction * diagonal;
+    double finest = (support ? kSupportChainFinestFraction : kChainFinestFraction) * diagonal;
     std::vector<double> ownSolidPositions;
     std::vector<uint32_t> ownSolidTriangles;
     if (!prepared.validSolid() && standIn && standIn->closedManifold && !standIn->triangles.empty()) {

@@ -294,7 +294,7 @@ ProxyError measureProxyError(const std::vector<float>& proxyPositions,
 /// Every certified enclosing version of one object, as the bake makes them for its per-object
 /// LOD chain (docs/design.md §2.6) but not cut at any group's error: conservative
 /// simplifications at error targets sqrt(2) apart from a thousandth of the object's box
-/// diagonal up to the diagonal, and enclosing polytopes of its convex hull. Each is closed,
+/// diagonal (a support surface's: a four-thousandth) up to the diagonal, and enclosing polytopes of its convex hull. Each is closed,
 /// contains the object (or `standIn`, the closed solid that stands in for an object that is
 /// not one: its SolidReport, or null) and carries its certified error (world units) in
 /// `error`; `positions`, `indices` and `budget` are filled, the tree fields are not.
