@@ -224,17 +224,11 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
     // tree afterwards: its coarsest bundle becomes a root, the roots that join none stay roots.
     uint32_t sceneGroup = kNoNode;
     if (tree.roots.size() >= 2 && !tree.nodeOfAggregate.empty()) {
-        std::vector<double> eff(nodes.size(), 0.0);  // the largest error on each subtree
-        for (size_t i = 0; i < nodes.size(); ++i) {
-            eff[i] = nodes[i].leaf ? 0.0 : nodes[i].error.bound();
-            for (uint32_t c : nodes[i].children) eff[i] = std::max(eff[i], eff[c]);
-        }
-        HierarchyNode scene;
+        HierarchyNode scene;  // its error, the largest of its roots', is set below (Planner::eff)
         scene.children = tree.roots;
         for (uint32_t r : tree.roots) {
             scene.sources.insert(scene.sources.end(), nodes[r].sources.begin(), nodes[r].sources.end());
             scene.exactTriangleCount += nodes[r].exactTriangleCount;
-            scene.error.proxyToOriginals = std::max(scene.error.proxyToOriginals, eff[r]);
             scene.delta = std::max(scene.delta, nodes[r].delta);
         }
         std::sort(scene.sources.begin(), scene.sources.end());
@@ -251,6 +245,7 @@ bool addDrawBundles(HierarchyNodes& tree, const std::vector<InputObject>& object
     };
     const uint32_t count = static_cast<uint32_t>(nodes.size());
     Planner planner(nodes, versionsAbove);
+    if (sceneGroup != kNoNode) nodes[sceneGroup].error.proxyToOriginals = planner.eff(sceneGroup);
     // Each object's box, for its groups' diagonals (a group's proxy may be out of memory).
     std::vector<std::array<double, 6>> objectBox(objects.size());
     for (size_t o = 0; o < objects.size(); ++o) {

@@ -483,15 +483,13 @@ bool supportSolid(const detail::PreparedObject& surface, double diagonal, std::v
                   std::vector<uint32_t>& triangles, double& reach) {
     const double offset = kSupportSolidOffsetFraction * diagonal;
     const double alpha = std::max(kSupportSolidAlphaFraction * diagonal, 2 * offset);
+    // As the bake takes a model's solid: valid and closed as the triangulator would see it.
     const auto valid = [&] {
-        InputObject solid;
-        solid.positions = positions;
-        solid.indices = triangles;
-        detail::PreparedObject check;
-        std::vector<Diagnostic> ignored;
-        detail::prepareObject(solid, 0.0, check, ignored);
-        return check.validSolid() && check.positions.size() == positions.size() &&
-               check.triangles.size() == triangles.size();
+        detail::PreparedObject check = detail::checkedSurface(positions, triangles);
+        if (!check.validSolid() || check.positions.size() != positions.size()) return false;
+        positions = std::move(check.positions);
+        triangles = std::move(check.triangles);
+        return true;
     };
     std::string why;
     if (detail::thickenSurface(surface.positions, surface.triangles, offset / 2, offset, alpha, positions, triangles, why) &&

@@ -166,6 +166,16 @@ bool selfIntersects(const std::vector<double>& positions, const std::vector<uint
     return false;
 }
 
+PreparedObject checkedSurface(const std::vector<double>& positions, const std::vector<uint32_t>& triangles) {
+    InputObject surface;
+    surface.positions = positions;
+    surface.indices = triangles;
+    PreparedObject check;
+    std::vector<Diagnostic> ignored;
+    prepareObject(surface, 0.0, check, ignored);
+    return check;
+}
+
 void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject& out,
                    std::vector<Diagnostic>& diagnostics) {
     out = PreparedObject{};

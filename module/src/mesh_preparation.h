@@ -28,6 +28,10 @@ struct PreparedObject {
 void prepareObject(const InputObject& object, double areaEpsilon, PreparedObject& out,
                    std::vector<Diagnostic>& diagnostics);
 
+/// A mesh as the triangulator's input check sees it (prepareObject, no area threshold, no
+/// diagnostics): cleaned, and whether it is a valid closed, edge-manifold solid.
+PreparedObject checkedSurface(const std::vector<double>& positions, const std::vector<uint32_t>& triangles);
+
 /// Whether two triangles of the mesh that share no vertex intersect or touch (exact
 /// triangle-triangle test of mesh_distance.h on the pairs whose boxes overlap, found in a
 /// uniform grid of cells about twice the mean triangle size). Triangles sharing a vertex are

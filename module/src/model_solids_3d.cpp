@@ -18,18 +18,6 @@ namespace aggrelod::detail {
 
 namespace {
 
-/// A surface as the triangulator's input check sees it: cleaned, and whether it is a valid
-/// closed, edge-manifold solid.
-PreparedObject checkedSurface(const std::vector<double>& positions, const std::vector<uint32_t>& triangles) {
-    InputObject surface;
-    surface.positions = positions;
-    surface.indices = triangles;
-    PreparedObject check;
-    std::vector<Diagnostic> ignored;
-    prepareObject(surface, 0.0, check, ignored);
-    return check;
-}
-
 // Sample i of a surface (p, t) for the sampled distances: its vertices, then its triangles'
 // centroids (c: 3 doubles).
 void surfaceSample(const std::vector<double>& p, const std::vector<uint32_t>& t, size_t i, double* c) {

@@ -533,3 +533,44 @@ TEST(HierarchyNodes, EnclosingVersionsOfAnObjectContainItWithinTheirCertifiedErr
     open.indices.resize(open.indices.size() - 3);
     EXPECT_TRUE(enclosingVersions(open, nullptr, ProxySettings{}).empty());
 }
+
+TEST(HierarchyNodes, AnOpenSupportSurfaceGetsVersionsThatContainIt) {
+    // An open, rolling ground (a support surface: the bake made no solid for it) is simplified
+    // from a thin solid made around it: every version closed and outward, containing every
+    // vertex of the surface, within its budget and covering a dense grid measurement.
+    InputObject ground;
+    ground.name = "ground";
+    const int n = 24;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            const double x = i * 100.0 / n, y = j * 100.0 / n;
+            ground.positions.insert(ground.positions.end(), {x, y, 3 * std::sin(x / 15) * std::cos(y / 20)});
+        }
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+            ground.indices.insert(ground.indices.end(), {a, b, d, a, d, c});
+        }
+    EXPECT_TRUE(enclosingVersions(ground, nullptr, ProxySettings{}).empty()) << "not a support surface: no solid";
+    const std::vector<HierarchyNode> versions = enclosingVersions(ground, nullptr, ProxySettings{}, true);
+    ASSERT_GE(versions.size(), 2u);
+    for (size_t i = 0; i < versions.size(); ++i) {
+        const HierarchyNode& v = versions[i];
+        EXPECT_LE(v.error.bound(), v.budget) << "version " << i;
+        InputObject mesh;
+        mesh.positions.assign(v.positions.begin(), v.positions.end());
+        mesh.indices = v.indices;
+        EXPECT_EQ(aggrelod::testing::checkClosedAfterWeld(mesh).problem, "") << "version " << i;
+        EXPECT_GT(aggrelod::testing::signedVolumeOf(mesh), 0.0) << "version " << i;
+        detail::TriangleBvh surface;
+        surface.build(mesh.positions.data(), mesh.positions.size() / 3, v.indices.data(), v.indices.size() / 3);
+        for (size_t k = 0; k + 2 < ground.positions.size(); k += 3) {
+            const bool on = detail::closestPoint(surface, &ground.positions[k]).distance <= 1e-6;
+            EXPECT_TRUE(on || aggrelod::testing::windingNumber(mesh.positions, v.indices, &ground.positions[k]) > 0.5)
+                << "version " << i << ", vertex " << k / 3;
+        }
+        const aggrelod::testing::GridMeasured m = aggrelod::testing::gridMeasure(v.positions, v.indices, {&ground}, 6);
+        EXPECT_GE(v.error.bound() + 1e-9, m.proxyToOriginals) << "version " << i;
+    }
+    EXPECT_LT(versions.back().indices.size() * 4, ground.indices.size());
+}
